@@ -1,0 +1,159 @@
+// DAG -> tape compilation (topological order, linear-scan register reuse) and tape pruning.
+#include "frep/tape.h"
+
+#include <algorithm>
+#include <atomic>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace frep {
+
+namespace {
+std::atomic<uint64_t> gNextTapeId{1};
+bool isChoiceOp(Op op) { return op == Op::Min || op == Op::Max || op == Op::Select; }
+}  // namespace
+
+struct TapeBuilder {
+  static TapePtr make() { return TapePtr(new Tape()); }
+  static Tape& mut(const TapePtr& t) { return const_cast<Tape&>(*t); }
+};
+
+TapePtr Tape::compile(const Expr& e, uint32_t nvars) {
+  // 1. Topological order of the distinct nodes (children first).
+  std::vector<const Node*> order;
+  forEachNode(e, [&](const Node& n) { order.push_back(&n); });
+
+  nvars = std::max(nvars, frep::numVars(e));
+  auto uniforms = std::make_shared<std::vector<double>>();
+  std::unordered_map<const Node*, uint32_t> constReg;
+  std::unordered_map<const Node*, size_t> position;
+  for (size_t i = 0; i < order.size(); ++i) {
+    const Node* n = order[i];
+    position[n] = i;
+    if (n->op == Op::Param)
+      throw std::invalid_argument("Tape::compile: parameter a[" + std::to_string(n->index + 1) +
+                                  "] is not bound (call bindParams first)");
+    if (n->op == Op::Const) {
+      constReg[n] = static_cast<uint32_t>(uniforms->size());
+      uniforms->push_back(n->value);
+    }
+  }
+  const uint32_t nu = static_cast<uint32_t>(uniforms->size());
+
+  // 2. Last reader of each node.
+  std::unordered_map<const Node*, size_t> lastUse;
+  for (size_t i = 0; i < order.size(); ++i)
+    for (int k = 0; k < opArity(order[i]->op); ++k) lastUse[order[i]->args[k].get()] = i;
+
+  // 3. Linear-scan allocation of temporaries; inputs whose last use is this instruction are
+  //    freed before the output is allocated, so an output may reuse an input's register.
+  std::unordered_map<const Node*, uint32_t> reg;
+  std::vector<uint32_t> freeRegs;
+  uint32_t next = nu + nvars;
+  TapePtr tape = TapeBuilder::make();
+  Tape& t = TapeBuilder::mut(tape);
+  auto regOf = [&](const Node* n) -> uint32_t {
+    if (n->op == Op::Const) return constReg.at(n);
+    if (n->op == Op::Var) return nu + n->index;
+    return reg.at(n);
+  };
+  for (size_t i = 0; i < order.size(); ++i) {
+    const Node* n = order[i];
+    int arity = opArity(n->op);
+    if (arity == 0) continue;
+    Instr ins;
+    ins.op = n->op;
+    ins.imm = n->value;
+    uint32_t in[3] = {0, 0, 0};
+    for (int k = 0; k < arity; ++k) in[k] = regOf(n->args[k].get());
+    ins.a = in[0];
+    ins.b = in[1];
+    ins.c = in[2];
+    for (int k = 0; k < arity; ++k) {
+      const Node* child = n->args[k].get();
+      if (child->op == Op::Const || child->op == Op::Var) continue;
+      if (lastUse.at(child) == i && reg.count(child)) {
+        freeRegs.push_back(reg.at(child));
+        reg.erase(child);
+      }
+    }
+    uint32_t out;
+    if (!freeRegs.empty()) {
+      // lowest free register keeps the file compact and the allocation deterministic
+      auto it = std::min_element(freeRegs.begin(), freeRegs.end());
+      out = *it;
+      freeRegs.erase(it);
+    } else {
+      out = next++;
+    }
+    ins.out = out;
+    reg[n] = out;
+    if (isChoiceOp(n->op)) ++t.numChoices_;
+    t.code_.push_back(ins);
+  }
+  t.numVars_ = nvars;
+  t.numRegs_ = next;
+  t.uniforms_ = uniforms;
+  t.result_ = regOf(&e.node());
+  t.id_ = gNextTapeId++;
+  return tape;
+}
+
+TapePtr Tape::prune(const std::vector<Choice>& choices, const TapePtr& self) const {
+  if (choices.size() != code_.size()) throw std::invalid_argument("Tape::prune: choice count");
+  bool any = false;
+  for (size_t i = 0; i < code_.size(); ++i)
+    if (choices[i] != Choice::Both && isChoiceOp(code_[i].op)) any = true;
+  if (!any) return self;
+
+  // Rewrite decided instructions into copies, then drop what is no longer read. Walking
+  // backwards with the set of registers still needed is exact even with register reuse,
+  // because every instruction's write kills the register's previous value.
+  std::vector<Instr> code = code_;
+  for (size_t i = 0; i < code.size(); ++i) {
+    Instr& ins = code[i];
+    if (!isChoiceOp(ins.op) || choices[i] == Choice::Both) continue;
+    uint32_t src;
+    if (ins.op == Op::Select) src = choices[i] == Choice::KeepA ? ins.b : ins.c;
+    else src = choices[i] == Choice::KeepA ? ins.a : ins.b;
+    ins = Instr{Op::Copy, ins.out, src, 0, 0, 0.0};
+  }
+  std::vector<char> needed(numRegs_, 0);
+  needed[result_] = 1;
+  std::vector<Instr> kept;
+  kept.reserve(code.size());
+  for (size_t i = code.size(); i-- > 0;) {
+    const Instr& ins = code[i];
+    if (!needed[ins.out]) continue;
+    needed[ins.out] = 0;
+    int arity = opArity(ins.op);
+    if (arity > 0) needed[ins.a] = 1;
+    if (arity > 1) needed[ins.b] = 1;
+    if (arity > 2) needed[ins.c] = 1;
+    kept.push_back(ins);
+  }
+  std::reverse(kept.begin(), kept.end());
+
+  // A copy into the result register at the very end can be folded away by redirecting the
+  // result (saves one pass over the batch).
+  uint32_t result = result_;
+  while (!kept.empty() && kept.back().op == Op::Copy && kept.back().out == result) {
+    result = kept.back().a;
+    kept.pop_back();
+  }
+
+  TapePtr out = TapeBuilder::make();
+  Tape& t = TapeBuilder::mut(out);
+  t.numVars_ = numVars_;
+  t.numRegs_ = numRegs_;
+  t.uniforms_ = uniforms_;
+  t.result_ = result;
+  t.code_ = std::move(kept);
+  for (auto& ins : t.code_)
+    if (isChoiceOp(ins.op)) ++t.numChoices_;
+  t.root_ = root_ ? root_ : self;
+  t.id_ = gNextTapeId++;
+  return out;
+}
+
+}  // namespace frep
