@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(
   build-essential cmake pkg-config
-  libopenvdb-dev libopenvdb-tools python3-openvdb
+  libopenvdb-dev libopenvdb-tools python3-openvdb libboost-iostreams-dev
   cppzmq-dev libzmq3-dev
   libprotobuf-dev protobuf-compiler
   libspdlog-dev libtbb-dev libcli11-dev nlohmann-json3-dev libeigen3-dev

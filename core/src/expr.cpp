@@ -389,52 +389,56 @@ Expr bindParams(const Expr& e, const std::vector<Expr>& params) {
 }
 
 Expr derivative(const Expr& e, uint32_t var) {
-  // Forward rules per node, memoised: d[n] = d n / d x[var].
+  // Forward rules per node, memoised: d[n] = d n / d x[var]. Each rule is a sum of
+  // partial * input-derivative terms; a term whose input derivative is the constant 0 is
+  // dropped (not multiplied out), so constant sub-expressions cost nothing and an infinite
+  // partial (sqrt at 0, pow at 0, ...) times a constant input gives 0, not NaN. The
+  // GradientEvaluator follows the same conventions.
   std::unordered_map<const Node*, Expr> d;
+  auto term = [](const Expr& partial, const Expr& dx) { return dx.isConst(0.0) ? Expr(0.0) : partial * dx; };
   forEachNode(e, [&](const Node& n) {
     auto D = [&](int i) { return d.at(n.args[i].get()); };
     Expr a = opArity(n.op) > 0 ? Expr(n.args[0]) : Expr();
     Expr b = opArity(n.op) > 1 ? Expr(n.args[1]) : Expr();
+    auto unary = [&](const Expr& pa) { return term(pa, D(0)); };
+    auto binary = [&](const Expr& pa, const Expr& pb) { return term(pa, D(0)) + term(pb, D(1)); };
     Expr r;
     switch (n.op) {
       case Op::Const: case Op::Param: r = 0.0; break;
       case Op::Var: r = n.index == var ? 1.0 : 0.0; break;
       case Op::Neg: r = -D(0); break;
-      case Op::Abs: r = D(0) * sign(a); break;
-      case Op::Sqrt: r = select(gt(a, 0.0), D(0) / (2.0 * sqrt(a)), 0.0); break;
-      case Op::Exp: r = D(0) * exp(a); break;
-      case Op::Log: r = select(gt(a, kLogFloor), D(0) / a, 0.0); break;
-      case Op::Log10: r = select(gt(a, kLogFloor), D(0) / (a * std::log(10.0)), 0.0); break;
-      case Op::Sin: r = D(0) * cos(a); break;
-      case Op::Cos: r = -(D(0) * sin(a)); break;
-      case Op::Tan: r = D(0) * (1.0 + square(tan(a))); break;
-      case Op::Asin: r = select(lt(abs(a), 1.0), D(0) / sqrt(1.0 - square(a)), 0.0); break;
-      case Op::Acos: r = select(lt(abs(a), 1.0), -(D(0) / sqrt(1.0 - square(a))), 0.0); break;
-      case Op::Atan: r = D(0) / (1.0 + square(a)); break;
-      case Op::Sinh: r = D(0) * cosh(a); break;
-      case Op::Cosh: r = D(0) * sinh(a); break;
-      case Op::Tanh: r = D(0) * (1.0 - square(tanh(a))); break;
+      case Op::Abs: r = unary(sign(a)); break;
+      case Op::Sqrt: r = unary(select(gt(a, 0.0), 1.0 / (2.0 * sqrt(a)), 0.0)); break;
+      case Op::Exp: r = unary(exp(a)); break;
+      case Op::Log: r = unary(select(gt(a, kLogFloor), 1.0 / a, 0.0)); break;
+      case Op::Log10: r = unary(select(gt(a, kLogFloor), 1.0 / (a * std::log(10.0)), 0.0)); break;
+      case Op::Sin: r = unary(cos(a)); break;
+      case Op::Cos: r = unary(-sin(a)); break;
+      case Op::Tan: r = unary(1.0 + square(tan(a))); break;
+      case Op::Asin: r = unary(select(lt(abs(a), 1.0), 1.0 / sqrt(1.0 - square(a)), 0.0)); break;
+      case Op::Acos: r = unary(select(lt(abs(a), 1.0), -1.0 / sqrt(1.0 - square(a)), 0.0)); break;
+      case Op::Atan: r = unary(1.0 / (1.0 + square(a))); break;
+      case Op::Sinh: r = unary(cosh(a)); break;
+      case Op::Cosh: r = unary(sinh(a)); break;
+      case Op::Tanh: r = unary(1.0 - square(tanh(a))); break;
       case Op::Floor: case Op::Ceil: case Op::Trunc: case Op::Not:
       case Op::Lt: case Op::Le: case Op::Gt: case Op::Ge: case Op::Eq: case Op::Ne:
       case Op::And: case Op::Or:
         r = 0.0;
         break;
-      case Op::Frac: r = D(0); break;
-      case Op::PowI: r = D(0) * n.value * Expr::powi(a, static_cast<int>(n.value) - 1); break;
-      case Op::Copy: r = D(0); break;
+      case Op::Frac: case Op::Copy: r = D(0); break;
+      case Op::PowI: r = unary(n.value * Expr::powi(a, static_cast<int>(n.value) - 1)); break;
       case Op::Add: r = D(0) + D(1); break;
       case Op::Sub: r = D(0) - D(1); break;
-      case Op::Mul: r = D(0) * b + a * D(1); break;
-      case Op::Div: r = (D(0) * b - a * D(1)) / square(b); break;
-      case Op::Pow: {
-        Expr p = pow(a, b);
-        r = p * (D(1) * log(a) + b * D(0) / a);
-        break;
-      }
-      case Op::Atan2: r = (b * D(0) - a * D(1)) / (square(a) + square(b)); break;
+      case Op::Mul: r = binary(b, a); break;
+      case Op::Div: r = binary(1.0 / b, -a / square(b)); break;
+      // d/da a^b = b a^(b-1): finite at a = 0 for b >= 1 and right for a < 0 with integer b
+      // (the former p * b / a form gave NaN at a = 0). d/db = a^b log a, log with its floor.
+      case Op::Pow: r = binary(b * pow(a, b - 1.0), pow(a, b) * log(a)); break;
+      case Op::Atan2: r = binary(b / (square(a) + square(b)), -a / (square(a) + square(b))); break;
       case Op::Min: r = select(lt(b, a), D(1), D(0)); break;
       case Op::Max: r = select(gt(b, a), D(1), D(0)); break;
-      case Op::Fmod: r = D(0) - trunc(a / b) * D(1); break;
+      case Op::Fmod: r = binary(1.0, -trunc(a / b)); break;
       case Op::Select: r = select(a, D(1), D(2)); break;
       case Op::Count_: break;
     }

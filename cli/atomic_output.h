@@ -1,0 +1,28 @@
+// An output file that appears complete or not at all: it is written to a temporary file next to
+// the target (same directory, so rename() is atomic) and renamed on commit(). Destroying it
+// without commit() removes the temporary file.
+#pragma once
+
+#include <string>
+
+namespace frep::cli {
+
+class AtomicOutput {
+ public:
+  // Creates the temporary file now, so an unwritable path fails before any work is done.
+  // Throws CliError(kExitIoError) naming `field` and the path.
+  AtomicOutput(const std::string& field, const std::string& path);
+  ~AtomicOutput();
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+
+  const std::string& tempPath() const { return temp_; }
+  const std::string& path() const { return path_; }
+  void commit();  // rename temp -> path; throws CliError(kExitIoError)
+
+ private:
+  std::string field_, path_, temp_;
+  bool committed_ = false;
+};
+
+}  // namespace frep::cli

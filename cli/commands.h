@@ -1,0 +1,46 @@
+// The frep verbs, one function each (one file each: check_command.cpp, ...). Each returns the
+// exit code or throws CliError; main() wires them to the command line.
+#pragma once
+
+#include <string>
+
+#include "model_loader.h"
+
+namespace frep::cli {
+
+// frep check: diagnostics and the list of objects.
+int runCheck(const ModelRequest& model);
+
+struct EvalRequest {
+  ModelRequest model;
+  std::string at;           // --at: one value per coordinate
+  double tolerance = 1e-9;  // |f| <= tolerance counts as on the surface
+};
+int runEval(const EvalRequest& request);
+
+// Shared by the verbs that sample a region.
+struct RegionRequest {
+  std::string bounds;  // -b/--bounds text; "" = hfp's default ±10
+  int res = 0;         // --res; 0 = not given
+  std::string cells;   // -g/--grid text; "" = not given
+  std::string out;     // -O/--out
+};
+
+struct SliceRequest {
+  ModelRequest model;
+  RegionRequest region;
+  std::string axis;  // "" = z (3D objects); ignored for 2D objects
+  double at = 0.0;   // position of the slicing plane on that axis
+};
+int runSlice(const SliceRequest& request);
+
+struct SampleRequest {
+  ModelRequest model;
+  RegionRequest region;
+  int band = 3;     // narrow band half-width in voxels
+  int threads = 0;  // 0: all cores
+  std::string commandLine;  // recorded in the grid's metadata
+};
+int runSample(const SampleRequest& request);
+
+}  // namespace frep::cli

@@ -1,0 +1,33 @@
+// The frep command's exit codes (documented in docs/cli.md and `frep --help`) and the error
+// type commands throw to end with one of them.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace frep::cli {
+
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitModelError = 1,  // the model has errors (diagnostics were printed)
+  kExitBadArgs = 2,     // a command-line argument is missing or malformed
+  kExitIoError = 3,     // a file could not be read or written
+  kExitInternal = 4,    // a bug or an unexpected failure inside frep
+};
+
+// What a user reads after "frep --help".
+inline const char* exitCodeHelp() {
+  return "Exit codes: 0 ok, 1 model error (diagnostics printed), 2 bad arguments, "
+         "3 I/O error, 4 internal error.";
+}
+
+// Thrown anywhere in a command; main prints what() and exits with code.
+struct CliError : std::runtime_error {
+  int code;
+  CliError(int c, const std::string& message) : std::runtime_error(message), code(c) {}
+};
+
+inline CliError badArgs(const std::string& message) { return {kExitBadArgs, message}; }
+inline CliError ioError(const std::string& message) { return {kExitIoError, message}; }
+
+}  // namespace frep::cli

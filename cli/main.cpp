@@ -1,0 +1,127 @@
+// The frep command: argument wiring, logging setup and the mapping of failures to exit codes.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "commands.h"
+#include "exit_codes.h"
+
+#ifndef FREP_VERSION
+#define FREP_VERSION "unknown"
+#endif
+
+namespace {
+
+using namespace frep::cli;
+
+// Recorded in output metadata: quoted so that it can be pasted back into a shell.
+std::string joinCommandLine(int argc, char** argv) {
+  std::string line;
+  for (int i = 0; i < argc; ++i) {
+    std::string arg = argv[i];
+    bool plain = !arg.empty() && arg.find_first_not_of(
+        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_.,/=:+@%") == std::string::npos;
+    if (!plain) {
+      std::string quoted = "'";
+      for (char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+      arg = quoted + "'";
+    }
+    line += (i ? " " : "") + arg;
+  }
+  return line;
+}
+
+void addModelOptions(CLI::App* sub, ModelRequest& m, bool withFieldOptions) {
+  sub->add_option("model", m.path, "The HyperFun model (.hf)")->required();
+  sub->add_option("-o,--object", m.object, "Object to use (as hfp: default my_model, else the first)");
+  if (!withFieldOptions) return;
+  sub->add_option("-a,--params", m.params, "Values of a[1..m], comma-separated (default all 0)");
+  sub->add_option("-x,--map", m.mapping,
+                  "Map x[1..n] to axes X, Y, Z or constants, e.g. X,Y,Z,0.5 (default: x[4..] = 0)");
+  sub->add_option("-i,--iso", m.iso, "Isovalue: the solid is f >= iso (default 0)");
+}
+
+void addRegionOptions(CLI::App* sub, RegionRequest& r, const std::string& outHelp, int defaultRes) {
+  sub->add_option("-b,--bounds", r.bounds, "Box: B | min,max | bx,by,bz | xmin,ymin,zmin,xmax,ymax,zmax (default 10)");
+  sub->add_option("--res", r.res, "Points along the longest axis (default " + std::to_string(defaultRes) + ")");
+  sub->add_option("-g,--grid", r.cells, "Cells per axis, hfp style: N or Nx,Ny,Nz (instead of --res)");
+  sub->add_option("-O,--out", r.out, outHelp + " (required)");  // required: checked by the command, after -o
+}
+
+void checkObjectIsNotAFile(const ModelRequest& m) {
+  if (m.object.find_first_of("./") != std::string::npos)
+    throw badArgs("-o/--object: '" + m.object +
+                  "' looks like a file name; -o selects the object (as in hfp), write files with -O/--out");
+}
+
+void setUpLogging(const std::string& level) {
+  auto logger = spdlog::stderr_color_mt("frep");
+  logger->set_pattern("frep: %^%l%$: %v");
+  logger->set_level(spdlog::level::from_str(level));
+  spdlog::set_default_logger(logger);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"frep " FREP_VERSION ": evaluate, slice and sample F-rep models written in HyperFun (.hf)."};
+  app.footer(std::string(exitCodeHelp()) + "\nOptions -o (object), -a, -b, -g, -i, -x follow hfp; "
+             "output files are -O/--out. See docs/cli.md.");
+  app.require_subcommand(1);
+  app.set_version_flag("--version", FREP_VERSION);
+  std::string logLevel = "info";
+  app.add_option("--log-level", logLevel, "trace, debug, info, warn, error, critical or off (default info)")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+
+  ModelRequest checkModel;
+  CLI::App* check = app.add_subcommand("check", "Compile a model: print diagnostics and list its objects");
+  addModelOptions(check, checkModel, false);
+
+  EvalRequest eval;
+  CLI::App* evalCmd = app.add_subcommand("eval", "Value, in/on/out and gradient of f at one point");
+  addModelOptions(evalCmd, eval.model, true);
+  evalCmd->add_option("--at", eval.at, "The point: one value per coordinate, e.g. 1,0,0")->required();
+  evalCmd->add_option("--tolerance", eval.tolerance, "|f| <= tolerance is 'on' (default 1e-9)");
+
+  SliceRequest slice;
+  CLI::App* sliceCmd = app.add_subcommand("slice", "Heat map PNG of f on a plane, zero contour in black");
+  addModelOptions(sliceCmd, slice.model, true);
+  addRegionOptions(sliceCmd, slice.region, "Output PNG file", 512);
+  sliceCmd->add_option("--axis", slice.axis, "Axis normal to the plane: x, y or z (default z; not for 2D objects)");
+  sliceCmd->add_option("--at", slice.at, "Position of the plane on that axis (default 0)");
+
+  SampleRequest sample;
+  CLI::App* sampleCmd = app.add_subcommand("sample", "Narrow-band OpenVDB level set (stores -f) of a model");
+  addModelOptions(sampleCmd, sample.model, true);
+  addRegionOptions(sampleCmd, sample.region, "Output .vdb file", 128);
+  sampleCmd->add_option("--band", sample.band, "Band half-width in voxels (default 3)");
+  sampleCmd->add_option("--threads", sample.threads, "Threads (default 0: all cores)");
+
+  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd}) sub->fallthrough();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::cerr << "frep: error: " << e.what() << "\nRun 'frep --help' for usage.\n";
+    return kExitBadArgs;
+  }
+
+  setUpLogging(logLevel);
+  try {
+    if (check->parsed()) return checkObjectIsNotAFile(checkModel), runCheck(checkModel);
+    if (evalCmd->parsed()) return checkObjectIsNotAFile(eval.model), runEval(eval);
+    if (sliceCmd->parsed()) return checkObjectIsNotAFile(slice.model), runSlice(slice);
+    sample.commandLine = joinCommandLine(argc, argv);
+    checkObjectIsNotAFile(sample.model);
+    return runSample(sample);
+  } catch (const CliError& e) {
+    std::cerr << "frep: error: " << e.what() << "\n";
+    return e.code;
+  } catch (const std::exception& e) {
+    std::cerr << "frep: internal error: " << e.what() << "\n";
+    return kExitInternal;
+  }
+}

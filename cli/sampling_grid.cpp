@@ -1,0 +1,43 @@
+#include "sampling_grid.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "exit_codes.h"
+
+namespace frep::cli {
+
+GridSpec makeGrid(const Box& box, int axes, const Resolution& r) {
+  GridSpec g;
+  g.origin = box.lo;
+  double voxel = 0.0;
+  for (int a = 0; a < axes; ++a) {
+    double extent = box.hi[a] - box.lo[a];
+    voxel = std::max(voxel, r.res > 0 ? extent / double(r.res - 1) : extent / double(r.cells[a]));
+  }
+  g.voxel = voxel;
+  for (int a = 0; a < 3; ++a) {
+    if (a >= axes) { g.dims[a] = 1; continue; }
+    // 1e-9: an extent that is a whole number of voxels up to rounding gets no extra point.
+    double steps = std::ceil((box.hi[a] - box.lo[a]) / voxel - 1e-9);
+    g.dims[a] = static_cast<int32_t>(steps) + 1;
+  }
+  return g;
+}
+
+Resolution resolutionFrom(int res, const std::string& cellsText, int defaultRes) {
+  Resolution r;
+  if (!cellsText.empty()) {
+    if (res != 0) throw badArgs("--res and -g/--grid: give one of them, not both");
+    r.cells = parseCells("-g/--grid", cellsText);
+    return r;
+  }
+  if (res == 0) res = defaultRes;
+  if (res < 2 || res > kMaxCells + 1)
+    throw badArgs("--res: expected an integer from 2 to " + std::to_string(kMaxCells + 1) + ", got " +
+                  std::to_string(res));
+  r.res = res;
+  return r;
+}
+
+}  // namespace frep::cli

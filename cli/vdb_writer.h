@@ -1,0 +1,27 @@
+// Sampler output -> OpenVDB level set file. The only translation unit that includes OpenVDB
+// (its headers take ~25 s to compile).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "frep/sample.h"
+
+namespace frep::cli {
+
+struct VdbMetadata {
+  std::string gridName;     // the object's name
+  std::string commandLine;  // as typed
+  std::string params;       // -a as given ("" = none)
+  uint64_t sourceHash = 0;  // lang::Model::sourceHash
+  double iso = 0.0;
+};
+
+// Writes one FloatGrid of class level set holding -f (negative inside, as OpenVDB expects):
+// leaf voxels from the sampler (active in the band), tiles and the background at ±band*voxel,
+// the grid's transform (voxel size, translated to the grid origin) and metadata
+// frep_sign = "value = -f", frep_model_hash, frep_object, frep_command, frep_band_voxels,
+// frep_band, frep_iso, frep_params, frep_version. Throws CliError(kExitIoError).
+void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta);
+
+}  // namespace frep::cli

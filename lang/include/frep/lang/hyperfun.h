@@ -1,0 +1,52 @@
+// HyperFun front end: source text -> checked, lowered models (core expressions).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "frep/expr.h"
+
+namespace frep::lang {
+
+struct Diagnostic {
+  enum class Severity { Error, Warning, Note } severity = Severity::Error;
+  std::string file;
+  int line = 0, column = 0;  // 1-based; 0 when not tied to a place
+  std::string message;
+  std::string sourceLine;    // the line's text, for the caret display
+  // "file:line:column: error: message\n  <line>\n  ^"
+  std::string format() const;
+};
+
+struct ObjectInfo {
+  std::string name;  // lower-cased, as HyperFun compares names
+  int xSize = 0, aSize = 0, sSize = 0;
+  int line = 0;
+};
+
+struct Model {
+  std::string objectName;  // the selected object
+  int xSize = 0;           // dimension n of x[n]
+  int aSize = 0;           // size of a[m]
+  Expr field;              // f(x, a) with x as Expr::x(i), a as Expr::param(i) (0-based)
+  uint64_t sourceHash = 0; // hash of the source text (metadata, caches)
+};
+
+struct CompileResult {
+  std::vector<Diagnostic> diagnostics;  // errors and warnings in source order
+  std::vector<ObjectInfo> objects;      // every object in the file
+  bool ok = false;                      // no errors and a model was selected
+  Model model;
+};
+
+struct CompileOptions {
+  std::string object;  // object to select: this name, else "my_model", else the first
+  // Loop unrolling limit: total loop iterations per object before "loop does not terminate".
+  long maxLoopIterations = 1000000;
+};
+
+CompileResult compile(const std::string& source, const std::string& fileName,
+                      const CompileOptions& options = {});
+CompileResult compileFile(const std::string& path, const CompileOptions& options = {});
+
+}  // namespace frep::lang

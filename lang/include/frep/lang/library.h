@@ -1,0 +1,49 @@
+// The registry of callable library functions: HyperFun's hf* library and frepfarm's fr*
+// extensions. Each function lowers its call to core expressions at compile time.
+#pragma once
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "frep/expr.h"
+
+namespace frep::lang {
+
+// One argument of a call: a scalar expression, or an array of per-element expressions.
+// Array arguments are passed by reference: transformations (hfShift3D, ...) mutate them in
+// place and the caller sees the change for the rest of the object (HyperFun semantics).
+struct Arg {
+  bool isArray = false;
+  Expr value;                          // when !isArray
+  std::vector<Expr>* array = nullptr;  // when isArray
+  std::string name;                    // array name as written, for messages
+};
+
+// Thrown by a library function on bad arguments (wrong array size, ...). The lowering turns it
+// into a diagnostic at the call's (or the argument's, if argIndex >= 0) line and column.
+struct LibraryError : std::runtime_error {
+  int argIndex;
+  LibraryError(const std::string& what, int arg = -1) : std::runtime_error(what), argIndex(arg) {}
+};
+
+struct LibraryFunction {
+  std::string name;       // canonical spelling, e.g. "hfSphere" (lookup is case-insensitive)
+  std::string signature;  // one letter per argument: 'A' array, 'S' scalar, e.g. "AAS"
+  std::string summary;    // one line: formula or effect (docs/language.md, `frep check` help)
+  // Returns the call's value: a primitive's field, or 1 for transformations.
+  std::function<Expr(std::vector<Arg>& args)> lower;
+};
+
+// Registration happens at static-init time from each library source file.
+void registerLibraryFunction(LibraryFunction fn);
+const LibraryFunction* findLibraryFunction(std::string_view name);  // case-insensitive
+const std::vector<LibraryFunction>& libraryFunctions();             // sorted by name
+
+// Helper for registration at namespace scope in a .cpp file:
+//   static const bool reg = registerAll({ {...}, {...} });
+bool registerAll(std::vector<LibraryFunction> fns);
+
+}  // namespace frep::lang

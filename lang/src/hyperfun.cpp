@@ -1,0 +1,90 @@
+// Entry points: source text -> diagnostics, object list and the selected object's model.
+#include "frep/lang/hyperfun.h"
+
+#include <cctype>
+#include <fstream>
+#include <sstream>
+
+#include "frep/lang/diagnostics.h"
+#include "frep/lang/lexer.h"
+#include "frep/lang/lower.h"
+#include "frep/lang/parser.h"
+
+namespace frep::lang {
+namespace {
+
+uint64_t fnv1a(const std::string& s) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::string lowerCase(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// options.object, else "my_model", else the first object (hfp's rule).
+int selectObject(const std::vector<LoweredObject>& objs, const CompileOptions& options,
+                 DiagnosticSink& diags) {
+  auto find = [&](const std::string& name) {
+    for (size_t i = 0; i < objs.size(); ++i)
+      if (objs[i].info.name == name) return static_cast<int>(i);
+    return -1;
+  };
+  if (objs.empty()) return -1;
+  if (!options.object.empty()) {
+    int i = find(lowerCase(options.object));
+    if (i >= 0) return i;
+  }
+  int i = find("my_model");
+  if (i < 0) i = 0;
+  if (!options.object.empty())
+    diags.warning(Loc{}, "no object named '" + options.object + "'; using '" +
+                             objs[i].info.name + "'");
+  return i;
+}
+
+}  // namespace
+
+CompileResult compile(const std::string& source, const std::string& fileName,
+                      const CompileOptions& options) {
+  CompileResult result;
+  DiagnosticSink diags(fileName, source);
+  std::vector<Token> tokens = lex(source, diags);
+  Program program = parse(tokens, diags);
+  std::vector<LoweredObject> lowered = lowerProgram(program, options, diags);
+  for (const auto& o : lowered) result.objects.push_back(o.info);
+  int sel = selectObject(lowered, options, diags);
+  if (sel >= 0) {
+    const LoweredObject& o = lowered[sel];
+    result.model.objectName = o.info.name;
+    result.model.xSize = o.info.xSize;
+    result.model.aSize = o.info.aSize;
+    result.model.field = o.field;
+    result.model.sourceHash = fnv1a(source);
+    result.ok = o.ok && diags.errorCount() == 0;
+  }
+  result.diagnostics = diags.take();
+  return result;
+}
+
+CompileResult compileFile(const std::string& path, const CompileOptions& options) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    CompileResult r;
+    Diagnostic d;
+    d.file = path;
+    d.message = "cannot open file";
+    r.diagnostics.push_back(d);
+    return r;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return compile(ss.str(), path, options);
+}
+
+}  // namespace frep::lang

@@ -1,0 +1,158 @@
+// HyperFun's convolution surfaces with the Cauchy kernel k(r) = 1 / (1 + S^2 r^2)^2
+// (McCormack and Sherstyuk 1998): the field is the kernel integrated over a skeleton, minus a
+// threshold T. Sums over skeleton elements unroll (array sizes are known at compile time).
+#include <string>
+
+#include "lib_hf_util.h"
+
+namespace frep::lang::hf {
+namespace {
+
+Vec3 at(const std::vector<Expr>& v, size_t i) { return {v[i], v[i + 1], v[i + 2]}; }
+Vec3 minus(const Vec3& a, const Vec3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
+// Kernel integrated along the segment b -> e:
+// t/(2p^2(p^2+S^2t^2)) + (l-t)/(2p^2q^2) + (atan(St/p) + atan(S(l-t)/p))/(2Sp^3),
+// t = (x-b).(e-b)/l, p^2 = 1 + S^2(|x-b|^2 - t^2), q^2 = 1 + S^2(|x-b|^2 + l^2 - 2lt).
+Expr segment(const Vec3& x, const Vec3& b, const Vec3& e, const Expr& S) {
+  Vec3 d = minus(x, b), be = minus(e, b);
+  Expr l = sqrt(norm2(be));
+  Expr t = dot3(d, be) / l;
+  Expr d2 = norm2(d), S2 = S * S;
+  Expr p2 = 1.0 + S2 * (d2 - t * t);
+  Expr q2 = 1.0 + S2 * (d2 + l * l - 2.0 * l * t);
+  Expr p = sqrt(p2);
+  return t / (2.0 * p2 * (p2 + S2 * t * t)) + (l - t) / (2.0 * p2 * q2) +
+         (atan(S * t / p) + atan(S * (l - t) / p)) / (2.0 * S * p2 * p);
+}
+
+// Kernel integrated over the triangle (A, B, C). With h the distance to the triangle's plane
+// and c^2 = 1 + S^2 h^2, the integral is a signed sum over edges of fans from the foot of the
+// perpendicular: for edge P -> Q with unit direction u, a = signed in-plane distance of x from
+// the edge line (positive on the triangle's side), w = sqrt(c^2 + S^2 a^2):
+//   a / (2 S c^2 w) * (atan(S (Q-x).u / w) - atan(S (P-x).u / w)).
+Expr triangle(const Vec3& x, const Vec3 v[3], const Expr& S) {
+  Vec3 n = cross(minus(v[1], v[0]), minus(v[2], v[0]));
+  Expr nn = sqrt(norm2(n));
+  Vec3 nu = {n.x / nn, n.y / nn, n.z / nn};
+  Expr h = dot3(minus(x, v[0]), nu);
+  Expr S2 = S * S;
+  Expr c2 = 1.0 + S2 * h * h;
+  Expr sum = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 &P = v[i], &Q = v[(i + 1) % 3];
+    Vec3 pq = minus(Q, P);
+    Expr len = sqrt(norm2(pq));
+    Vec3 u = {pq.x / len, pq.y / len, pq.z / len};
+    Vec3 inward = cross(nu, u);
+    Expr a = dot3(minus(x, P), inward);
+    Expr w = sqrt(c2 + S2 * a * a);
+    Expr uq = dot3(minus(Q, x), u), up = dot3(minus(P, x), u);
+    sum = sum + a / (2.0 * S * c2 * w) * (atan(S * uq / w) - atan(S * up / w));
+  }
+  return sum;
+}
+
+const std::vector<Expr>& coords(const char* fn, std::vector<Arg>& a) {
+  return arrayAtLeast(fn, a, 0, 3, "x");
+}
+
+Expr convPoint(std::vector<Arg>& a) {
+  const char* fn = "hfConvPoint";
+  Vec3 x = at(coords(fn, a), 0);
+  auto& S = arrayArg(fn, a, 2);
+  auto& v = arrayExactly(fn, a, 1, 3 * S.size(), " (3 per element of " + argName(a, 2, "S") + ")");
+  Expr sum = 0.0;
+  for (size_t i = 0; i < S.size(); ++i) {
+    Expr r2 = norm2(minus(x, at(v, 3 * i)));
+    sum = sum + 1.0 / square(1.0 + S[i] * S[i] * r2);
+  }
+  return sum - scalarArg(fn, a, 3);
+}
+
+Expr convLine(std::vector<Arg>& a) {
+  const char* fn = "hfConvLine";
+  Vec3 x = at(coords(fn, a), 0);
+  auto& S = arrayArg(fn, a, 3);
+  std::string why = " (3 per element of " + argName(a, 3, "S") + ")";
+  auto& b = arrayExactly(fn, a, 1, 3 * S.size(), why);
+  auto& e = arrayExactly(fn, a, 2, 3 * S.size(), why);
+  Expr sum = 0.0;
+  for (size_t i = 0; i < S.size(); ++i) sum = sum + segment(x, at(b, 3 * i), at(e, 3 * i), S[i]);
+  return sum - scalarArg(fn, a, 4);
+}
+
+// Polyline v0 -> v1 -> ... -> vN with one S per segment.
+Expr convCurve(std::vector<Arg>& a) {
+  const char* fn = "hfConvCurve";
+  Vec3 x = at(coords(fn, a), 0);
+  auto& S = arrayArg(fn, a, 2);
+  auto& v = arrayExactly(fn, a, 1, 3 * (S.size() + 1),
+                         " (3 per vertex, one more vertex than " + argName(a, 2, "S") + ")");
+  Expr sum = 0.0;
+  for (size_t i = 0; i < S.size(); ++i)
+    sum = sum + segment(x, at(v, 3 * i), at(v, 3 * i + 3), S[i]);
+  return sum - scalarArg(fn, a, 3);
+}
+
+// Triangles given by 9 coordinates each, one S per triangle.
+Expr convTriangle(std::vector<Arg>& a) {
+  const char* fn = "hfConvTriangle";
+  Vec3 x = at(coords(fn, a), 0);
+  auto& S = arrayArg(fn, a, 2);
+  auto& v = arrayExactly(fn, a, 1, 9 * S.size(), " (9 per element of " + argName(a, 2, "S") + ")");
+  Expr sum = 0.0;
+  for (size_t i = 0; i < S.size(); ++i) {
+    Vec3 tri[3] = {at(v, 9 * i), at(v, 9 * i + 3), at(v, 9 * i + 6)};
+    sum = sum + triangle(x, tri, S[i]);
+  }
+  return sum - scalarArg(fn, a, 3);
+}
+
+// Indexed mesh: vertices v[3V], triangles tri[3N] of 1-based vertex numbers (compile-time
+// constants), one S per triangle.
+Expr convMesh(std::vector<Arg>& a) {
+  const char* fn = "hfConvMesh";
+  Vec3 x = at(coords(fn, a), 0);
+  auto& v = arrayArg(fn, a, 1);
+  auto& S = arrayArg(fn, a, 3);
+  auto& tri = arrayExactly(fn, a, 2, 3 * S.size(), " (3 per element of " + argName(a, 3, "S") + ")");
+  if (v.size() % 3 != 0)
+    throw LibraryError(std::string(fn) + ": vertex array " + argName(a, 1, "v") +
+                           " size must be a multiple of 3 (got " + std::to_string(v.size()) + ")",
+                       1);
+  Expr sum = 0.0;
+  for (size_t i = 0; i < S.size(); ++i) {
+    Vec3 corners[3];
+    for (int k = 0; k < 3; ++k) {
+      const Expr& idx = tri[3 * i + k];
+      if (!idx.isConst())
+        throw LibraryError(std::string(fn) + ": triangle indices must be constants", 2);
+      long n = std::lround(idx.constValue());
+      if (n < 1 || 3 * static_cast<size_t>(n) > v.size())
+        throw LibraryError(std::string(fn) + ": triangle index " + std::to_string(n) +
+                               " out of range 1.." + std::to_string(v.size() / 3),
+                           2);
+      corners[k] = at(v, 3 * (n - 1));
+    }
+    sum = sum + triangle(x, corners, S[i]);
+  }
+  return sum - scalarArg(fn, a, 4);
+}
+
+const bool registered = registerAll({
+    {"hfConvPoint", "AAAS", "sum 1/(1 + S_i^2 r_i^2)^2 - T", convPoint},
+    {"hfConvLine", "AAAAS", "sum of Cauchy kernel integrals over segments b_i -> e_i - T",
+     convLine},
+    {"hfConvCurve", "AAAS", "sum of Cauchy kernel integrals over polyline segments - T",
+     convCurve},
+    {"hfConvTriangle", "AAAS", "sum of Cauchy kernel integrals over triangles - T", convTriangle},
+    {"hfConvMesh", "AAAAS", "sum of Cauchy kernel integrals over indexed triangles - T",
+     convMesh},
+});
+
+}  // namespace
+}  // namespace frep::lang::hf

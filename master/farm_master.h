@@ -1,0 +1,71 @@
+// The master: plans a job as bricks, leases them to workers over a ZeroMQ ROUTER (or computes
+// them in-process), survives workers that die or stall, journals what it merged, and returns
+// the merged result. Writing the output files is the caller's business (cli/).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "farm.pb.h"
+#include "frep/sample.h"
+
+namespace frep::farm {
+
+struct FarmOptions {
+  int workers = -1;              // local worker processes: -1 one per core, 0 compute in-process
+  std::string listen;            // cluster mode: bind here (tcp://*:5555) and spawn nothing
+  int expectWorkers = 0;         // cluster mode: workers expected (progress, warnings)
+  int brickVoxels = 64;          // brick edge, a multiple of 8
+  int heartbeatMs = 500;         // both ways
+  int liveness = 6;              // missed beats before a peer counts as dead
+  int maxAttempts = 3;           // failures or worker deaths before a brick is poisoned
+  double leaseSeconds = 0;       // re-issue a brick running longer; 0: max(30 s, 10 x median)
+  int noWorkerTimeoutSec = 120;  // give up when no worker is alive for this long
+  std::string curveDir;          // require CURVE keys (frep keygen)
+  std::string journalPath;       // empty: no journal
+  bool resume = false;
+  bool progressJson = false;     // JSON progress events on stdout
+  bool progressBar = false;      // progress bar on stderr
+  std::string workerExecutable;  // local mode: path of frep-worker ("" = next to this program)
+  int workerThreads = 1;         // local mode: threads per worker
+  std::string logLevel = "warn"; // local mode: workers' --log-level
+};
+
+struct WorkerShare {
+  uint64_t bricks = 0, pointEvals = 0;
+  double computeSeconds = 0;
+};
+
+struct PoisonedBrick {
+  uint64_t brick;
+  std::array<int32_t, 3> lo, hi;
+  std::string error;
+};
+
+struct FarmReport {
+  double wallSeconds = 0;
+  uint64_t bricks = 0, bricksComputed = 0, bricksFromJournal = 0;
+  uint64_t pointEvals = 0, intervalEvals = 0, denseEvals = 0, nanValues = 0;
+  uint64_t leaves = 0, tiles = 0;
+  uint64_t retries = 0, duplicates = 0, lateResults = 0, malformed = 0, oversized = 0;
+  uint64_t deadWorkers = 0, handedBack = 0, stragglerReissues = 0, leaseReissues = 0, refused = 0;
+  uint64_t curveRejected = 0;
+  int workersSeen = 0;
+  std::map<std::string, WorkerShare> perWorker;  // by worker id ("in-process" for --workers 0)
+  std::vector<PoisonedBrick> poisoned;
+  bool interrupted = false;  // SIGTERM/SIGINT: journal flushed, resume with --resume
+  std::string toJson() const;
+};
+
+struct FarmOutcome {
+  SampleResult result;  // merged, sorted as sample() sorts; complete only if nothing was poisoned
+  FarmReport report;
+};
+
+// Runs a "sample" job. Throws std::runtime_error for setup failures (bind, journal, keys).
+FarmOutcome runSampleJob(const JobSpec& job, const FarmOptions& options);
+
+}  // namespace frep::farm

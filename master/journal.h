@@ -1,0 +1,34 @@
+// The master's journal: every merged brick is appended (id, crc, payload), so a master that
+// crashed or was stopped can resume without recomputing what it had. Append-only; a torn last
+// record (crash mid-write) is detected by its length and CRC and dropped on resume.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <string>
+
+namespace frep::farm {
+
+class Journal {
+ public:
+  // Opens path for a job. With resume, replays the records of the same job through onRecord
+  // and keeps appending after the last good one; a journal of another job is an error
+  // (std::runtime_error). Without resume, any old journal is replaced.
+  Journal(const std::string& path, uint64_t jobId, bool resume,
+          const std::function<void(uint64_t brick, const std::string& payload)>& onRecord);
+  ~Journal();
+  Journal(const Journal&) = delete;
+  Journal& operator=(const Journal&) = delete;
+
+  void append(uint64_t brick, const std::string& payload);
+  void flush();  // to the disk (fdatasync)
+  void remove(); // after the output was written: the journal is no longer needed
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  FILE* file_ = nullptr;
+};
+
+}  // namespace frep::farm

@@ -1,0 +1,84 @@
+#include "local_workers.h"
+
+#include <signal.h>
+#include <spawn.h>
+#include <spdlog/spdlog.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+#include <thread>
+
+extern char** environ;
+
+namespace frep::farm {
+
+std::string siblingExecutable(const std::string& name) {
+  std::error_code ec;
+  auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return name;
+  return (self.parent_path() / name).string();
+}
+
+LocalWorkers::LocalWorkers(std::string executable, std::vector<std::string> args) : args_(std::move(args)) {
+  if (!executable.empty()) exe_ = executable;
+  else if (const char* env = std::getenv("FREP_WORKER")) exe_ = env;
+  else exe_ = siblingExecutable("frep-worker");
+  if (::access(exe_.c_str(), X_OK) != 0)
+    throw std::runtime_error("worker program not found or not executable: " + exe_ +
+                             " (set FREP_WORKER or use --workers 0)");
+}
+
+LocalWorkers::~LocalWorkers() { terminateAll(); }
+
+void LocalWorkers::spawn(int count) {
+  for (int i = 0; i < count; ++i) {
+    std::vector<char*> argv;
+    argv.push_back(const_cast<char*>(exe_.c_str()));
+    for (auto& a : args_) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    int rc = posix_spawn(&pid, exe_.c_str(), nullptr, nullptr, argv.data(), environ);
+    if (rc != 0) throw std::runtime_error("cannot start " + exe_ + ": " + std::strerror(rc));
+    pids_.push_back(pid);
+    spdlog::debug("started local worker pid {}", pid);
+  }
+}
+
+int LocalWorkers::reap() {
+  int exited = 0;
+  for (auto it = pids_.begin(); it != pids_.end();) {
+    int status = 0;
+    if (::waitpid(*it, &status, WNOHANG) == *it) {
+      if (WIFSIGNALED(status))
+        spdlog::warn("local worker pid {} killed by signal {}", *it, WTERMSIG(status));
+      else
+        spdlog::debug("local worker pid {} exited with {}", *it, WEXITSTATUS(status));
+      it = pids_.erase(it);
+      ++exited;
+    } else {
+      ++it;
+    }
+  }
+  return exited;
+}
+
+void LocalWorkers::terminateAll() {
+  for (pid_t p : pids_) ::kill(p, SIGTERM);
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (!pids_.empty() && std::chrono::steady_clock::now() < deadline) {
+    reap();
+    if (!pids_.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  for (pid_t p : pids_) {
+    ::kill(p, SIGKILL);
+    ::waitpid(p, nullptr, 0);
+  }
+  pids_.clear();
+}
+
+}  // namespace frep::farm

@@ -1,0 +1,30 @@
+// Sending and receiving envelopes over ZeroMQ: [routing id (ROUTER side only)] envelope [payload].
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+#include <zmq.hpp>
+
+#include "farm.pb.h"
+
+namespace frep::farm {
+
+constexpr uint32_t kProtoMajor = 1;
+constexpr uint32_t kProtoMinor = 0;
+
+struct Incoming {
+  std::string routingId;  // empty on the DEALER side
+  Envelope envelope;
+  std::optional<zmq::message_t> payload;
+};
+
+// Receives one message without blocking. Returns false if none is waiting. Sets *error (and
+// returns true with an empty envelope body) when a message arrived but was malformed: wrong
+// frame count, unparsable protobuf. Never throws on bad input.
+bool receive(zmq::socket_t& socket, bool router, Incoming& in, std::string* error);
+
+// Sends an envelope (and optional payload). Returns false when the peer is unreachable.
+bool send(zmq::socket_t& socket, const std::string& routingId, Envelope& env, const std::string* payload = nullptr);
+
+}  // namespace frep::farm

@@ -1,0 +1,47 @@
+// Grids from --res and -g: point counts, voxel size and origin.
+#include "sampling_grid.h"
+
+#include <gtest/gtest.h>
+
+#include "exit_codes.h"
+
+using namespace frep::cli;
+
+TEST(SamplingGrid, ResCountsPointsAlongTheLongestAxis) {
+  Box box = parseBounds("-b", "-1,-2,-1,1,2,1");
+  frep::GridSpec g = makeGrid(box, 3, resolutionFrom(41, "", 128));
+  EXPECT_DOUBLE_EQ(g.voxel, 0.1);
+  EXPECT_EQ(g.dims, (std::array<int32_t, 3>{21, 41, 21}));
+  EXPECT_EQ(g.origin, (std::array<double, 3>{-1, -2, -1}));
+}
+
+TEST(SamplingGrid, HfpCellsGiveNPlusOnePoints) {
+  frep::GridSpec g = makeGrid(parseBounds("-b", "10"), 3, resolutionFrom(0, "30", 128));
+  EXPECT_EQ(g.dims, (std::array<int32_t, 3>{31, 31, 31}));
+  // Per-axis cells: cubic voxels of the coarsest axis, every axis still covered.
+  frep::GridSpec h = makeGrid(parseBounds("-b", "1"), 3, resolutionFrom(0, "4,8,2", 128));
+  EXPECT_DOUBLE_EQ(h.voxel, 1.0);
+  EXPECT_EQ(h.dims, (std::array<int32_t, 3>{3, 3, 3}));
+}
+
+TEST(SamplingGrid, TwoAxesLeaveTheThirdSingle) {
+  frep::GridSpec g = makeGrid(parseBounds("-b", "0,0,0,2,1,0.5"), 2, resolutionFrom(0, "", 5));
+  EXPECT_DOUBLE_EQ(g.voxel, 0.5);
+  EXPECT_EQ(g.dims, (std::array<int32_t, 3>{5, 3, 1}));
+}
+
+TEST(SamplingGrid, ResolutionErrors) {
+  try {
+    resolutionFrom(100, "30", 128);
+    FAIL();
+  } catch (const CliError& e) {
+    EXPECT_EQ(e.code, kExitBadArgs);
+    EXPECT_STREQ(e.what(), "--res and -g/--grid: give one of them, not both");
+  }
+  try {
+    resolutionFrom(1, "", 128);
+    FAIL();
+  } catch (const CliError& e) {
+    EXPECT_STREQ(e.what(), "--res: expected an integer from 2 to 65536, got 1");
+  }
+}

@@ -1,0 +1,53 @@
+// Helpers for the language tests: compile a model and evaluate it at a point.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "frep/eval.h"
+#include "frep/lang/hyperfun.h"
+#include "frep/tape.h"
+
+namespace frep::lang::testing {
+
+inline std::string allDiagnostics(const CompileResult& r) {
+  std::string s;
+  for (const auto& d : r.diagnostics) s += d.format() + "\n";
+  return s;
+}
+
+// Compiles src and expects success.
+inline Model compileOk(const std::string& src, const CompileOptions& opt = {}) {
+  CompileResult r = compile(src, "test.hf", opt);
+  EXPECT_TRUE(r.ok) << allDiagnostics(r);
+  return r.model;
+}
+
+// Evaluates a compiled model at x with parameters a (through the tape, as the farm does).
+inline double evalModel(const Model& m, std::vector<double> x, const std::vector<double>& a = {}) {
+  std::vector<Expr> params;
+  for (double v : a) params.push_back(Expr(v));
+  while (params.size() < static_cast<size_t>(m.aSize)) params.push_back(Expr(0.0));
+  Expr f = bindParams(m.field, params);
+  x.resize(std::max<size_t>(x.size(), static_cast<size_t>(m.xSize)), 0.0);
+  auto tape = Tape::compile(f, static_cast<uint32_t>(x.size()));
+  PointEvaluator ev;
+  return ev.eval(*tape, x.data());
+}
+
+// Value of `expr` in a 3D model with x = (x1, x2, x3).
+inline double valueOf(const std::string& expr, std::vector<double> x = {0, 0, 0}) {
+  Model m = compileOk("my_model(x[3], a[1]) { my_model = " + expr + "; }");
+  return evalModel(m, x);
+}
+
+// Expects relative agreement to 1e-9 (absolute near zero).
+#define EXPECT_CLOSE(actual, expected)                                                  \
+  do {                                                                                  \
+    double a_ = (actual), e_ = (expected);                                              \
+    EXPECT_NEAR(a_, e_, 1e-9 * std::max(1.0, std::fabs(e_))) << "expected " << e_;      \
+  } while (0)
+
+}  // namespace frep::lang::testing

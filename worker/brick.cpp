@@ -1,0 +1,160 @@
+#include "brick.h"
+
+#include <zlib.h>
+
+#include <cstring>
+#include <stdexcept>
+
+#include "frep/lang/hyperfun.h"
+
+namespace frep::farm {
+
+GridSpec gridOf(const JobSpec& job) {
+  if (job.origin_size() != 3 || job.dims_size() != 3)
+    throw std::invalid_argument("job: origin and dims need 3 values each");
+  GridSpec g;
+  for (int a = 0; a < 3; ++a) {
+    g.origin[a] = job.origin(a);
+    g.dims[a] = job.dims(a);
+  }
+  g.voxel = job.voxel();
+  return g;
+}
+
+uint64_t jobIdOf(const JobSpec& job) {
+  std::string bytes;
+  job.SerializeToString(&bytes);  // deterministic for a given message (no maps in JobSpec)
+  uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+TapePtr compileJobModel(const JobSpec& job) {
+  lang::CompileOptions opt;
+  opt.object = job.object();
+  lang::CompileResult r = lang::compile(job.model_source(), job.model_name(), opt);
+  if (!r.ok) {
+    std::string msg;
+    for (auto& d : r.diagnostics)
+      if (d.severity == lang::Diagnostic::Severity::Error) msg += d.format() + "\n";
+    throw std::runtime_error(msg.empty() ? "model does not compile" : msg);
+  }
+  std::vector<Expr> params;
+  for (int i = 0; i < r.model.aSize; ++i) params.push_back(i < job.params_size() ? job.params(i) : 0.0);
+  Expr f = bindParams(r.model.field, params) - job.iso();
+  return Tape::compile(f, uint32_t(r.model.xSize));
+}
+
+TapePtr ModelCache::get(const JobSpec& job, uint64_t jobId) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = tapes_.find(jobId);
+  if (it != tapes_.end()) return it->second;
+  TapePtr t = compileJobModel(job);
+  tapes_[jobId] = t;
+  return t;
+}
+
+BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::array<int32_t, 3>& lo,
+                         const std::array<int32_t, 3>& hi, int threads) {
+  SampleOptions opt;
+  opt.bandVoxels = job.band();
+  opt.regionLo = lo;
+  opt.regionHi = hi;
+  opt.fixedCoords.assign(job.fixed_coords().begin(), job.fixed_coords().end());
+  opt.threads = threads;
+  SampleResult r = sample(tape, gridOf(job), opt);
+  return BrickOutput{std::move(r.leaves), std::move(r.tiles), r.stats};
+}
+
+namespace {
+template <typename T>
+void put(std::string& s, const T& v) {
+  s.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+struct Reader {
+  const char* p;
+  const char* end;
+  template <typename T>
+  bool get(T& v) {
+    if (size_t(end - p) < sizeof v) return false;
+    std::memcpy(&v, p, sizeof v);
+    p += sizeof v;
+    return true;
+  }
+};
+constexpr size_t kTileBytes = 5 * 4;
+constexpr size_t kLeafBytes = 3 * 4 + 8 * 8 + kLeafVoxels * 4;
+}  // namespace
+
+std::string encodeBrick(const BrickOutput& out) {
+  std::string s;
+  s.reserve(12 + out.tiles.size() * kTileBytes + out.leaves.size() * kLeafBytes);
+  s.append("FRB1", 4);
+  put(s, uint32_t(out.leaves.size()));
+  put(s, uint32_t(out.tiles.size()));
+  for (const Tile& t : out.tiles) {
+    for (int a = 0; a < 3; ++a) put(s, t.origin[a]);
+    put(s, t.size);
+    put(s, int32_t(t.inside ? 1 : 0));
+  }
+  for (const LeafBlock& l : out.leaves) {
+    for (int a = 0; a < 3; ++a) put(s, l.origin[a]);
+    s.append(reinterpret_cast<const char*>(l.active.data()), sizeof l.active);
+    s.append(reinterpret_cast<const char*>(l.values.data()), sizeof l.values);
+  }
+  return s;
+}
+
+bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* error) {
+  auto fail = [&](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  Reader r{static_cast<const char*>(data), static_cast<const char*>(data) + size};
+  if (size < 12 || std::memcmp(data, "FRB1", 4) != 0) return fail("payload: bad magic");
+  r.p += 4;
+  uint32_t nl = 0, nt = 0;
+  r.get(nl);
+  r.get(nt);
+  if (uint64_t(nt) * kTileBytes + uint64_t(nl) * kLeafBytes != size - 12) return fail("payload: size does not match counts");
+  out.tiles.resize(nt);
+  for (Tile& t : out.tiles) {
+    int32_t inside = 0;
+    r.get(t.origin[0]);
+    r.get(t.origin[1]);
+    r.get(t.origin[2]);
+    r.get(t.size);
+    r.get(inside);
+    if (t.size < kLeafDim || (t.size & (t.size - 1)) != 0) return fail("payload: bad tile size");
+    t.inside = inside != 0;
+  }
+  out.leaves.resize(nl);
+  for (LeafBlock& l : out.leaves) {
+    r.get(l.origin[0]);
+    r.get(l.origin[1]);
+    r.get(l.origin[2]);
+    if ((l.origin[0] | l.origin[1] | l.origin[2]) & 7) return fail("payload: leaf origin not a multiple of 8");
+    std::memcpy(l.active.data(), r.p, sizeof l.active);
+    r.p += sizeof l.active;
+    std::memcpy(l.values.data(), r.p, sizeof l.values);
+    r.p += sizeof l.values;
+  }
+  return true;
+}
+
+uint32_t crc32Of(const void* data, size_t size) {
+  uLong c = crc32(0L, Z_NULL, 0);
+  const Bytef* p = static_cast<const Bytef*>(data);
+  while (size > 0) {
+    uInt n = size > (1u << 30) ? (1u << 30) : uInt(size);
+    c = crc32(c, p, n);
+    p += n;
+    size -= n;
+  }
+  return uint32_t(c);
+}
+
+}  // namespace frep::farm

@@ -1,0 +1,39 @@
+// frep-worker: joins a frepfarm master and computes bricks until the job ends.
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <cstdlib>
+
+#include "worker.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"frep-worker: computes bricks for a frepfarm master.\n"
+               "Exit codes: 0 done or stopped by SIGTERM, 2 bad arguments, 75 no master reachable,\n"
+               "78 refused by the master (e.g. protocol version)."};
+  frep::farm::WorkerOptions opt;
+  std::string level = "info";
+  if (const char* env = std::getenv("FREP_MASTER")) opt.endpoint = env;
+  app.add_option("--connect", opt.endpoint, "master endpoint, e.g. tcp://host:5555 (default: $FREP_MASTER)");
+  app.add_option("--threads", opt.threads, "threads per brick (default: all cores)");
+  app.add_option("--curve", opt.curveDir, "directory with CURVE keys from `frep keygen`");
+  app.add_option("--master-timeout", opt.masterTimeoutSec, "seconds without a master before giving up")
+      ->capture_default_str();
+  app.add_option("--log-level", level, "trace, debug, info, warn, error, off")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int rc = app.exit(e);
+    return rc == 0 ? 0 : frep::farm::kWorkerBadArgs;
+  }
+  if (opt.endpoint.empty()) {
+    spdlog::error("--connect: no master endpoint given (or set FREP_MASTER)");
+    return frep::farm::kWorkerBadArgs;
+  }
+  spdlog::set_level(spdlog::level::from_str(level));
+  try {
+    return frep::farm::runWorker(opt);
+  } catch (const std::exception& e) {
+    spdlog::error("worker: {}", e.what());
+    return frep::farm::kWorkerBadArgs;
+  }
+}
