@@ -39,7 +39,7 @@ void addModelOptions(CLI::App* sub, ModelRequest& m, bool withFieldOptions) {
   if (!withFieldOptions) return;
   sub->add_option("-a,--params", m.params, "Values of a[1..m], comma-separated (default all 0)");
   sub->add_option("-x,--map", m.mapping,
-                  "Map x[1..n] to axes X, Y, Z or constants, e.g. X,Y,Z,0.5 (default: x[4..] = 0)");
+                  "Map x[1..n] to axes X, Y, Z or constants, e.g. X,Y,Z,0.5 (see docs/cli.md)");
   sub->add_option("-i,--iso", m.iso, "Isovalue: the solid is f >= iso (default 0)");
 }
 
@@ -105,7 +105,10 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    std::cerr << "frep: error: " << e.what() << "\nRun 'frep --help' for usage.\n";
+    std::string message = e.what();
+    if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice and sample";
+    std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
 

@@ -148,7 +148,7 @@ TEST_F(FrepTest, BadArgumentsNameTheField) {
       {"slice s.hf --res 16", "frep: error: -O/--out: the output PNG path is required"},
       {"sample s.hf --band 0 -O s.vdb", "frep: error: --band: expected an integer from 1 to 64 (voxels), got 0"},
       {"eval s.hf", "--at is required"},
-      {"frob s.hf", "frep: error:"},
+      {"frob s.hf", "frep: error: unknown verb 'frob'; the verbs are check, eval, slice and sample"},
       {"eval s.hf --at 0,0,0 --log-level loud", "--log-level"},
   };
   for (const Case& c : cases) {
@@ -253,4 +253,18 @@ TEST_F(FrepTest, SliceHoldsHigherCoordinatesAtZeroOrAtTheirMapping) {
   EXPECT_TRUE(black(b.at(8, 5)));  // f = 0 exactly on the circle of radius 0.6
   EXPECT_TRUE(cool(b.at(9, 5)));
   EXPECT_TRUE(warm(b.at(7, 5)));
+}
+
+TEST_F(FrepTest, DomainErrorsAreReportedNotFatal) {
+  // x^0.5 is NaN for x < 0 (core convention): eval says so, slice paints those pixels grey.
+  write("n.hf", "my_model(x[3], a[1]) { my_model = 0.5 - x[1]^0.5; }\n");
+  RunResult r = run("eval n.hf --at -1,0,0");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "value: nan\nstatus: out (NaN: a domain error, counted as outside)\n")) << r.out;
+  RunResult s = run("slice n.hf -b 1 --res 16 -O n.png");
+  ASSERT_EQ(s.code, 0) << s.err;
+  EXPECT_TRUE(contains(s.out, ", 128 NaN pixels (grey)\n")) << s.out;  // columns 0..7 of 16 rows
+  Png png = readPng(path("n.png"));
+  EXPECT_EQ(png.at(3, 3)[0], 128);
+  EXPECT_EQ(png.at(3, 3)[2], 128);
 }

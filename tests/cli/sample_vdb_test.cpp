@@ -87,3 +87,11 @@ TEST_F(FrepTest, SampleLogsThroughSpdlogAtTheChosenLevel) {
   ASSERT_EQ(quiet.code, 0) << quiet.err;
   EXPECT_EQ(quiet.err, "");
 }
+
+TEST_F(FrepTest, SampleCountsNaNValues) {
+  write("n.hf", "my_model(x[3], a[1]) { my_model = 0.5 - x[1]^0.5; }\n");
+  RunResult r = run("sample n.hf -b 1 --res 16 -O n.vdb");
+  ASSERT_EQ(r.code, 0) << r.err;
+  // Voxels with x < 0 (8 of 16 columns) are NaN; NaN widens every interval, so all are sampled.
+  EXPECT_NE(r.out.find("  NaN values 2048 (domain errors, stored as outside)\n"), std::string::npos) << r.out;
+}
