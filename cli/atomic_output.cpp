@@ -4,12 +4,39 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 
 #include "exit_codes.h"
 
 namespace frep::cli {
+namespace {
+
+// The temporary file in progress, for the signal handler: Ctrl-C or a batch system's SIGTERM
+// must not leave it behind. One output at a time is all the frep verbs need.
+char gPendingTemp[4096];
+volatile std::sig_atomic_t gHavePending = 0;
+
+extern "C" void removePendingAndReraise(int sig) {
+  if (gHavePending) ::unlink(gPendingTemp);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+void trackPending(const std::string& temp) {
+  static const bool installed = [] {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, removePendingAndReraise);
+    return true;
+  }();
+  (void)installed;
+  gHavePending = 0;
+  if (temp.size() >= sizeof gPendingTemp) return;  // untracked: only a leftover on a signal
+  std::memcpy(gPendingTemp, temp.c_str(), temp.size() + 1);
+  gHavePending = 1;
+}
+
+}  // namespace
 
 AtomicOutput::AtomicOutput(const std::string& field, const std::string& path) : field_(field), path_(path) {
   if (path.empty()) throw badArgs(field + ": the output path is empty");
@@ -23,9 +50,11 @@ AtomicOutput::AtomicOutput(const std::string& field, const std::string& path) : 
   if (fd < 0)
     throw ioError(field + ": cannot write '" + path + "': " + std::strerror(errno));
   ::close(fd);
+  trackPending(temp_);
 }
 
 AtomicOutput::~AtomicOutput() {
+  gHavePending = 0;
   if (!committed_) std::remove(temp_.c_str());
 }
 

@@ -114,11 +114,20 @@ int main(int argc, char** argv) {
 
   setUpLogging(logLevel);
   try {
-    if (check->parsed()) return checkObjectIsNotAFile(checkModel), runCheck(checkModel);
-    if (evalCmd->parsed()) return checkObjectIsNotAFile(eval.model), runEval(eval);
-    if (sliceCmd->parsed()) return checkObjectIsNotAFile(slice.model), runSlice(slice);
-    sample.commandLine = joinCommandLine(argc, argv);
+    if (check->parsed()) {
+      checkObjectIsNotAFile(checkModel);
+      return runCheck(checkModel);
+    }
+    if (evalCmd->parsed()) {
+      checkObjectIsNotAFile(eval.model);
+      return runEval(eval);
+    }
+    if (sliceCmd->parsed()) {
+      checkObjectIsNotAFile(slice.model);
+      return runSlice(slice);
+    }
     checkObjectIsNotAFile(sample.model);
+    sample.commandLine = joinCommandLine(argc, argv);
     return runSample(sample);
   } catch (const CliError& e) {
     std::cerr << "frep: error: " << e.what() << "\n";

@@ -14,6 +14,7 @@ constexpr int kMaxChain = 2000;
 struct SyntaxError {
   Loc loc;
   std::string message;
+  bool reported = false;  // already reported: only unwind to the statement's recovery point
 };
 
 class Parser {
@@ -65,7 +66,9 @@ class Parser {
     if (!at(k)) fail(what.empty() ? tokenName(k) : what);
     return next();
   }
-  void report(const SyntaxError& e) { diags_.error(e.loc, e.message); }
+  void report(const SyntaxError& e) {
+    if (!e.reported) diags_.error(e.loc, e.message);
+  }
 
   // Skips the rest of a bad statement: through the next ';', or up to a block end.
   void sync() {
@@ -250,6 +253,7 @@ class Parser {
     } catch (const SyntaxError& e) {
       report(e);
       while (!at(Tok::End) && !at(until) && !at(Tok::Semi) && !at(Tok::RBrace)) next();
+      if (!at(until)) throw SyntaxError{e.loc, e.message, true};
       auto n = std::make_unique<AstExpr>();  // stands in for the bad condition
       n->loc = cur().loc;
       return n;

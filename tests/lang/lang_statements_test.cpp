@@ -282,6 +282,20 @@ TEST(LangStatements, AttributeFunctionsWarnOnceAndKeepGeometry) {
   EXPECT_CLOSE(evalModel(r.model, {0.25, 0, 0}), 0.25);
 }
 
+TEST(LangStatements, RealLibraryShiftThenSphere) {
+  if (!findLibraryFunction("hfSphere") || !findLibraryFunction("hfShift3D"))
+    GTEST_SKIP() << "hf library not linked";
+  Model m = compileOk(R"(my_model(x[3], a[1]) {
+    array c[3], xt[3];
+    c = [0, 0, 0];
+    xt = [x[1], x[2], x[3]];
+    d = hfShift3D(xt, 1, 2, 0);
+    my_model = hfSphere(xt, c, a[1]);
+  })");
+  // (x - (1, 2, 0)) at (1.5, 2, 0.5): R^2 - 0.25 - 0 - 0.25
+  EXPECT_CLOSE(evalModel(m, {1.5, 2, 0.5}, {2}), 4 - 0.5);
+}
+
 TEST(LangStatements, CarriageReturnsAreAccepted) {
   Model m = compileOk("m(x[1], a[1])\r\n{\r\n  m = x[1] + 1;\r\n}\r\n");
   EXPECT_CLOSE(evalModel(m, {1}), 2.0);

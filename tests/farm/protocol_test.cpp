@@ -1,0 +1,196 @@
+// The master against hostile or mismatched peers: it must refuse, count and carry on.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <random>
+#include <thread>
+#include <zmq.hpp>
+#include <zmq_addon.hpp>
+
+#include "brick.h"
+#include "curve.h"
+#include "farm_master.h"
+#include "wire.h"
+
+using namespace frep;
+using namespace frep::farm;
+
+namespace {
+
+JobSpec sphereJob() {
+  JobSpec j;
+  j.set_operation("sample");
+  j.set_model_source("my_model(x[3], a[1]) { my_model = 0.64 - x[1]^2 - x[2]^2 - x[3]^2; }");
+  j.set_model_name("sphere.hf");
+  GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 64);
+  for (int a = 0; a < 3; ++a) {
+    j.add_origin(g.origin[a]);
+    j.add_dims(g.dims[a]);
+  }
+  j.set_voxel(g.voxel);
+  j.set_band(3);
+  return j;
+}
+
+std::string endpoint() { return "tcp://127.0.0.1:" + std::to_string(30000 + (getpid() % 10000) * 2); }
+
+int runWorker(const std::vector<std::string>& extra, int timeoutSec = 20) {
+  std::vector<std::string> args{FREP_WORKER_PATH, "--threads", "1", "--log-level", "off"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid;
+  if (posix_spawn(&pid, FREP_WORKER_PATH, nullptr, nullptr, argv.data(), environ) != 0) return -1;
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(timeoutSec);
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      return -2;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+FarmOptions clusterOptions(const std::string& ep) {
+  FarmOptions o;
+  o.listen = ep;
+  o.brickVoxels = 32;
+  o.heartbeatMs = 100;
+  o.noWorkerTimeoutSec = 20;
+  return o;
+}
+
+}  // namespace
+
+TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
+  JobSpec j = sphereJob();
+  FarmOutcome ref = runSampleJob(j, FarmOptions{0});
+  std::string ep = endpoint();
+  FarmOutcome out;
+  std::thread master([&] { out = runSampleJob(j, clusterOptions(ep)); });
+
+  zmq::context_t ctx(1);
+  zmq::socket_t rogue(ctx, zmq::socket_type::dealer);
+  rogue.set(zmq::sockopt::linger, 0);
+  rogue.connect(ep);
+  std::mt19937 rng(7);
+  std::string junk(300, '\0');
+  for (auto& c : junk) c = char(rng());
+  rogue.send(zmq::buffer(junk));  // random bytes
+  Envelope hello;
+  hello.set_proto_major(kProtoMajor);
+  hello.mutable_hello()->set_worker_id("rogue");
+  std::string bytes;
+  hello.SerializeToString(&bytes);
+  rogue.send(zmq::buffer(bytes.substr(0, bytes.size() - 3)));  // truncated protobuf
+  std::vector<zmq::const_buffer> three{zmq::buffer(bytes), zmq::str_buffer("a"), zmq::str_buffer("b")};
+  zmq::send_multipart(rogue, three);  // wrong frame count
+  std::string huge(2 << 20, 'x');
+  rogue.send(zmq::buffer(huge));  // oversized frame
+  // A forged result for a brick the rogue never leased, with a bad payload.
+  Envelope forged;
+  forged.set_proto_major(kProtoMajor);
+  forged.set_job_id(jobIdOf(j));
+  forged.mutable_result()->set_brick_id(1);
+  forged.SerializeToString(&bytes);
+  std::vector<zmq::const_buffer> withPayload{zmq::buffer(bytes), zmq::str_buffer("garbage")};
+  zmq::send_multipart(rogue, withPayload);
+
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(runWorker({"--connect", ep}), 0);  // a real worker finishes the job
+  master.join();
+  EXPECT_GE(out.report.malformed + out.report.oversized, 3u);
+  EXPECT_EQ(out.result.leaves.size(), ref.result.leaves.size());
+  for (size_t i = 0; i < ref.result.leaves.size(); ++i) ASSERT_EQ(out.result.leaves[i].values, ref.result.leaves[i].values);
+}
+
+TEST(Protocol, WorkerOfAnotherProtocolMajorIsRefusedWithAReason) {
+  JobSpec j = sphereJob();
+  std::string ep = endpoint();
+  FarmOutcome out;
+  std::thread master([&] { out = runSampleJob(j, clusterOptions(ep)); });
+  zmq::context_t ctx(1);
+  zmq::socket_t peer(ctx, zmq::socket_type::dealer);
+  peer.set(zmq::sockopt::linger, 0);
+  peer.connect(ep);
+  Envelope hello;
+  hello.set_proto_major(kProtoMajor + 1);
+  hello.mutable_hello()->set_worker_id("future");
+  std::string bytes;
+  hello.SerializeToString(&bytes);
+  peer.send(zmq::buffer(bytes));
+  zmq::pollitem_t item{static_cast<void*>(peer), 0, ZMQ_POLLIN, 0};
+  zmq::poll(&item, 1, std::chrono::milliseconds(5000));
+  ASSERT_TRUE(item.revents & ZMQ_POLLIN);
+  zmq::message_t reply;
+  ASSERT_TRUE(peer.recv(reply));
+  Envelope r;
+  ASSERT_TRUE(r.ParseFromArray(reply.data(), int(reply.size())));
+  ASSERT_EQ(r.body_case(), Envelope::kReject);
+  EXPECT_NE(r.reject().reason().find("protocol major 2"), std::string::npos) << r.reject().reason();
+  EXPECT_EQ(runWorker({"--connect", ep}), 0);
+  master.join();
+  EXPECT_EQ(out.report.refused, 1u);
+}
+
+TEST(Protocol, CurveMasterRefusesWorkersWithoutTheKeys) {
+  namespace fs = std::filesystem;
+  fs::path dir = fs::temp_directory_path() / ("frep-curve-" + std::to_string(getpid()));
+  fs::path other = dir / "other";
+  generateCurveKeys(dir.string());
+  generateCurveKeys(other.string());
+  // An intruder who knows the master's public key but holds an unlisted worker key.
+  fs::path intruder = dir / "intruder";
+  fs::create_directories(intruder);
+  fs::copy_file(dir / "master.pub", intruder / "master.pub");
+  fs::copy_file(other / "worker.pub", intruder / "worker.pub");
+  fs::copy_file(other / "worker.key", intruder / "worker.key");
+  JobSpec j = sphereJob();
+  std::string ep = endpoint();
+  FarmOptions o = clusterOptions(ep);
+  o.curveDir = dir.string();
+  FarmOutcome out;
+  std::thread master([&] { out = runSampleJob(j, o); });
+  // Plain TCP: the handshake never completes, the worker gives up (75) without joining.
+  EXPECT_EQ(runWorker({"--connect", ep, "--master-timeout", "1"}), 75);
+  // Keys of another farm: the handshake fails, gives up too.
+  EXPECT_EQ(runWorker({"--connect", ep, "--master-timeout", "1", "--curve", other.string()}), 75);
+  // The master's public key but an unauthorized worker key: refused by the ZAP handler.
+  EXPECT_EQ(runWorker({"--connect", ep, "--master-timeout", "1", "--curve", intruder.string()}), 75);
+  // The right keys: joins and finishes the job.
+  EXPECT_EQ(runWorker({"--connect", ep, "--curve", dir.string()}), 0);
+  master.join();
+  EXPECT_EQ(out.report.workersSeen, 1);
+  EXPECT_GE(out.report.curveRejected, 1u);
+  EXPECT_TRUE(out.report.poisoned.empty());
+  fs::remove_all(dir);
+}
+
+TEST(Protocol, PayloadCodecRejectsMalformedInput) {
+  BrickOutput b;
+  LeafBlock l{};
+  l.origin = {8, 16, 24};
+  l.values.fill(1.5f);
+  l.active.fill(~0ull);
+  b.leaves.push_back(l);
+  b.tiles.push_back(Tile{{0, 0, 0}, 8, true});
+  std::string s = encodeBrick(b);
+  BrickOutput back;
+  std::string err;
+  ASSERT_TRUE(decodeBrick(s.data(), s.size(), back, &err));
+  EXPECT_EQ(back.leaves[0].values, l.values);
+  EXPECT_FALSE(decodeBrick(s.data(), s.size() - 1, back, &err));
+  EXPECT_FALSE(decodeBrick("FRB1", 4, back, &err));
+  std::string bad = s;
+  bad[12 + 20] = 3;  // leaf origin x = 3: not a multiple of 8
+  EXPECT_FALSE(decodeBrick(bad.data(), bad.size(), back, &err));
+}
