@@ -18,8 +18,9 @@ GridSpec makeGrid(const Box& box, int axes, const Resolution& r) {
   g.voxel = voxel;
   for (int a = 0; a < 3; ++a) {
     if (a >= axes) { g.dims[a] = 1; continue; }
-    // 1e-9: an extent that is a whole number of voxels up to rounding gets no extra point.
-    double steps = std::ceil((box.hi[a] - box.lo[a]) / voxel - 1e-9);
+    // As GridSpec::fromBounds: points stay inside the box; 1e-9 keeps an extent that is a whole
+    // number of voxels up to rounding from losing its last point.
+    double steps = std::floor((box.hi[a] - box.lo[a]) / voxel + 1e-9);
     g.dims[a] = static_cast<int32_t>(steps) + 1;
   }
   return g;

@@ -17,7 +17,8 @@ struct Resolution {
 
 // Grid over the first `axes` axes of `box` (the others get one point at lo). The grid starts at
 // box.lo; the voxel is the largest extent / cells ratio (extent / (res - 1) for --res), and each
-// axis gets enough points to cover its extent, so -g N on a cube gives hfp's N + 1 points.
+// axis gets the points that fit in the box, so -g N on a cube gives hfp's N + 1 points and
+// --res in 3D gives exactly GridSpec::fromBounds.
 GridSpec makeGrid(const Box& box, int axes, const Resolution& r);
 
 }  // namespace frep::cli

@@ -60,6 +60,7 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
   grid->setGridClass(openvdb::GRID_LEVEL_SET);
   grid->setName(meta.gridName);
   grid->insertMeta("frep_sign", openvdb::StringMetadata("value = -f"));
+  grid->insertMeta("frep_operation", openvdb::StringMetadata("sample"));
   grid->insertMeta("frep_model_hash", openvdb::StringMetadata(hex(meta.sourceHash)));
   grid->insertMeta("frep_object", openvdb::StringMetadata(meta.gridName));
   grid->insertMeta("frep_command", openvdb::StringMetadata(meta.commandLine));

@@ -19,9 +19,9 @@ struct VdbMetadata {
 
 // Writes one FloatGrid of class level set holding -f (negative inside, as OpenVDB expects):
 // leaf voxels from the sampler (active in the band), tiles and the background at ±band*voxel,
-// the grid's transform (voxel size, translated to the grid origin) and metadata
-// frep_sign = "value = -f", frep_model_hash, frep_object, frep_command, frep_band_voxels,
-// frep_band, frep_iso, frep_params, frep_version. Throws CliError(kExitIoError).
+// the grid's transform (voxel size, translated to the grid origin) and metadata (frep_sign =
+// "value = -f", frep_operation, frep_model_hash, frep_object, frep_command, frep_band_voxels,
+// frep_band, frep_iso, frep_params, frep_version). Throws CliError(kExitIoError).
 void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta);
 
 }  // namespace frep::cli

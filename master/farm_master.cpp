@@ -126,6 +126,9 @@ class Master {
         }
     outputs_.resize(bricks_.size());
     report_.bricks = bricks_.size();
+    size_t leaves = 0;
+    for (auto& br : bricks_) leaves = std::max(leaves, br.maxLeaves);
+    payloadLimit_ = 12 + leaves * (12 + 64 + 2048) + leaves * 8 * 20 + 4096;
   }
 
   // A brick's result is final: keep it, journal it, count it.
@@ -133,6 +136,7 @@ class Master {
     Brick& b = bricks_[id];
     b.phase = BrickPhase::Done;
     b.holders.clear();
+    leased_.erase(id);
     ++done_;
     report_.leaves += out.leaves.size();
     report_.tiles += out.tiles.size();
@@ -332,11 +336,7 @@ class Master {
     }
   }
 
-  size_t payloadLimit() const {
-    size_t leaves = 0;
-    for (auto& b : bricks_) leaves = std::max(leaves, b.maxLeaves);
-    return 12 + leaves * (12 + 64 + 2048) + leaves * 8 * 20 + 4096;
-  }
+  size_t payloadLimit() const { return payloadLimit_; }
 
   static std::string printable(const std::string& rid) {
     std::string s;
@@ -417,6 +417,7 @@ class Master {
 
   void requeue(Brick& b, const std::string& why, bool counts) {
     b.lastError = why;
+    leased_.erase(b.id);
     if (counts && ++b.failures >= opt_.maxAttempts) {
       b.phase = BrickPhase::Poisoned;
       ++poisoned_;
@@ -466,8 +467,9 @@ class Master {
   // running: whichever result comes first is merged).
   void reissueOverdue(Clock::time_point now) {
     double lease = opt_.leaseSeconds > 0 ? opt_.leaseSeconds : std::max(30.0, 10 * medianBrickSeconds());
-    for (Brick& b : bricks_) {
-      if (b.phase != BrickPhase::Leased || b.leaseReissued) continue;
+    for (uint64_t id : leased_) {
+      Brick& b = bricks_[id];
+      if (b.leaseReissued) continue;
       if (std::chrono::duration<double>(now - b.firstLease).count() > lease) {
         b.leaseReissued = true;
         ++report_.leaseReissues;
@@ -493,6 +495,7 @@ class Master {
     }
     if (b.phase != BrickPhase::Leased) b.firstLease = now;
     b.phase = BrickPhase::Leased;
+    leased_.insert(b.id);
     b.holders[rid] = now;
     p.inflight.insert(b.id);
   }
@@ -527,8 +530,8 @@ class Master {
       auto it = peers_.find(rid);
       if (it == peers_.end() || !it->second.inflight.empty()) continue;
       Brick* oldest = nullptr;
-      for (Brick& b : bricks_)
-        if (b.phase == BrickPhase::Leased && !b.backupIssued && !b.holders.count(rid) &&
+      for (uint64_t id : leased_)
+        if (Brick& b = bricks_[id]; !b.backupIssued && !b.holders.count(rid) &&
             std::chrono::duration<double>(now - b.firstLease).count() > threshold &&
             (!oldest || b.firstLease < oldest->firstLease))
           oldest = &b;
@@ -572,6 +575,8 @@ class Master {
   std::vector<BrickOutput> outputs_;
   std::map<std::string, Peer> peers_;
   std::vector<double> brickSeconds_;
+  std::set<uint64_t> leased_;  // bricks in phase Leased (timers scan only these)
+  size_t payloadLimit_ = 0;
   size_t done_ = 0, poisoned_ = 0;
   FarmReport report_;
   std::unique_ptr<Journal> journal_;

@@ -100,6 +100,9 @@ class ObjectLowering {
       execBlock(obj_.body);
       finish(out);
     } catch (const StopObject&) {
+    } catch (const std::exception& e) {  // a bug or resource limit: report, never crash
+      ++errors_;
+      sh_.diags.error(obj_.loc, std::string("internal error while compiling this object: ") + e.what());
     }
     out.ok = out.ok && errors_ == 0;
     return out;
@@ -653,6 +656,7 @@ class ObjectLowering {
                                     callee.spelling + "(x, a) or " + callee.spelling +
                                     "(x, a, s), not with " + std::to_string(e.args.size()) +
                                     " arguments"};
+    if (!callee.headerOk) return Expr(0.0);  // its header error is already reported
     const int sizes[3] = {callee.xSize, callee.aSize, std::max(1, callee.sSize)};
     const char* roles[3] = {"x", "a", "s"};
     std::vector<Value*> arrs;

@@ -35,6 +35,7 @@ TEST_F(FrepTest, SampleWritesALevelSetOfMinusF) {
   EXPECT_EQ(grid->getGridClass(), openvdb::GRID_LEVEL_SET);
   EXPECT_EQ(grid->metaValue<std::string>("frep_sign"), "value = -f");
   EXPECT_EQ(grid->metaValue<std::string>("frep_object"), "my_model");
+  EXPECT_EQ(grid->metaValue<std::string>("frep_operation"), "sample");
   EXPECT_EQ(grid->metaValue<std::string>("frep_model_hash").size(), 16u);
   EXPECT_NE(grid->metaValue<std::string>("frep_command").find("sample s.hf -b 2 --res 33 --band 3 -O s.vdb"),
             std::string::npos);

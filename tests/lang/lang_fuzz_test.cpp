@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 
 #include "frep/lang/diagnostics.h"
@@ -201,6 +202,13 @@ void check(const std::string& src, Tally& tally) {
   ASSERT_TRUE(anyError) << "not ok but no error:\n" << src;
 }
 
+// FREP_FUZZ_SCALE=k runs k times as many cases (for a long local run; the default is 1).
+int scale() {
+  const char* s = std::getenv("FREP_FUZZ_SCALE");
+  int k = s ? std::atoi(s) : 1;
+  return k > 0 ? k : 1;
+}
+
 TEST(LangFuzz, SeedsCompile) {
   for (const char* seed : kSeeds) {
     CompileResult r = compile(seed, "seed.hf");
@@ -211,7 +219,7 @@ TEST(LangFuzz, SeedsCompile) {
 TEST(LangFuzz, MutatedSeeds) {
   std::mt19937 rng(20261126);
   Tally tally;
-  for (int i = 0; i < 4000; ++i) {
+  for (int i = 0; i < 4000 * scale(); ++i) {
     std::string src = mutate(kSeeds[i % 3], rng);
     check(src, tally);
     if (::testing::Test::HasFatalFailure()) return;
@@ -225,7 +233,7 @@ TEST(LangFuzz, MutatedSeeds) {
 TEST(LangFuzz, RandomTokensAndBytes) {
   std::mt19937 rng(7);
   Tally tally;
-  for (int i = 0; i < 1500; ++i) {
+  for (int i = 0; i < 1500 * scale(); ++i) {
     check(i % 3 == 0 ? randomBytes(rng) : randomTokens(rng), tally);
     if (::testing::Test::HasFatalFailure()) return;
   }

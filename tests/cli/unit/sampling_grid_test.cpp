@@ -45,3 +45,13 @@ TEST(SamplingGrid, ResolutionErrors) {
     EXPECT_STREQ(e.what(), "--res: expected an integer from 2 to 65536, got 1");
   }
 }
+
+TEST(SamplingGrid, ResMatchesTheCoreGridAndStaysInsideTheBox) {
+  Box box = parseBounds("-b", "0,0,0,1,0.35,0.3");
+  frep::GridSpec g = makeGrid(box, 3, resolutionFrom(11, "", 128));
+  frep::GridSpec core = frep::GridSpec::fromBounds(box.lo, box.hi, 11);
+  EXPECT_EQ(g.dims, core.dims);
+  EXPECT_EQ(g.voxel, core.voxel);
+  EXPECT_EQ(g.origin, core.origin);
+  EXPECT_EQ(g.dims, (std::array<int32_t, 3>{11, 4, 4}));  // 0.35 / 0.1 -> 3 steps; 0.3 / 0.1 -> 3
+}

@@ -1,0 +1,148 @@
+// Farm figures, all measured in this run:
+//  1. speed-up of a compute-heavy job from 1 to 2 local workers (this machine has 2 cores);
+//  2. the master's own throughput against instant fake workers (bricks and leaf blocks merged
+//     per second), and from it how many real workers one master keeps busy at the brick time
+//     measured in 1.
+#include <chrono>
+#include <cstdio>
+#include <thread>
+#include <vector>
+#include <zmq.hpp>
+
+#include "brick.h"
+#include "farm_master.h"
+#include "wire.h"
+
+using namespace frep;
+using namespace frep::farm;
+
+namespace {
+
+// Soft objects in HyperFun's sample-model style: a 9-term while loop, heavy per point.
+const char* kHeavyModel = R"(
+my_model(x[3], a[1]) {
+  array x0[9], y0[9], z0[9], d[9];
+  i = 1;
+  while (i <= 9) loop
+    x0[i] = 0.5 * cos(i * 0.7);
+    y0[i] = 0.5 * sin(i * 1.3);
+    z0[i] = 0.4 * sin(i * 0.5);
+    d[i] = 0.55;
+    i = i + 1;
+  endloop;
+  soft = hfSoft(x, x0, y0, z0, d, 0.3);
+  my_model = soft & (0.9 - x[1]^2 - x[2]^2 - x[3]^2) + 0.02 * sin(20 * x[1]) * sin(20 * x[2]);
+}
+)";
+
+JobSpec job(const char* source, int res) {
+  JobSpec j;
+  j.set_operation("sample");
+  j.set_model_source(source);
+  j.set_model_name("bench.hf");
+  GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, res);
+  for (int a = 0; a < 3; ++a) {
+    j.add_origin(g.origin[a]);
+    j.add_dims(g.dims[a]);
+  }
+  j.set_voxel(g.voxel);
+  j.set_band(3);
+  return j;
+}
+
+double seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A fake worker: answers every task at once with a canned payload of `leaves` leaf blocks.
+void fakeWorker(const std::string& ep, int leaves, std::atomic<bool>& stop) {
+  zmq::context_t ctx(1);
+  zmq::socket_t s(ctx, zmq::socket_type::dealer);
+  s.set(zmq::sockopt::linger, 0);
+  s.connect(ep);
+  Envelope hello;
+  hello.mutable_hello()->set_worker_id("fake");
+  send(s, "", hello);
+  std::string payloadCache;
+  while (!stop) {
+    zmq::pollitem_t item{static_cast<void*>(s), 0, ZMQ_POLLIN, 0};
+    zmq::poll(&item, 1, std::chrono::milliseconds(50));
+    Incoming in;
+    while (receive(s, false, in, nullptr)) {
+      if (in.envelope.body_case() == Envelope::kBye) return;
+      if (in.envelope.body_case() != Envelope::kTask) continue;
+      const Task& t = in.envelope.task();
+      BrickOutput b;
+      for (int i = 0; i < leaves; ++i) {
+        LeafBlock l{};
+        l.origin = {t.lo(0) + 8 * (i % 8), t.lo(1) + 8 * ((i / 8) % 8), t.lo(2) + 8 * (i / 64)};
+        l.values.fill(0.5f);
+        l.active.fill(~0ull);
+        b.leaves.push_back(l);
+      }
+      std::string payload = encodeBrick(b);
+      Envelope r;
+      r.set_job_id(in.envelope.job_id());
+      Result* res = r.mutable_result();
+      res->set_brick_id(t.brick_id());
+      res->set_attempt(t.attempt());
+      res->set_leaves(uint32_t(leaves));
+      res->set_payload_crc32(crc32Of(payload.data(), payload.size()));
+      send(s, "", r, &payload);
+    }
+  }
+}
+
+}  // namespace
+
+int main() {
+  // 1. Speed-up, 1 -> 2 local workers.
+  JobSpec heavy = job(kHeavyModel, 256);
+  double t[3] = {0, 0, 0};
+  uint64_t bricks = 0;
+  double brickSeconds = 0;
+  for (int w : {1, 2}) {
+    FarmOptions o;
+    o.workers = w;
+    o.brickVoxels = 64;
+    o.workerExecutable = FREP_WORKER_PATH;
+    auto t0 = std::chrono::steady_clock::now();
+    FarmOutcome out = runSampleJob(heavy, o);
+    t[w] = seconds(t0);
+    bricks = out.report.bricksComputed;
+    if (w == 1) brickSeconds = out.report.perWorker.begin()->second.computeSeconds / double(out.report.bricks);
+    std::printf("heavy model 256^3, %d worker(s): %.2f s, %llu bricks, %llu point evals\n", w, t[w],
+                (unsigned long long)bricks, (unsigned long long)out.report.pointEvals);
+  }
+  std::printf("speed-up 1 -> 2 workers: %.2fx\n", t[1] / t[2]);
+  std::printf("mean brick compute time (64^3 bricks): %.4f s\n\n", brickSeconds);
+
+  // 2. Master throughput with instant fake workers: a 1024^3 grid in 64^3 bricks = 4096
+  //    bricks, each answered with 128 leaf blocks (a surface crossing a 64^3 brick).
+  JobSpec big = job("my_model(x[3], a[1]) { my_model = 1; }", 1024);
+  const int leavesPerBrick = 128;
+  for (int fakes : {2, 8}) {
+    FarmOptions o;
+    o.listen = "tcp://127.0.0.1:" + std::to_string(40000 + fakes);
+    o.brickVoxels = 64;
+    o.heartbeatMs = 500;
+    std::atomic<bool> stop{false};
+    std::vector<std::thread> ws;
+    auto t0 = std::chrono::steady_clock::now();
+    std::thread master([&] {
+      FarmOutcome out = runSampleJob(big, o);
+      double s = seconds(t0);
+      double rate = double(out.report.bricks) / s;
+      std::printf("master with %2d instant fake workers: %llu bricks, %llu leaves in %.2f s = %.0f bricks/s, %.0f leaves/s\n",
+                  fakes, (unsigned long long)out.report.bricks, (unsigned long long)out.report.leaves, s, rate,
+                  double(out.report.leaves) / s);
+      std::printf("  -> at %.4f s per brick one master keeps %.0f workers busy (goal >= 256)\n", brickSeconds,
+                  rate * brickSeconds);
+    });
+    for (int i = 0; i < fakes; ++i) ws.emplace_back(fakeWorker, o.listen, leavesPerBrick, std::ref(stop));
+    master.join();
+    stop = true;
+    for (auto& w : ws) w.join();
+  }
+  return 0;
+}

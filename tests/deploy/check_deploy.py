@@ -1,0 +1,695 @@
+#!/usr/bin/env python3
+"""Checks the deployment files without a container engine or a cluster.
+
+usage: check_deploy.py SOURCE_DIR BIN_DIR
+
+- every YAML file (docker-compose.yml, deploy/k8s/*.yaml) parses and has the expected structure;
+- every flag the deploy files pass to frep / frep-worker appears in that program's --help;
+- deploy/Dockerfile: debian:12, COPY sources and RUN scripts exist, exec-form ENTRYPOINT;
+- deploy/slurm/frep.sbatch passes `bash -n`;
+- then each topology runs as local processes on a tiny sphere (res 32): the compose master and
+  two workers with the compose commands, the same for the Kubernetes manifests, and the sbatch
+  script itself with stub `srun`/`scontrol` and a fake Slurm environment. Each must write the
+  .vdb and its report, and the report must say 2 workers were seen.
+
+Exit status 0 when every check passed; each failure is printed with what was expected.
+"""
+import glob
+import json
+import os
+import re
+import shlex
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+
+try:
+    import yaml
+except ImportError:  # python3-yaml is in deploy/install-deps.sh
+    print("FAIL: python3 cannot import yaml (install python3-yaml: deploy/install-deps.sh)")
+    sys.exit(1)
+
+RUN_TIMEOUT = 60  # seconds for one end-to-end topology
+WORKER_LEAVE_TIMEOUT = 20  # seconds for workers to exit after the master finished
+
+SPHERE = "my_model(x[3], a[1]) { my_model = 1 - x[1]^2 - x[2]^2 - x[3]^2; }\n"
+
+failures = []
+
+
+def fail(what, message):
+    failures.append(f"{what}: {message}")
+    print(f"FAIL {what}: {message}", flush=True)
+
+
+def ok(what):
+    print(f"ok   {what}", flush=True)
+
+
+class Check:
+    """with Check("name"): ...  -- an AssertionError inside is reported as a failure."""
+
+    def __init__(self, name):
+        self.name = name
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, value, tb):
+        if kind is None:
+            ok(self.name)
+            return False
+        if issubclass(kind, AssertionError):
+            fail(self.name, str(value))
+            return True
+        if issubclass(kind, Exception):
+            fail(self.name, f"{kind.__name__}: {value}")
+            return True
+        return False
+
+
+def require(condition, message):
+    if not condition:
+        raise AssertionError(message)
+
+
+# ---------------------------------------------------------------------------------------------
+# helpers
+
+def interpolate(value, env):
+    """Compose variable interpolation: ${VAR}, ${VAR:-default}, ${VAR-default}, $VAR, $$."""
+
+    def one(m):
+        if m.group(0) == "$$":
+            return "$"
+        name = m.group(1) or m.group(4)
+        op, default = m.group(2), m.group(3) or ""
+        if op == ":-":
+            return env.get(name) or default
+        if op == "-":
+            return env.get(name, default)
+        return env.get(name, "")
+
+    pattern = r"\$\$|\$\{([A-Za-z_][A-Za-z0-9_]*)(?:(:?-)([^}]*))?\}|\$([A-Za-z_][A-Za-z0-9_]*)"
+    if isinstance(value, str):
+        return re.sub(pattern, one, value)
+    if isinstance(value, list):
+        return [interpolate(v, env) for v in value]
+    if isinstance(value, dict):
+        return {k: interpolate(v, env) for k, v in value.items()}
+    return value
+
+
+def as_argv(value):
+    if value is None:
+        return []
+    if isinstance(value, str):
+        return shlex.split(value)
+    return [str(v) for v in value]
+
+
+def flag_value(argv, flag):
+    for i, a in enumerate(argv):
+        if a == flag and i + 1 < len(argv):
+            return argv[i + 1]
+        if a.startswith(flag + "="):
+            return a.split("=", 1)[1]
+    return None
+
+
+def set_flag(argv, flag, value):
+    out = list(argv)
+    for i, a in enumerate(out):
+        if a == flag and i + 1 < len(out):
+            out[i + 1] = value
+            return out
+        if a.startswith(flag + "="):
+            out[i] = f"{flag}={value}"
+            return out
+    return out + [flag, value]
+
+
+def help_text(binary, *args):
+    p = subprocess.run([binary, *args, "--help"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                       text=True, timeout=30)
+    return p.stdout
+
+
+def check_flags(argv, help_txt, program):
+    """Every option in argv must be named in the program's --help."""
+    missing = []
+    for a in argv:
+        if not a.startswith("-") or a == "-" or re.fullmatch(r"-[0-9.]+", a):
+            continue
+        flag = a.split("=", 1)[0]
+        if not re.search(r"(?<![\w-])" + re.escape(flag) + r"(?![\w-])", help_txt):
+            missing.append(flag)
+    require(not missing, f"{program} --help does not mention {', '.join(missing)} (used in {shlex.join(argv)})")
+
+
+def program_name(argv):
+    return os.path.basename(argv[0]) if argv else ""
+
+
+def free_port():
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def tail(path, n=15):
+    try:
+        with open(path, errors="replace") as f:
+            return "".join(f.readlines()[-n:])
+    except OSError:
+        return "(no output)"
+
+
+def kill_group(p, sig=signal.SIGKILL):
+    try:
+        os.killpg(p.pid, sig)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
+def check_outputs(out_vdb, what):
+    report_path = out_vdb + ".report.json"
+    require(os.path.isfile(out_vdb) and os.path.getsize(out_vdb) > 0, f"{what}: {out_vdb} was not written")
+    require(os.path.isfile(report_path), f"{what}: {report_path} was not written")
+    with open(report_path) as f:
+        report = json.load(f)
+    seen = report.get("workers_seen")
+    require(seen == 2, f"{what}: report says workers_seen={seen!r}, expected 2")
+
+
+def localize_master(argv, model, out_vdb, port):
+    """The master's command line with the test's model, output, size and a local port."""
+    argv = list(argv)
+    require(len(argv) >= 3 and argv[1] == "sample", f"master command is not `frep sample MODEL ...`: {argv}")
+    argv[0] = os.path.join(BIN_DIR, "frep")
+    argv[2] = model
+    argv = set_flag(argv, "--out", out_vdb)
+    argv = set_flag(argv, "--res", "32")
+    argv = set_flag(argv, "-b", "1.5")
+    argv = set_flag(argv, "--listen", f"tcp://127.0.0.1:{port}")
+    argv = set_flag(argv, "--expect-workers", "2")
+    return argv
+
+
+def local_endpoint(endpoint, port):
+    m = re.fullmatch(r"tcp://([^:/]+):(\d+)", endpoint or "")
+    require(m is not None, f"worker endpoint {endpoint!r} is not tcp://HOST:PORT")
+    return f"tcp://127.0.0.1:{port}"
+
+
+def run_topology(what, master_argv, worker_argvs, worker_env, tmp, out_vdb):
+    """Starts the master and the workers as local processes; checks outputs and exit codes."""
+    procs = []
+    logs = []
+    try:
+        mlog = os.path.join(tmp, "master.log")
+        logs.append(("master", mlog))
+        with open(mlog, "w") as f:
+            master = subprocess.Popen(master_argv, stdout=f, stderr=subprocess.STDOUT, cwd=tmp,
+                                      start_new_session=True)
+        procs.append(master)
+        workers = []
+        for i, argv in enumerate(worker_argvs):
+            wlog = os.path.join(tmp, f"worker{i}.log")
+            logs.append((f"worker {i}", wlog))
+            env = dict(os.environ)
+            env.pop("FREP_MASTER", None)
+            env.update(worker_env)
+            with open(wlog, "w") as f:
+                w = subprocess.Popen(argv, stdout=f, stderr=subprocess.STDOUT, cwd=tmp, env=env,
+                                     start_new_session=True)
+            workers.append(w)
+            procs.append(w)
+        try:
+            rc = master.wait(timeout=RUN_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            raise AssertionError(f"{what}: the master did not finish within {RUN_TIMEOUT} s")
+        require(rc == 0, f"{what}: master exited with {rc}")
+        deadline = time.time() + WORKER_LEAVE_TIMEOUT
+        for i, w in enumerate(workers):
+            try:
+                wrc = w.wait(timeout=max(0.1, deadline - time.time()))
+            except subprocess.TimeoutExpired:
+                raise AssertionError(f"{what}: worker {i} still running {WORKER_LEAVE_TIMEOUT} s after the master finished")
+            require(wrc == 0, f"{what}: worker {i} exited with {wrc}")
+        check_outputs(out_vdb, what)
+    except AssertionError as e:
+        detail = "\n".join(f"--- {name} ({shlex.join(p.args) if hasattr(p, 'args') else ''}):\n{tail(log)}"
+                           for (name, log), p in zip(logs, procs))
+        raise AssertionError(f"{e}\n{detail}")
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                kill_group(p)
+                p.wait()
+
+
+# ---------------------------------------------------------------------------------------------
+# checks
+
+def check_yaml_files():
+    files = [os.path.join(SRC, "docker-compose.yml")] + sorted(glob.glob(os.path.join(SRC, "deploy", "k8s", "*.yaml")) +
+                                                           glob.glob(os.path.join(SRC, "deploy", "k8s", "*.yml")))
+    docs = {}
+    for path in files:
+        rel = os.path.relpath(path, SRC)
+        with Check(f"YAML parses: {rel}"):
+            require(os.path.isfile(path), "missing")
+            with open(path) as f:
+                docs[rel] = [d for d in yaml.safe_load_all(f) if d is not None]
+            require(docs[rel], "no document")
+    return docs
+
+
+def check_dockerfile(compose_programs):
+    path = os.path.join(SRC, "deploy", "Dockerfile")
+    with Check("Dockerfile: base, COPY sources, RUN scripts, exec-form ENTRYPOINT"):
+        require(os.path.isfile(path), "deploy/Dockerfile is missing")
+        with open(path) as f:
+            text = f.read()
+        # Logical instructions: join continuation lines, drop comments.
+        lines, cur = [], ""
+        for raw in text.splitlines():
+            s = raw.strip()
+            if not cur and (not s or s.startswith("#")):
+                continue
+            if s.startswith("#"):
+                continue
+            if s.endswith("\\"):
+                cur += s[:-1] + " "
+                continue
+            lines.append(cur + s)
+            cur = ""
+        instr = [(l.split(None, 1)[0].upper(), l.split(None, 1)[1] if len(l.split(None, 1)) > 1 else "") for l in lines]
+        froms = [a.split()[0] for k, a in instr if k == "FROM"]
+        require(froms and all(f == "debian:12" for f in froms), f"FROM must be debian:12, got {froms}")
+        copied = set()
+        for k, a in instr:
+            if k in ("COPY", "ADD"):
+                parts = [p for p in a.split() if not p.startswith("--")]
+                if "--from" in a:
+                    continue
+                for src in parts[:-1]:
+                    require(os.path.exists(os.path.join(SRC, src)), f"COPY source {src} does not exist")
+                    copied.add(os.path.normpath(src))
+        # Every source folder the top-level CMakeLists.txt adds must be in the image (tests and
+        # bench only when the Dockerfile does not switch them off).
+        with open(os.path.join(SRC, "CMakeLists.txt")) as f:
+            subdirs = re.findall(r"add_subdirectory\(\s*([\w./-]+)", f.read())
+        run_text = " ".join(a for k, a in instr if k == "RUN")
+        for d in subdirs:
+            if d == "tests" and "FREP_BUILD_TESTS=OFF" in run_text:
+                continue
+            if d == "bench" and "FREP_BUILD_BENCH=OFF" in run_text:
+                continue
+            require(d in copied or "." in copied, f"add_subdirectory({d}) but the Dockerfile does not COPY {d}")
+        require("CMakeLists.txt" in copied or "." in copied, "the top-level CMakeLists.txt is not copied")
+        # Scripts the RUN lines call must exist in the checkout (as /src/<path> or <path>).
+        scripts = re.findall(r"(?:/src/|\./)?(deploy/[\w./-]+\.sh)", run_text)
+        require(any(s.endswith("install-deps.sh") for s in scripts), "no RUN line runs deploy/install-deps.sh")
+        for s in scripts:
+            require(os.path.isfile(os.path.join(SRC, s)), f"RUN uses {s}, which does not exist")
+            require(os.access(os.path.join(SRC, s), os.X_OK), f"RUN uses {s}, which is not executable")
+        require("CMAKE_BUILD_TYPE=Release" in run_text, "cmake is not run with -DCMAKE_BUILD_TYPE=Release")
+        for prog in ("frep", "frep-worker"):
+            require(re.search(r"/usr/local/bin/?\S*", text) and re.search(r"bin/" + re.escape(prog) + r"\b", text),
+                    f"{prog} is not installed into /usr/local/bin")
+        entry = [a for k, a in instr if k == "ENTRYPOINT"]
+        require(entry, "no ENTRYPOINT")
+        try:
+            ep = json.loads(entry[-1])
+        except ValueError:
+            raise AssertionError(f"ENTRYPOINT is not in exec form (a JSON array): {entry[-1]}")
+        require(isinstance(ep, list) and ep and os.path.basename(ep[0]) in ("frep", "frep-worker"),
+                f"ENTRYPOINT should run frep or frep-worker: {ep}")
+        for prog in compose_programs:
+            require(prog in ("frep", "frep-worker", "/usr/local/bin/frep", "/usr/local/bin/frep-worker"),
+                    f"an entrypoint runs {prog}, which the image does not install")
+
+    # The runtime stage installs the packages that own the libraries the programs load: run the
+    # Dockerfile's own pipeline on the binaries built here.
+    m = re.search(r"RUN (ldd /usr/local/bin/frep[^\n]*(?:\\\n[^\n]*)*?> /runtime-packages\.txt)", text)
+    if m and subprocess.run(["which", "dpkg"], stdout=subprocess.DEVNULL).returncode == 0:
+        with Check("Dockerfile: runtime-package pipeline finds the libraries' packages"):
+            cmd = m.group(1).replace("\\\n", " ").replace("/usr/local/bin/", BIN_DIR + "/")
+            cmd = cmd.replace("> /runtime-packages.txt", "")
+            p = subprocess.run(["bash", "-o", "pipefail", "-c", cmd], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, timeout=60)
+            pkgs = p.stdout.split()
+            require(p.returncode == 0, f"pipeline failed: {p.stderr.strip()}")
+            require(any(x.startswith("libzmq") for x in pkgs) and "libc6" in pkgs,
+                    f"expected libzmq5 and libc6 among {pkgs}")
+
+
+def check_compose(docs, frep_help, worker_help):
+    compose = docs.get("docker-compose.yml", [None])[0]
+    result = {}
+    with Check("docker-compose.yml: master and worker services"):
+        require(isinstance(compose, dict) and isinstance(compose.get("services"), dict), "no services")
+        env = {}  # defaults only, as on a machine with no FREP_* variables set
+        services = interpolate(compose["services"], env)
+        require("master" in services and "worker" in services, f"services are {list(services)}")
+        master, worker = services["master"], services["worker"]
+        for name, svc in (("master", master), ("worker", worker)):
+            b = svc.get("build")
+            if b:
+                ctx = b if isinstance(b, str) else b.get("context", ".")
+                df = None if isinstance(b, str) else b.get("dockerfile")
+                require(os.path.isdir(os.path.join(SRC, ctx)), f"{name}: build context {ctx} missing")
+                if df:
+                    require(os.path.isfile(os.path.join(SRC, ctx, df)), f"{name}: {df} missing")
+            require("stop_grace_period" in svc, f"{name}: no stop_grace_period")
+        margv = as_argv(master.get("entrypoint")) + as_argv(master.get("command"))
+        wargv = as_argv(worker.get("entrypoint")) + as_argv(worker.get("command"))
+        require(program_name(margv) == "frep" and margv[1:2] == ["sample"], f"master runs {margv}")
+        for flag in ("--out", "--listen", "--expect-workers", "--json"):
+            require(flag in margv, f"master command lacks {flag}")
+        require(re.fullmatch(r"\d+", flag_value(margv, "--expect-workers") or ""),
+                f"--expect-workers {flag_value(margv, '--expect-workers')!r} is not a number")
+        require(program_name(wargv) == "frep-worker", f"worker runs {wargv}")
+        listen = flag_value(margv, "--listen")
+        port = re.fullmatch(r"tcp://\*:(\d+)", listen or "")
+        require(port, f"master --listen {listen!r} is not tcp://*:PORT")
+        connect = flag_value(wargv, "--connect") or worker.get("environment", {}).get("FREP_MASTER")
+        require(connect == f"tcp://master:{port.group(1)}", f"worker connects to {connect!r}, expected tcp://master:{port.group(1)}")
+        require(str(worker.get("restart", "")).startswith("on-failure"), f"worker restart is {worker.get('restart')!r}")
+        # Volumes: the model comes from ./examples read-only, the output goes to a named volume.
+        named = set((compose.get("volumes") or {}).keys())
+        mounts = [str(v) for v in master.get("volumes", [])]
+        out_dir = os.path.dirname(flag_value(margv, "--out"))
+        out_mounts = [m for m in mounts if m.split(":")[1] == out_dir]
+        require(out_mounts and out_mounts[0].split(":")[0] in named,
+                f"--out is in {out_dir}, which is not a named volume (mounts {mounts}, volumes {sorted(named)})")
+        model = margv[2]
+        model_mounts = [m for m in mounts if model.startswith(m.split(":")[1].rstrip("/") + "/")]
+        require(model_mounts, f"the model {model} is in no mounted directory")
+        host_dir, cont_dir = model_mounts[0].split(":")[:2]
+        require(model_mounts[0].endswith(":ro"), f"the model mount {model_mounts[0]} is not read-only")
+        host_model = os.path.join(SRC, host_dir, os.path.relpath(model, cont_dir))
+        require(os.path.isfile(host_model), f"the model {model} would be {host_model}, which does not exist")
+        result = {"master": margv, "worker": wargv, "model": host_model}
+    if result:
+        with Check("docker-compose.yml: flags exist in frep / frep-worker --help"):
+            check_flags(result["master"][2:], frep_help, "frep sample")
+            check_flags(result["worker"][1:], worker_help, "frep-worker")
+    return result
+
+
+def k8s_objects(docs):
+    objs = []
+    for rel, ds in docs.items():
+        if rel.startswith("deploy"):
+            for d in ds:
+                if isinstance(d, dict) and d.get("kind") == "List":
+                    objs += d.get("items", [])
+                elif isinstance(d, dict):
+                    objs.append(d)
+    return objs
+
+
+def check_k8s(docs, frep_help, worker_help):
+    objs = k8s_objects(docs)
+    result = {}
+    with Check("deploy/k8s: master Job + Service, worker Job, ConfigMap, PVC"):
+        by_kind = {}
+        for o in objs:
+            require("apiVersion" in o and "kind" in o and o.get("metadata", {}).get("name"),
+                    f"object without apiVersion/kind/metadata.name: {str(o)[:80]}")
+            by_kind.setdefault(o["kind"], []).append(o)
+        jobs = by_kind.get("Job", [])
+
+        def container(job):
+            return job["spec"]["template"]["spec"]["containers"][0]
+
+        def argv(c):
+            return as_argv(c.get("command")) + as_argv(c.get("args"))
+
+        masters = [j for j in jobs if program_name(argv(container(j))) == "frep"]
+        workers = [j for j in jobs if program_name(argv(container(j))) == "frep-worker"]
+        require(len(masters) == 1 and len(workers) == 1,
+                f"expected one Job running frep and one running frep-worker, got {[j['metadata']['name'] for j in jobs]}")
+        mjob, wjob = masters[0], workers[0]
+        mc, wc = container(mjob), container(wjob)
+        margv, wargv = argv(mc), argv(wc)
+        require(margv[1:2] == ["sample"] and "--listen" in margv and "--expect-workers" in margv,
+                f"master runs {margv}")
+        port = re.fullmatch(r"tcp://\*:(\d+)", flag_value(margv, "--listen") or "")
+        require(port, f"master --listen {flag_value(margv, '--listen')!r} is not tcp://*:PORT")
+        port = int(port.group(1))
+        # The Service selects the master pod and exposes the port.
+        labels = mjob["spec"]["template"].get("metadata", {}).get("labels", {})
+        services = [s for s in by_kind.get("Service", [])
+                    if s["spec"].get("selector") and all(labels.get(k) == v for k, v in s["spec"]["selector"].items())]
+        require(services, f"no Service selects the master pod labels {labels}")
+        svc = services[0]
+        sports = {p.get("port"): p.get("targetPort", p.get("port")) for p in svc["spec"].get("ports", [])}
+        require(any(t == port for t in sports.values()), f"Service {svc['metadata']['name']} does not target port {port}")
+        svc_port = [p for p, t in sports.items() if t == port][0]
+        # Workers: parallelism, endpoint by env var, FailJob on 78.
+        wspec = wjob["spec"]
+        require(int(wspec.get("parallelism", 1)) >= 2, "worker Job parallelism should be >= 2")
+        env = {e["name"]: e.get("value") for e in wc.get("env", [])}
+        expected = f"tcp://{svc['metadata']['name']}:{svc_port}"
+        require(env.get("FREP_MASTER") == expected, f"worker FREP_MASTER={env.get('FREP_MASTER')!r}, expected {expected}")
+        require(wspec["template"]["spec"].get("restartPolicy") == "Never", "podFailurePolicy needs restartPolicy Never")
+        rules = wspec.get("podFailurePolicy", {}).get("rules", [])
+        require(any(r.get("action") == "FailJob" and 78 in r.get("onExitCodes", {}).get("values", [])
+                    and r["onExitCodes"].get("operator") == "In"
+                    and r["onExitCodes"].get("containerName", wc["name"]) == wc["name"] for r in rules),
+                "worker Job has no podFailurePolicy rule FailJob on exit code 78")
+        # Volumes: the model from a ConfigMap, the output on a PVC.
+        vols = {v["name"]: v for v in mjob["spec"]["template"]["spec"].get("volumes", [])}
+        mounts = {m["mountPath"].rstrip("/"): m["name"] for m in mc.get("volumeMounts", [])}
+        model = margv[2]
+        mdir = os.path.dirname(model)
+        require(mdir in mounts and "configMap" in vols.get(mounts[mdir], {}),
+                f"the model {model} is not on a mounted ConfigMap")
+        cm_name = vols[mounts[mdir]]["configMap"]["name"]
+        cms = [c for c in by_kind.get("ConfigMap", []) if c["metadata"]["name"] == cm_name]
+        require(cms and os.path.basename(model) in cms[0].get("data", {}),
+                f"ConfigMap {cm_name} with key {os.path.basename(model)} is not in deploy/k8s")
+        odir = os.path.dirname(flag_value(margv, "--out") or "")
+        require(odir in mounts and "persistentVolumeClaim" in vols.get(mounts[odir], {}),
+                f"--out is in {odir}, which is not a mounted PVC")
+        claim = vols[mounts[odir]]["persistentVolumeClaim"]["claimName"]
+        require(any(p["metadata"]["name"] == claim for p in by_kind.get("PersistentVolumeClaim", [])),
+                f"PVC {claim} is not in deploy/k8s")
+        result = {"master": margv, "worker": wargv, "env": env, "model_text": cms[0]["data"][os.path.basename(model)],
+                  "parallelism": int(wspec.get("parallelism", 1))}
+    if result:
+        with Check("deploy/k8s: flags exist in frep / frep-worker --help"):
+            check_flags(result["master"][2:], frep_help, "frep sample")
+            check_flags(result["worker"][1:], worker_help, "frep-worker")
+        with Check("deploy/k8s: the ConfigMap's model compiles (frep check)"):
+            with tempfile.TemporaryDirectory() as tmp:
+                path = os.path.join(tmp, "model.hf")
+                with open(path, "w") as f:
+                    f.write(result["model_text"])
+                p = subprocess.run([os.path.join(BIN_DIR, "frep"), "check", path], stdout=subprocess.PIPE,
+                                   stderr=subprocess.STDOUT, text=True, timeout=30)
+                require(p.returncode == 0, f"frep check failed ({p.returncode}): {p.stdout.strip()}")
+    return result
+
+
+def check_sbatch_syntax():
+    path = os.path.join(SRC, "deploy", "slurm", "frep.sbatch")
+    text = None
+    with Check("frep.sbatch: bash -n, Slurm directives"):
+        require(os.path.isfile(path), "deploy/slurm/frep.sbatch is missing")
+        p = subprocess.run(["bash", "-n", path], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        require(p.returncode == 0, f"bash -n: {p.stdout.strip()}")
+        with open(path) as f:
+            text = f.read()
+        require(re.search(r"^#SBATCH\s+--signal=", text, re.M), "no #SBATCH --signal= for a graceful stop")
+        require("scontrol show hostnames" in text and "SLURM_JOB_NODELIST" in text, "master host not from the node list")
+        require("SLURM_PROCID" in text and "FREP_MASTER" in text, "no SLURM_PROCID split / FREP_MASTER")
+        require(re.search(r"\bsrun\b", text), "no srun")
+    return text
+
+
+def sbatch_command_flags(text, program):
+    """The options on the line(s) of the sbatch script that exec `program`."""
+    m = re.search(r'exec "\$\{FREP_BIN\}' + re.escape(program) + r'"((?:[^\n]*\\\n)*[^\n]*)', text)
+    require(m, f"the task script does not exec \"${{FREP_BIN}}{program}\"")
+    segment = m.group(1)
+    flags = re.findall(r"(?<![\w$-])--?[A-Za-z][\w-]*", segment)
+    # Options kept in bash arrays (curve=(--curve "$DIR")) and expanded as "${curve[@]}".
+    for name in re.findall(r'"\$\{(\w+)\[@\]\}"', segment):
+        flags += re.findall(r"\b" + name + r"=\((--?[A-Za-z][\w-]*)", text)
+    return flags
+
+
+def check_sbatch_flags(text, frep_help, worker_help):
+    with Check("frep.sbatch: flags exist in frep / frep-worker --help"):
+        require(text, "the script did not pass its syntax check")
+        check_flags(sbatch_command_flags(text, "frep"), frep_help, "frep sample")
+        check_flags(sbatch_command_flags(text, "frep-worker"), worker_help, "frep-worker")
+
+
+# ---------------------------------------------------------------------------------------------
+# end to end, as local processes
+
+def e2e_compose(c):
+    with Check("docker-compose topology as local processes (master + 2 workers)"):
+        require(c, "the compose file did not pass its structure check")
+        with tempfile.TemporaryDirectory(prefix="frep-compose-") as tmp:
+            model = os.path.join(tmp, "sphere.hf")
+            with open(model, "w") as f:
+                f.write(SPHERE)
+            port = free_port()
+            out_vdb = os.path.join(tmp, "out", "sphere.vdb")
+            os.makedirs(os.path.dirname(out_vdb))
+            margv = localize_master(c["master"], model, out_vdb, port)
+            wargv = list(c["worker"])
+            wargv[0] = os.path.join(BIN_DIR, "frep-worker")
+            wargv = set_flag(wargv, "--connect", local_endpoint(flag_value(wargv, "--connect"), port))
+            run_topology("compose", margv, [wargv, wargv], {}, tmp, out_vdb)
+
+
+def e2e_k8s(k):
+    with Check("Kubernetes topology as local processes (master + 2 workers, FREP_MASTER)"):
+        require(k, "the manifests did not pass their structure check")
+        with tempfile.TemporaryDirectory(prefix="frep-k8s-") as tmp:
+            model = os.path.join(tmp, "model.hf")
+            with open(model, "w") as f:
+                f.write(SPHERE)
+            port = free_port()
+            out_vdb = os.path.join(tmp, "output", "model.vdb")
+            os.makedirs(os.path.dirname(out_vdb))
+            margv = localize_master(k["master"], model, out_vdb, port)
+            wargv = list(k["worker"])
+            wargv[0] = os.path.join(BIN_DIR, "frep-worker")
+            env = dict(k["env"])
+            env["FREP_MASTER"] = local_endpoint(env.get("FREP_MASTER"), port)
+            run_topology("k8s", margv, [wargv, wargv], env, tmp, out_vdb)
+
+
+SRUN_STUB = r"""#!/usr/bin/env bash
+# Test stub for srun: starts --ntasks copies of the command on this machine with SLURM_PROCID
+# set, each writing to --output (with %j and %t expanded), and exits with task 0's status.
+n=1; out=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --ntasks=*) n="${1#*=}"; shift ;;
+    -n) n="$2"; shift 2 ;;
+    --output=*) out="${1#*=}"; shift ;;
+    -*) shift ;;
+    *) break ;;
+  esac
+done
+echo "srun-stub: $n tasks: $*" >&2
+pids=()
+for ((i = 0; i < n; i++)); do
+  log="${out:-/dev/stderr}"; log="${log//%j/${SLURM_JOB_ID:-0}}"; log="${log//%t/$i}"
+  SLURM_PROCID=$i SLURM_LOCALID=$i SLURM_NODEID=0 SLURM_STEP_ID=0 "$@" >"$log" 2>&1 &
+  pids+=($!)
+done
+rc=0
+for i in "${!pids[@]}"; do
+  wait "${pids[$i]}"; r=$?
+  [ "$i" -eq 0 ] && rc=$r
+  echo "srun-stub: task $i exited $r" >&2
+done
+exit $rc
+"""
+
+SCONTROL_STUB = r"""#!/usr/bin/env bash
+# Test stub for scontrol: `scontrol show hostnames LIST` prints LIST's hosts one per line
+# (plain comma-separated lists only).
+if [ "$1" = show ] && [ "$2" = hostnames ]; then
+  tr ',' '\n' <<< "${3:-$SLURM_JOB_NODELIST}"
+  exit 0
+fi
+echo "scontrol stub: unsupported: $*" >&2
+exit 1
+"""
+
+
+def e2e_sbatch():
+    with Check("frep.sbatch run with stub srun/scontrol (task 0 master, tasks 1-2 workers)"):
+        script = os.path.join(SRC, "deploy", "slurm", "frep.sbatch")
+        with tempfile.TemporaryDirectory(prefix="frep-slurm-") as tmp:
+            stubs = os.path.join(tmp, "stubs")
+            os.makedirs(stubs)
+            for name, body in (("srun", SRUN_STUB), ("scontrol", SCONTROL_STUB)):
+                with open(os.path.join(stubs, name), "w") as f:
+                    f.write(body)
+                os.chmod(os.path.join(stubs, name), 0o755)
+            model = os.path.join(tmp, "sphere.hf")
+            with open(model, "w") as f:
+                f.write(SPHERE)
+            out_vdb = os.path.join(tmp, "sphere.vdb")
+            env = {k: v for k, v in os.environ.items() if not k.startswith(("SLURM_", "FREP_"))}
+            env.update({
+                "PATH": stubs + os.pathsep + BIN_DIR + os.pathsep + env.get("PATH", "/usr/bin:/bin"),
+                "SLURM_JOB_ID": "4242", "SLURM_JOB_NODELIST": "localhost", "SLURM_NTASKS": "3",
+                "SLURM_NNODES": "1", "SLURM_CPUS_PER_TASK": "1", "SLURM_SUBMIT_DIR": tmp,
+                "FREP_PORT": str(free_port()), "FREP_LOG_DIR": os.path.join(tmp, "logs"),
+            })
+            log = os.path.join(tmp, "sbatch.log")
+            with open(log, "w") as f:
+                p = subprocess.Popen(["bash", script, model, out_vdb, "--res", "32", "-b", "1.5"], cwd=tmp, env=env,
+                                     stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
+            try:
+                try:
+                    rc = p.wait(timeout=RUN_TIMEOUT + WORKER_LEAVE_TIMEOUT)
+                except subprocess.TimeoutExpired:
+                    raise AssertionError(f"the job did not finish within {RUN_TIMEOUT + WORKER_LEAVE_TIMEOUT} s")
+                require(rc == 0, f"the batch script exited with {rc}")
+                check_outputs(out_vdb, "sbatch")
+            except AssertionError as e:
+                detail = f"--- batch script:\n{tail(log)}"
+                for t in sorted(glob.glob(os.path.join(tmp, "logs", "*.log"))):
+                    detail += f"\n--- {os.path.basename(t)}:\n{tail(t)}"
+                raise AssertionError(f"{e}\n{detail}")
+            finally:
+                if p.poll() is None:
+                    kill_group(p)
+                    p.wait()
+                else:
+                    kill_group(p)  # stray tasks of the stub srun
+
+
+def main():
+    global SRC, BIN_DIR
+    if len(sys.argv) != 3:
+        print(__doc__)
+        return 2
+    SRC, BIN_DIR = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    frep, worker = os.path.join(BIN_DIR, "frep"), os.path.join(BIN_DIR, "frep-worker")
+    for b in (frep, worker):
+        if not os.access(b, os.X_OK):
+            print(f"FAIL: {b} is not an executable")
+            return 1
+    frep_help = help_text(frep, "sample")
+    worker_help = help_text(worker)
+
+    docs = check_yaml_files()
+    c = check_compose(docs, frep_help, worker_help)
+    compose_programs = [program_name(c[k]) for k in ("master", "worker")] if c else []
+    check_dockerfile(compose_programs)
+    k = check_k8s(docs, frep_help, worker_help)
+    sbatch_text = check_sbatch_syntax()
+    check_sbatch_flags(sbatch_text, frep_help, worker_help)
+
+    e2e_compose(c)
+    e2e_k8s(k)
+    e2e_sbatch()
+
+    if failures:
+        print(f"\n{len(failures)} check(s) failed")
+        return 1
+    print("\nall deploy checks passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
