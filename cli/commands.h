@@ -34,13 +34,30 @@ struct SliceRequest {
 };
 int runSlice(const SliceRequest& request);
 
+// How a job runs: the farm's options (docs/farm.md). None of them changes the output.
+struct FarmRequest {
+  int workers = -1;          // local workers; -1 one per core, 0 in-process
+  std::string listen;        // cluster mode endpoint
+  int expectWorkers = 0;
+  int brick = 64;            // brick edge in voxels
+  int heartbeatMs = 500;
+  bool resume = false;
+  bool json = false;         // JSON progress events on stdout
+  bool noProgress = false;
+  std::string curveDir;
+};
+
 struct SampleRequest {
   ModelRequest model;
   RegionRequest region;
+  FarmRequest farm;
   int band = 3;     // narrow band half-width in voxels
-  int threads = 0;  // 0: all cores
-  std::string commandLine;  // recorded in the grid's metadata
+  int threads = 0;  // threads of the in-process run (--workers 0); 0: all cores
+  std::string commandLine;  // recorded in the grid's metadata (without execution options)
+  std::string logLevel = "info";
 };
 int runSample(const SampleRequest& request);
+
+int runKeygen(const std::string& dir);
 
 }  // namespace frep::cli

@@ -13,12 +13,16 @@ enum ExitCode : int {
   kExitBadArgs = 2,     // a command-line argument is missing or malformed
   kExitIoError = 3,     // a file could not be read or written
   kExitInternal = 4,    // a bug or an unexpected failure inside frep
+  kExitPoisoned = 5,    // some bricks failed 3 times (named on stderr); no output, journal kept
+  kExitInterrupted = 6, // SIGTERM/SIGINT: journal flushed, continue with --resume
+  kExitFarmError = 7,   // the farm could not run (bind failed, no worker alive, CURVE keys, journal)
 };
 
 // What a user reads after "frep --help".
 inline const char* exitCodeHelp() {
   return "Exit codes: 0 ok, 1 model error (diagnostics printed), 2 bad arguments, "
-         "3 I/O error, 4 internal error.";
+         "3 I/O error, 4 internal error, 5 bricks poisoned (named), 6 interrupted (use --resume), "
+         "7 farm error.";
 }
 
 // Thrown anywhere in a command; main prints what() and exits with code.

@@ -33,6 +33,32 @@ std::string joinCommandLine(int argc, char** argv) {
   return line;
 }
 
+// The command line as recorded in the output, without the options that only choose how the
+// job runs (they never change the result, so outputs of any worker count stay identical).
+std::string recordedCommandLine(int argc, char** argv) {
+  // The output path is left out too: the same grid written anywhere is the same file.
+  static const char* execution[] = {"--workers", "--listen", "--expect-workers", "--heartbeat-ms", "--curve",
+                                    "--threads", "--log-level", "--brick", "-O", "--out"};
+  static const char* flags[] = {"--resume", "--json", "--no-progress"};
+  std::vector<char*> kept;
+  for (int i = 0; i < argc; ++i) {
+    std::string a = argv[i];
+    bool drop = false;
+    for (const char* f : flags) drop = drop || a == f;
+    for (const char* o : execution) {
+      std::string opt = o;
+      if (a == opt) {
+        drop = true;
+        ++i;  // and its value
+      } else if (a.rfind(opt + "=", 0) == 0) {
+        drop = true;
+      }
+    }
+    if (!drop) kept.push_back(argv[i]);
+  }
+  return joinCommandLine(int(kept.size()), kept.data());
+}
+
 void addModelOptions(CLI::App* sub, ModelRequest& m, bool withFieldOptions) {
   sub->add_option("model", m.path, "The HyperFun model (.hf)")->required();
   sub->add_option("-o,--object", m.object, "Object to use (as hfp: default my_model, else the first)");
@@ -97,7 +123,23 @@ int main(int argc, char** argv) {
   addModelOptions(sampleCmd, sample.model, true);
   addRegionOptions(sampleCmd, sample.region, "Output .vdb file", 128);
   sampleCmd->add_option("--band", sample.band, "Band half-width in voxels (default 3)");
-  sampleCmd->add_option("--threads", sample.threads, "Threads (default 0: all cores)");
+  sampleCmd->add_option("--threads", sample.threads, "Threads of the in-process run, --workers 0 (default 0: all cores)");
+  sampleCmd->add_option("--workers", sample.farm.workers,
+                        "Local worker processes (default: one per core; 0 computes in-process)");
+  sampleCmd->add_option("--listen", sample.farm.listen,
+                        "Cluster mode: bind here (e.g. tcp://*:5555), start no workers; they connect with "
+                        "frep-worker --connect");
+  sampleCmd->add_option("--expect-workers", sample.farm.expectWorkers, "Cluster mode: workers expected (progress)");
+  sampleCmd->add_option("--brick", sample.farm.brick, "Brick edge in voxels, a multiple of 8 (default 64)");
+  sampleCmd->add_option("--heartbeat-ms", sample.farm.heartbeatMs, "Heartbeat interval both ways (default 500)");
+  sampleCmd->add_flag("--resume", sample.farm.resume, "Continue a stopped job from OUT.journal");
+  sampleCmd->add_flag("--json", sample.farm.json, "JSON progress events on stdout (batch systems)");
+  sampleCmd->add_flag("--no-progress", sample.farm.noProgress, "No progress bar");
+  sampleCmd->add_option("--curve", sample.farm.curveDir, "Require CURVE keys from DIR (see frep keygen)");
+
+  std::string keygenDir;
+  CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
+  keygenCmd->add_option("dir", keygenDir, "Directory for the keys")->required();
 
   for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd}) sub->fallthrough();
 
@@ -107,7 +149,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice and sample";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
@@ -126,8 +168,10 @@ int main(int argc, char** argv) {
       checkObjectIsNotAFile(slice.model);
       return runSlice(slice);
     }
+    if (keygenCmd->parsed()) return runKeygen(keygenDir);
     checkObjectIsNotAFile(sample.model);
-    sample.commandLine = joinCommandLine(argc, argv);
+    sample.commandLine = recordedCommandLine(argc, argv);
+    sample.logLevel = logLevel;
     return runSample(sample);
   } catch (const CliError& e) {
     std::cerr << "frep: error: " << e.what() << "\n";

@@ -24,40 +24,38 @@ std::string readFile(const std::string& path) {
   return text.str();
 }
 
-Expr bindParameters(const LoadedModel& m, const std::string& text) {
-  std::vector<Expr> values(size_t(m.model.aSize), Expr(0.0));  // hfp's default: all zero
-  if (!text.empty()) {
-    std::vector<double> given = parseNumbers("-a/--params", text, "at most " + std::to_string(m.model.aSize));
-    if (given.size() > values.size())
-      throw badArgs("-a/--params: object '" + m.model.objectName + "' has a[" + std::to_string(m.model.aSize) +
-                    "], got " + std::to_string(given.size()) + " values in '" + text + "'");
-    std::copy(given.begin(), given.end(), values.begin());
-  }
-  return bindParams(m.model.field, values);
+std::vector<double> parseParameters(const lang::Model& model, const std::string& text) {
+  if (text.empty()) return {};
+  std::vector<double> given = parseNumbers("-a/--params", text, "at most " + std::to_string(model.aSize));
+  if (given.size() > size_t(model.aSize))
+    throw badArgs("-a/--params: object '" + model.objectName + "' has a[" + std::to_string(model.aSize) +
+                  "], got " + std::to_string(given.size()) + " values in '" + text + "'");
+  return given;
 }
 
-// Substitutes each model coordinate by a view axis or a constant; returns the view's dimension.
-int mapCoordinates(LoadedModel& m, const std::string& text, bool toView) {
-  const int n = m.model.xSize;
+// Chooses each model coordinate's view axis or constant; returns the view's dimension.
+int mapCoordinates(const lang::Model& model, const std::string& text, bool toView, lang::FieldSpec& spec) {
+  const int n = model.xSize;
   if (text.empty()) {
     if (!toView || n <= 3) return n;
     std::string example = "X,Y,Z";
     for (int i = 3; i < n; ++i) example += ",0";
     spdlog::warn("object '{}' has x[{}]: x[4] and above are held at 0 (choose with -x, e.g. -x {})",
-                 m.model.objectName, n, example);
-    std::vector<Expr> vars;
-    for (int i = 0; i < n; ++i) vars.push_back(i < 3 ? Expr::x(uint32_t(i)) : Expr(0.0));
-    m.field = remap(m.field, vars);
+                 model.objectName, n, example);
+    for (int i = 0; i < n; ++i) {
+      spec.axis.push_back(i < 3 ? i : -1);
+      spec.constant.push_back(0.0);
+    }
     return 3;
   }
   AxisMapping map = parseMapping("-x/--map", text);
   if (int(map.axis.size()) != n)
-    throw badArgs("-x/--map: object '" + m.model.objectName + "' has x[" + std::to_string(n) + "], so -x needs " +
+    throw badArgs("-x/--map: object '" + model.objectName + "' has x[" + std::to_string(n) + "], so -x needs " +
                   std::to_string(n) + " entries, got '" + text + "'");
-  std::vector<Expr> vars;
-  for (int i = 0; i < n; ++i)
-    vars.push_back(map.axis[size_t(i)] >= 0 ? Expr::x(uint32_t(map.axis[size_t(i)])) : Expr(map.constant[size_t(i)]));
-  m.field = remap(m.field, vars);
+  for (int i = 0; i < n; ++i) {
+    spec.axis.push_back(map.axis[size_t(i)]);
+    spec.constant.push_back(map.axis[size_t(i)] >= 0 ? 0.0 : map.constant[size_t(i)]);
+  }
   return map.viewDims;
 }
 
@@ -80,11 +78,13 @@ LoadedModel loadModel(const ModelRequest& request, bool toView) {
   }
 
   LoadedModel m;
+  m.source = source;
   m.model = compiled.model;
   m.objects = compiled.objects;
-  m.field = bindParameters(m, request.params);
-  if (request.iso != 0.0) m.field = m.field - Expr(request.iso);
-  m.dims = mapCoordinates(m, request.mapping, toView);
+  m.spec.params = parseParameters(m.model, request.params);
+  m.spec.iso = request.iso;
+  m.dims = mapCoordinates(m.model, request.mapping, toView, m.spec);
+  m.field = lang::fieldOf(m.model, m.spec);
   return m;
 }
 

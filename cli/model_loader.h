@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "frep/expr.h"
+#include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 
 namespace frep::cli {
@@ -19,7 +20,9 @@ struct ModelRequest {
 };
 
 struct LoadedModel {
+  std::string source;                    // the file's text (sent to farm workers)
   lang::Model model;                     // as compiled, before binding
+  lang::FieldSpec spec;                  // -a, -i and -x as resolved against the model
   std::vector<lang::ObjectInfo> objects;
   Expr field;                            // f - iso over `dims` coordinates, parameters bound
   int dims = 0;

@@ -1,6 +1,7 @@
 #include "vdb_writer.h"
 
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/Prune.h>
 
 #include <cstdio>
 
@@ -17,6 +18,10 @@ namespace {
 constexpr int32_t kTileEdge[4] = {1, 8, 128, 4096};
 
 // A sampler tile (power-of-two cube, aligned to its size) as the fewest VDB tiles.
+// Tiles are clipped to the grid's leaf-aligned extent (a brick's root cube may reach past it),
+// so that the tree, once pruned, does not depend on how the job was split into bricks.
+void addClippedTile(openvdb::FloatTree& tree, const Tile& tile, float value, const std::array<int32_t, 3>& extent);
+
 void addTile(openvdb::FloatTree& tree, const Tile& tile, float value) {
   int level = 3;
   while (kTileEdge[level] > tile.size) --level;
@@ -37,6 +42,53 @@ void addLeaf(openvdb::FloatTree& tree, const LeafBlock& block) {
   }
 }
 
+void addClippedTile(openvdb::FloatTree& tree, const Tile& tile, float value, const std::array<int32_t, 3>& extent) {
+  bool inside = true;
+  for (int a = 0; a < 3; ++a) {
+    if (tile.origin[a] >= extent[a]) return;  // entirely past the grid
+    inside = inside && tile.origin[a] + tile.size <= extent[a];
+  }
+  if (inside || tile.size == kLeafDim) {
+    addTile(tree, tile, value);
+    return;
+  }
+  const int32_t h = tile.size / 2;
+  for (int c = 0; c < 8; ++c)
+    addClippedTile(tree,
+                   Tile{{tile.origin[0] + ((c >> 2) & 1) * h, tile.origin[1] + ((c >> 1) & 1) * h,
+                         tile.origin[2] + (c & 1) * h},
+                        h, tile.inside},
+                   value, extent);
+}
+
+// OpenVDB stamps a random UUID into every file header; replace it by one derived from the file's
+// contents, so the same grid always gives the same bytes (farm runs are compared byte for byte).
+void makeHeaderDeterministic(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "r+b");
+  if (!f) throw ioError("cannot reopen VDB '" + path + "'");
+  std::string bytes;
+  char buf[1 << 16];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) bytes.append(buf, n);
+  constexpr size_t kUuidAt = 21, kUuidLen = 36;  // after magic, version, library version, flag
+  bool looksLikeUuid = bytes.size() > kUuidAt + kUuidLen && bytes[kUuidAt + 8] == '-' && bytes[kUuidAt + 13] == '-' &&
+                       bytes[kUuidAt + 18] == '-' && bytes[kUuidAt + 23] == '-';
+  if (looksLikeUuid) {
+    uint64_t h1 = 1469598103934665603ULL, h2 = 0x9e3779b97f4a7c15ULL;
+    for (size_t i = kUuidAt + kUuidLen; i < bytes.size(); ++i) {
+      h1 = (h1 ^ uint8_t(bytes[i])) * 1099511628211ULL;
+      h2 = (h2 ^ uint8_t(bytes[i])) * 0x100000001b3ULL + (h2 >> 29);
+    }
+    char uuid[40];
+    std::snprintf(uuid, sizeof uuid, "%08llx-%04llx-%04llx-%04llx-%012llx", (unsigned long long)(h1 >> 32),
+                  (unsigned long long)((h1 >> 16) & 0xffff), (unsigned long long)(h1 & 0xffff),
+                  (unsigned long long)(h2 >> 48), (unsigned long long)(h2 & 0xffffffffffffULL));
+    std::fseek(f, long(kUuidAt), SEEK_SET);
+    std::fwrite(uuid, 1, kUuidLen, f);
+  }
+  if (std::fclose(f) != 0) throw ioError("cannot write VDB '" + path + "'");
+}
+
 std::string hex(uint64_t v) {
   char buf[19];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
@@ -51,8 +103,10 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
   const float background = float(result.bandVoxels * g.voxel);
   openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(background);
   openvdb::FloatTree& tree = grid->tree();
-  for (const Tile& t : result.tiles) addTile(tree, t, t.inside ? -background : background);
+  const std::array<int32_t, 3> extent{(g.dims[0] + 7) & ~7, (g.dims[1] + 7) & ~7, (g.dims[2] + 7) & ~7};
+  for (const Tile& t : result.tiles) addClippedTile(tree, t, t.inside ? -background : background, extent);
   for (const LeafBlock& b : result.leaves) addLeaf(tree, b);
+  openvdb::tools::pruneLevelSet(tree);  // canonical tree: the same whatever the brick layout
 
   openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(g.voxel);
   xform->postTranslate(openvdb::Vec3d(g.origin[0], g.origin[1], g.origin[2]));
@@ -77,6 +131,7 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
     file.setCompression(compression);
     file.write(openvdb::GridCPtrVec{grid});
     file.close();
+    makeHeaderDeterministic(path);
   } catch (const openvdb::Exception& e) {
     throw ioError("cannot write VDB '" + path + "': " + e.what());
   }

@@ -2,9 +2,11 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
+#include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 
 namespace frep::farm {
@@ -42,10 +44,17 @@ TapePtr compileJobModel(const JobSpec& job) {
       if (d.severity == lang::Diagnostic::Severity::Error) msg += d.format() + "\n";
     throw std::runtime_error(msg.empty() ? "model does not compile" : msg);
   }
-  std::vector<Expr> params;
-  for (int i = 0; i < r.model.aSize; ++i) params.push_back(i < job.params_size() ? job.params(i) : 0.0);
-  Expr f = bindParams(r.model.field, params) - job.iso();
-  return Tape::compile(f, uint32_t(r.model.xSize));
+  lang::FieldSpec spec;
+  spec.params.assign(job.params().begin(), job.params().end());
+  spec.iso = job.iso();
+  spec.axis.assign(job.map_axis().begin(), job.map_axis().end());
+  spec.constant.assign(job.map_constant().begin(), job.map_constant().end());
+  Expr f = lang::fieldOf(r.model, spec);
+  const uint32_t dims = spec.axis.empty() ? uint32_t(r.model.xSize) : 3u;
+  if (frep::numVars(f) > 3)
+    throw std::runtime_error("the field has " + std::to_string(frep::numVars(f)) +
+                             " coordinates: map x[4..] to constants (-x)");
+  return Tape::compile(f, std::min(dims, 3u));
 }
 
 TapePtr ModelCache::get(const JobSpec& job, uint64_t jobId) {
@@ -63,7 +72,6 @@ BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::arr
   opt.bandVoxels = job.band();
   opt.regionLo = lo;
   opt.regionHi = hi;
-  opt.fixedCoords.assign(job.fixed_coords().begin(), job.fixed_coords().end());
   opt.threads = threads;
   SampleResult r = sample(tape, gridOf(job), opt);
   return BrickOutput{std::move(r.leaves), std::move(r.tiles), r.stats};

@@ -3,9 +3,11 @@
 // comparisons, select); transcendentals call libm per lane. The kernel is compiled for several
 // ISA levels (target_clones) and picked at run time; -ffp-contract=off keeps every clone
 // bit-identical to the others and to the point evaluator for + - * / sqrt.
+#include <algorithm>
 #include <cmath>
 
 #include "frep/eval.h"
+#include "frep/extremum.h"
 
 namespace frep {
 
@@ -129,8 +131,45 @@ const T* BatchEvaluator<T>::eval(const Tape& tape, size_t count) {
   // Lanes past count hold stale but finite-or-not values; they are computed and ignored.
   size_t n = (count + 7) & ~size_t(7);
   if (n > kBatch) n = kBatch;
-  runTape<T>(tape.code().data(), tape.code().size(), regs_.data(), n);
+  const auto& code = tape.code();
+  if (!tape.hasExtrema()) {
+    runTape<T>(code.data(), code.size(), regs_.data(), n);
+  } else {
+    // Straight-line segments between extremum instructions run vectorised as usual.
+    size_t start = 0;
+    for (size_t k = 0; k < code.size(); ++k) {
+      if (code[k].op != Op::Extremum) continue;
+      runTape<T>(code.data() + start, k - start, regs_.data(), n);
+      runExtremum(tape, code[k], count);
+      start = k + 1;
+    }
+    runTape<T>(code.data() + start, code.size() - start, regs_.data(), n);
+  }
   return regs_.data() + size_t(tape.resultReg()) * kBatch;
+}
+
+template <typename T>
+void BatchEvaluator<T>::runExtremum(const Tape& tape, const Instr& ins, size_t count) {
+  const ExtremumEntry& e = tape.extrema()[ins.a];
+  ExtremumSolver& solver = extrema_.get(tape, ins.a);
+  const size_t nin = e.inputRegs.size();
+  xbuf_.resize(nin);
+  res_.resize(kBatch);
+  bool haveWarm = false;
+  // Results go to a side buffer first: out may share a register with an input.
+  for (size_t i = 0; i < count; ++i) {
+    for (size_t k = 0; k < nin; ++k) xbuf_[k] = double(regs_[size_t(e.inputRegs[k]) * kBatch + i]);
+    ExtremumResult r = solver.solve(xbuf_.data(), haveWarm ? warm_.data() : nullptr);
+    res_[i] = r.value;
+    if (!r.t.empty()) {
+      warm_ = r.t;
+      haveWarm = true;
+    }
+  }
+  T* out = regs_.data() + size_t(ins.out) * kBatch;
+  const size_t padded = std::min(kBatch, (count + 7) & ~size_t(7));
+  for (size_t i = 0; i < count; ++i) out[i] = T(res_[i]);
+  for (size_t i = count; i < padded; ++i) out[i] = T(0);
 }
 
 template class BatchEvaluator<float>;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "frep/eval.h"
+#include "frep/extremum.h"
 
 namespace frep {
 
@@ -83,6 +84,23 @@ double GradientEvaluator::eval(const Tape& tape, const double* x, double* grad) 
   for (uint32_t i = 0; i < nv; ++i) v[tape.varReg(i)] = x[i];
 
   for (const Instr& ins : tape.code()) {
+    if (ins.op == Op::Extremum) {
+      // Danskin's theorem: d/dx max_u g(X(x), u) = sum_k dg/dX_k (X, u*) dX_k/dx.
+      const ExtremumEntry& e = tape.extrema()[ins.a];
+      const size_t nin = e.inputRegs.size();
+      xbuf_.resize(nin);
+      gbuf_.resize(nin);
+      for (size_t k = 0; k < nin; ++k) xbuf_[k] = v[e.inputRegs[k]];
+      const double value = extrema_.get(tape, ins.a).gradient(xbuf_.data(), gbuf_.data());
+      row_.assign(nv, 0.0);
+      for (size_t k = 0; k < nin; ++k) {
+        const double* dk = d + size_t(e.inputRegs[k]) * nv;
+        for (uint32_t j = 0; j < nv; ++j) row_[j] += term(gbuf_[k], dk[j]);
+      }
+      std::copy(row_.begin(), row_.end(), d + size_t(ins.out) * nv);
+      v[ins.out] = value;
+      continue;
+    }
     // Inputs are read before the output is written: out may alias a, b or c.
     const double a = v[ins.a], b = v[ins.b], c = v[ins.c];
     const double value = applyOp(ins.op, a, b, c, ins.imm);

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "frep/eval.h"
+#include "frep/extremum.h"
 
 namespace frep {
 
@@ -51,6 +52,15 @@ Interval IntervalEvaluator::eval(const Tape& tape, const Interval* box) {
   choices_.assign(code.size(), Choice::Both);  // keeps capacity: no allocation after warm-up
   for (size_t k = 0; k < code.size(); ++k) {
     const Instr& ins = code[k];
+    if (ins.op == Op::Extremum) {
+      // Not a choice: an extremum stays in pruned tapes. Sound bounds from a short
+      // branch-and-bound over the hidden domain (ExtremumSolver::bound).
+      const ExtremumEntry& e = tape.extrema()[ins.a];
+      xbuf_.resize(e.inputRegs.size());
+      for (size_t i = 0; i < e.inputRegs.size(); ++i) xbuf_[i] = r[e.inputRegs[i]];
+      r[ins.out] = extrema_.get(tape, ins.a).bound(xbuf_.data(), extremumSignOnly_);
+      continue;
+    }
     if (ins.op == Op::Min || ins.op == Op::Max || ins.op == Op::Select) {
       const Choice ch = decide(ins.op, r[ins.a], r[ins.b]);
       choices_[k] = ch;

@@ -1,5 +1,6 @@
 // Point evaluator: the double-precision reference walk of a tape.
 #include "frep/eval.h"
+#include "frep/extremum.h"
 
 namespace frep {
 
@@ -13,7 +14,20 @@ double PointEvaluator::eval(const Tape& tape, const double* x) {
   double* r = regs_.data();
   const uint32_t v0 = tape.varReg(0);
   for (uint32_t i = 0; i < tape.numVars(); ++i) r[v0 + i] = x[i];
-  for (const Instr& ins : tape.code()) r[ins.out] = applyOp(ins.op, r[ins.a], r[ins.b], r[ins.c], ins.imm);
+  if (!tape.hasExtrema()) {
+    for (const Instr& ins : tape.code()) r[ins.out] = applyOp(ins.op, r[ins.a], r[ins.b], r[ins.c], ins.imm);
+    return r[tape.resultReg()];
+  }
+  for (const Instr& ins : tape.code()) {
+    if (ins.op == Op::Extremum) {
+      const ExtremumEntry& e = tape.extrema()[ins.a];
+      xbuf_.resize(e.inputRegs.size());
+      for (size_t k = 0; k < e.inputRegs.size(); ++k) xbuf_[k] = r[e.inputRegs[k]];
+      r[ins.out] = extrema_.get(tape, ins.a).solve(xbuf_.data()).value;
+      continue;
+    }
+    r[ins.out] = applyOp(ins.op, r[ins.a], r[ins.b], r[ins.c], ins.imm);
+  }
   return r[tape.resultReg()];
 }
 

@@ -1,6 +1,8 @@
 // Hash-consed expression DAG: intern table, constant folding, structural rewrites.
 #include "frep/expr.h"
 
+#include "frep/extremum.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -20,7 +22,7 @@ struct OpInfo {
 };
 
 const OpInfo kOps[] = {
-    {"const", 0}, {"x", 0},      {"a", 0},     {"neg", 1},   {"abs", 1},    {"sqrt", 1},
+    {"const", 0}, {"x", 0},      {"a", 0},     {"extremum", 0}, {"neg", 1},   {"abs", 1},    {"sqrt", 1},
     {"exp", 1},   {"log", 1},    {"log10", 1}, {"sin", 1},   {"cos", 1},    {"tan", 1},
     {"asin", 1},  {"acos", 1},   {"atan", 1},  {"sinh", 1},  {"cosh", 1},   {"tanh", 1},
     {"floor", 1}, {"ceil", 1},   {"trunc", 1}, {"frac", 1},  {"powi", 1},   {"not", 1},
@@ -35,13 +37,58 @@ uint64_t mix(uint64_t h, uint64_t v) {
   return h;
 }
 
+uint64_t bitsOf(double v) {
+  uint64_t b = 0;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+
+// Content hash of an extremum spec (address-independent: body and inputs by structural hash).
+uint64_t specHash(const ExtremumSpec& s) {
+  uint64_t h = mix(static_cast<uint64_t>(s.kind), static_cast<uint64_t>(s.domain));
+  h = mix(h, static_cast<uint64_t>(s.method));
+  h = mix(h, s.hidden);
+  h = mix(h, s.body.node().hash);
+  for (double v : s.lo) h = mix(h, bitsOf(v));
+  for (double v : s.hi) h = mix(h, bitsOf(v));
+  h = mix(h, bitsOf(s.radius));
+  h = mix(h, bitsOf(s.eps));
+  h = mix(h, bitsOf(s.tolerance));
+  h = mix(h, s.maxBoxes);
+  h = mix(h, s.intervalBudget);
+  for (const Expr& e : s.inputs) h = mix(h, e.node().hash);
+  return h;
+}
+
+bool sameSpec(const ExtremumSpec& a, const ExtremumSpec& b) {
+  if (&a == &b) return true;
+  if (a.kind != b.kind || a.domain != b.domain || a.method != b.method || a.hidden != b.hidden ||
+      !a.body.same(b.body) || a.inputs.size() != b.inputs.size() || a.lo.size() != b.lo.size() ||
+      a.hi.size() != b.hi.size() || bitsOf(a.radius) != bitsOf(b.radius) ||
+      bitsOf(a.eps) != bitsOf(b.eps) || bitsOf(a.tolerance) != bitsOf(b.tolerance) ||
+      a.maxBoxes != b.maxBoxes || a.intervalBudget != b.intervalBudget)
+    return false;
+  for (size_t i = 0; i < a.lo.size(); ++i)
+    if (bitsOf(a.lo[i]) != bitsOf(b.lo[i])) return false;
+  for (size_t i = 0; i < a.hi.size(); ++i)
+    if (bitsOf(a.hi[i]) != bitsOf(b.hi[i])) return false;
+  for (size_t i = 0; i < a.inputs.size(); ++i)
+    if (!a.inputs[i].same(b.inputs[i])) return false;
+  return true;
+}
+
+// Extremum nodes are keyed by the spec's content (body, domain, method, inputs), so two builds
+// of the same extremum share one node.
 struct Key {
   Op op;
   uint32_t index;
   uint64_t valueBits;
   const Node* args[3];
+  const ExtremumSpec* spec;
   bool operator==(const Key& o) const {
-    return op == o.op && index == o.index && valueBits == o.valueBits && args[0] == o.args[0] &&
+    if (op != o.op) return false;
+    if (op == Op::Extremum) return sameSpec(*spec, *o.spec);
+    return index == o.index && valueBits == o.valueBits && args[0] == o.args[0] &&
            args[1] == o.args[1] && args[2] == o.args[2];
   }
 };
@@ -49,6 +96,7 @@ struct KeyHash {
   size_t operator()(const Key& k) const {
     uint64_t h = mix(static_cast<uint64_t>(k.op), k.index);
     h = mix(h, k.valueBits);
+    if (k.spec) return mix(h, specHash(*k.spec));
     for (auto* a : k.args) h = mix(h, reinterpret_cast<uintptr_t>(a));
     return h;
   }
@@ -67,7 +115,7 @@ InternTable& table() {
 Key keyOf(const Node& n) {
   uint64_t vb = 0;
   std::memcpy(&vb, &n.value, sizeof vb);
-  return Key{n.op, n.index, vb, {n.args[0].get(), n.args[1].get(), n.args[2].get()}};
+  return Key{n.op, n.index, vb, {n.args[0].get(), n.args[1].get(), n.args[2].get()}, n.spec.get()};
 }
 
 NodePtr intern(Node&& proto) {
@@ -77,6 +125,9 @@ NodePtr intern(Node&& proto) {
   auto it = t.map.find(key);
   if (it != t.map.end()) {
     if (auto alive = it->second.lock()) return alive;
+    // Replace the dead entry's key too: an extremum key points at its node's spec, which dies
+    // with the node.
+    t.map.erase(it);
   }
   uint64_t h = mix(static_cast<uint64_t>(proto.op), proto.index);
   h = mix(h, key.valueBits);
@@ -86,6 +137,11 @@ NodePtr intern(Node&& proto) {
       h = mix(h, a->hash);
       depth = std::max(depth, a->depth + 1);
     }
+  if (proto.spec) {
+    h = mix(h, specHash(*proto.spec));
+    depth = std::max(depth, proto.spec->body.node().depth + 1);
+    for (const Expr& in : proto.spec->inputs) depth = std::max(depth, in.node().depth + 1);
+  }
   proto.hash = h;
   proto.depth = depth;
   auto* raw = new Node(std::move(proto));
@@ -128,11 +184,28 @@ double powInt(double a, int n) {
 }  // namespace
 
 const char* opName(Op op) { return kOps[static_cast<int>(op)].name; }
+
+size_t numChildren(const Node& n) {
+  if (n.op == Op::Extremum) return n.spec->inputs.size();
+  return static_cast<size_t>(opArity(n.op));
+}
+const Node& child(const Node& n, size_t i) {
+  if (n.op == Op::Extremum) return n.spec->inputs[i].node();
+  return *n.args[i];
+}
+
+Expr Expr::makeExtremum(std::shared_ptr<const ExtremumSpec> spec) {
+  Node n;
+  n.op = Op::Extremum;
+  n.spec = std::move(spec);
+  return Expr(intern(std::move(n)));
+}
 int opArity(Op op) { return kOps[static_cast<int>(op)].arity; }
 
 double applyOp(Op op, double a, double b, double c, double imm) {
   switch (op) {
     case Op::Const: case Op::Var: case Op::Param: return a;
+    case Op::Extremum: break;  // not a scalar op: evaluated by a search (extremum.h)
     case Op::Neg: return -a;
     case Op::Abs: return std::fabs(a);
     case Op::Sqrt: return a > 0.0 ? std::sqrt(a) : 0.0;
@@ -312,11 +385,11 @@ void forEachNode(const Expr& e, const std::function<void(const Node&)>& fn) {
       stack.pop_back();
       continue;
     }
-    int arity = opArity(n->op);
+    const int arity = static_cast<int>(numChildren(*n));
     if (k < arity) {
-      const Node* child = n->args[k].get();
+      const Node* ch = &child(*n, static_cast<size_t>(k));
       ++k;
-      if (!seen.count(child)) stack.push_back({child, 0});
+      if (!seen.count(ch)) stack.push_back({ch, 0});
       continue;
     }
     seen[n] = true;
@@ -353,7 +426,23 @@ Expr rebuild(const Expr& e, const std::function<bool(const Node&, Expr&)>& leafM
     Expr out;
     if (!leafMap(n, out)) {
       int arity = opArity(n.op);
-      if (arity == 0) {
+      if (n.op == Op::Extremum) {
+        // Only the inputs live in the outer variable space; the body is left alone.
+        bool changed = false;
+        std::vector<Expr> ins;
+        ins.reserve(n.spec->inputs.size());
+        for (const Expr& in : n.spec->inputs) {
+          ins.push_back(done.at(&in.node()));
+          changed = changed || !ins.back().same(in);
+        }
+        if (!changed) {
+          out = Expr(intern(Node(n)));
+        } else {
+          auto spec = std::make_shared<ExtremumSpec>(*n.spec);
+          spec->inputs = std::move(ins);
+          out = Expr::makeExtremum(std::move(spec));
+        }
+      } else if (arity == 0) {
         out = Expr(n.op == Op::Const ? leaf(Op::Const, 0, n.value) : leaf(n.op, n.index, n.value));
       } else {
         Expr a = done.at(n.args[0].get());
@@ -397,6 +486,16 @@ Expr derivative(const Expr& e, uint32_t var) {
   std::unordered_map<const Node*, Expr> d;
   auto term = [](const Expr& partial, const Expr& dx) { return dx.isConst(0.0) ? Expr(0.0) : partial * dx; };
   forEachNode(e, [&](const Node& n) {
+    if (n.op == Op::Extremum) {
+      // Danskin: d/dX max_u g = dg/dX at the maximiser, which is not an expression. Exact only
+      // when no input depends on x[var].
+      for (const Expr& in : n.spec->inputs)
+        if (!d.at(&in.node()).isConst(0.0))
+          throw std::logic_error(
+              "derivative: an extremum node has no closed-form derivative (use GradientEvaluator)");
+      d.emplace(&n, Expr(0.0));
+      return;
+    }
     auto D = [&](int i) { return d.at(n.args[i].get()); };
     Expr a = opArity(n.op) > 0 ? Expr(n.args[0]) : Expr();
     Expr b = opArity(n.op) > 1 ? Expr(n.args[1]) : Expr();
@@ -404,7 +503,7 @@ Expr derivative(const Expr& e, uint32_t var) {
     auto binary = [&](const Expr& pa, const Expr& pb) { return term(pa, D(0)) + term(pb, D(1)); };
     Expr r;
     switch (n.op) {
-      case Op::Const: case Op::Param: r = 0.0; break;
+      case Op::Const: case Op::Param: case Op::Extremum: r = 0.0; break;
       case Op::Var: r = n.index == var ? 1.0 : 0.0; break;
       case Op::Neg: r = -D(0); break;
       case Op::Abs: r = unary(sign(a)); break;
@@ -459,6 +558,20 @@ std::string toString(const Expr& e) {
       case Op::Const: o << n.value; break;
       case Op::Var: o << "x" << n.index; break;
       case Op::Param: o << "a" << n.index; break;
+      case Op::Extremum: {
+        const ExtremumSpec& sp = *n.spec;
+        o << "(" << (sp.kind == ExtremumKind::Max ? "max" : "min") << " u"
+          << (sp.domain == DomainKind::Box ? " box" : sp.domain == DomainKind::Sphere ? " sphere" : " ball");
+        if (sp.domain == DomainKind::Box) {
+          for (size_t i = 0; i < sp.lo.size(); ++i) o << " [" << sp.lo[i] << " " << sp.hi[i] << "]";
+        } else {
+          o << " m=" << sp.hidden << " r=" << sp.radius;
+        }
+        o << " " << (sp.method == ExtremumMethod::Grid ? "grid" : "bnb") << " {" << toString(sp.body) << "}";
+        for (const Expr& in : sp.inputs) o << " " << s.at(&in.node());
+        o << ")";
+        break;
+      }
       default: {
         o << "(" << opName(n.op);
         if (n.op == Op::PowI) o << " " << n.value;

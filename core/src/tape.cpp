@@ -1,6 +1,8 @@
 // DAG -> tape compilation (topological order, linear-scan register reuse) and tape pruning.
 #include "frep/tape.h"
 
+#include "frep/extremum.h"
+
 #include <algorithm>
 #include <atomic>
 #include <stdexcept>
@@ -43,7 +45,8 @@ TapePtr Tape::compile(const Expr& e, uint32_t nvars) {
   // 2. Last reader of each node.
   std::unordered_map<const Node*, size_t> lastUse;
   for (size_t i = 0; i < order.size(); ++i)
-    for (int k = 0; k < opArity(order[i]->op); ++k) lastUse[order[i]->args[k].get()] = i;
+    for (size_t k = 0; k < numChildren(*order[i]); ++k) lastUse[&child(*order[i], k)] = i;
+  auto extrema = std::make_shared<std::vector<ExtremumEntry>>();
 
   // 3. Linear-scan allocation of temporaries; inputs whose last use is this instruction are
   //    freed before the output is allocated, so an output may reuse an input's register.
@@ -59,22 +62,31 @@ TapePtr Tape::compile(const Expr& e, uint32_t nvars) {
   };
   for (size_t i = 0; i < order.size(); ++i) {
     const Node* n = order[i];
-    int arity = opArity(n->op);
-    if (arity == 0) continue;
+    const int arity = static_cast<int>(numChildren(*n));
+    if (arity == 0 && n->op != Op::Extremum) continue;
     Instr ins;
     ins.op = n->op;
     ins.imm = n->value;
-    uint32_t in[3] = {0, 0, 0};
-    for (int k = 0; k < arity; ++k) in[k] = regOf(n->args[k].get());
-    ins.a = in[0];
-    ins.b = in[1];
-    ins.c = in[2];
+    if (n->op == Op::Extremum) {
+      ExtremumEntry entry;
+      entry.spec = n->spec;
+      for (const Expr& in : n->spec->inputs) entry.inputRegs.push_back(regOf(&in.node()));
+      entry.body = Tape::compile(n->spec->body, n->spec->outer() + n->spec->hidden);
+      ins.a = static_cast<uint32_t>(extrema->size());
+      extrema->push_back(std::move(entry));
+    } else {
+      uint32_t in[3] = {0, 0, 0};
+      for (int k = 0; k < arity; ++k) in[k] = regOf(n->args[k].get());
+      ins.a = in[0];
+      ins.b = in[1];
+      ins.c = in[2];
+    }
     for (int k = 0; k < arity; ++k) {
-      const Node* child = n->args[k].get();
-      if (child->op == Op::Const || child->op == Op::Var) continue;
-      if (lastUse.at(child) == i && reg.count(child)) {
-        freeRegs.push_back(reg.at(child));
-        reg.erase(child);
+      const Node* ch = &child(*n, static_cast<size_t>(k));
+      if (ch->op == Op::Const || ch->op == Op::Var) continue;
+      if (lastUse.at(ch) == i && reg.count(ch)) {
+        freeRegs.push_back(reg.at(ch));
+        reg.erase(ch);
       }
     }
     uint32_t out;
@@ -94,6 +106,7 @@ TapePtr Tape::compile(const Expr& e, uint32_t nvars) {
   t.numVars_ = nvars;
   t.numRegs_ = next;
   t.uniforms_ = uniforms;
+  t.extrema_ = extrema;
   t.result_ = regOf(&e.node());
   t.id_ = gNextTapeId++;
   return tape;
@@ -126,6 +139,11 @@ TapePtr Tape::prune(const std::vector<Choice>& choices, const TapePtr& self) con
     const Instr& ins = code[i];
     if (!needed[ins.out]) continue;
     needed[ins.out] = 0;
+    if (ins.op == Op::Extremum) {
+      for (uint32_t r : (*extrema_)[ins.a].inputRegs) needed[r] = 1;
+      kept.push_back(ins);
+      continue;
+    }
     int arity = opArity(ins.op);
     if (arity > 0) needed[ins.a] = 1;
     if (arity > 1) needed[ins.b] = 1;
@@ -147,6 +165,7 @@ TapePtr Tape::prune(const std::vector<Choice>& choices, const TapePtr& self) con
   t.numVars_ = numVars_;
   t.numRegs_ = numRegs_;
   t.uniforms_ = uniforms_;
+  t.extrema_ = extrema_;
   t.result_ = result;
   t.code_ = std::move(kept);
   for (auto& ins : t.code_)

@@ -27,27 +27,6 @@ std::string lowerCase(std::string s) {
   return s;
 }
 
-// options.object, else "my_model", else the first object (hfp's rule).
-int selectObject(const std::vector<LoweredObject>& objs, const CompileOptions& options,
-                 DiagnosticSink& diags) {
-  auto find = [&](const std::string& name) {
-    for (size_t i = 0; i < objs.size(); ++i)
-      if (objs[i].info.name == name) return static_cast<int>(i);
-    return -1;
-  };
-  if (objs.empty()) return -1;
-  if (!options.object.empty()) {
-    int i = find(lowerCase(options.object));
-    if (i >= 0) return i;
-  }
-  int i = find("my_model");
-  if (i < 0) i = 0;
-  if (!options.object.empty())
-    diags.warning(Loc{}, "no object named '" + options.object + "'; using '" +
-                             objs[i].info.name + "'");
-  return i;
-}
-
 }  // namespace
 
 CompileResult compile(const std::string& source, const std::string& fileName,
@@ -58,7 +37,10 @@ CompileResult compile(const std::string& source, const std::string& fileName,
   Program program = parse(tokens, diags);
   std::vector<LoweredObject> lowered = lowerProgram(program, options, diags);
   for (const auto& o : lowered) result.objects.push_back(o.info);
-  int sel = selectObject(lowered, options, diags);
+  int sel = selectedObject(program, options);
+  if (sel >= 0 && !options.object.empty() && lowered[sel].info.name != lowerCase(options.object))
+    diags.warning(Loc{}, "no object named '" + options.object + "'; using '" +
+                             lowered[sel].info.name + "'");
   if (sel >= 0) {
     const LoweredObject& o = lowered[sel];
     result.model.objectName = o.info.name;

@@ -56,6 +56,26 @@ Expr triangle(const Vec3& x, const Vec3 v[3], const Expr& S) {
   return sum;
 }
 
+// Kernel integrated along the arc of radius r in the local xy-plane from angle 0 to theta
+// (radians), for the local point p. With rho, phi0 the polar coordinates of (px, py),
+// A = 1 + S^2 (|p|^2 + r^2), B = 2 S^2 r rho, D = A - B cos psi, k^2 = A^2 - B^2 (> 0):
+//   r [B sin psi / (k^2 D) + (A/k^2) F(psi)] from psi = -phi0 to theta - phi0,
+//   F(psi) = psi/k + (2/k) atan((c-1) sin psi / ((c+1) - (c-1) cos psi)), c = sqrt((A+B)/(A-B)),
+// a continuous antiderivative of 1/D (valid for arcs longer than pi).
+Expr arc(const Vec3& p, const Expr& r, const Expr& theta, const Expr& S) {
+  Expr S2 = S * S;
+  Expr rho = sqrt(p.x * p.x + p.y * p.y);
+  Expr phi0 = atan2(p.y, p.x);
+  Expr A = 1.0 + S2 * (norm2(p) + r * r), B = 2.0 * S2 * r * rho;
+  Expr k2 = A * A - B * B, k = sqrt(k2);
+  Expr c = sqrt((A + B) / (A - B));
+  auto prim = [&](const Expr& psi) {
+    Expr F = psi / k + (2.0 / k) * atan((c - 1.0) * sin(psi) / ((c + 1.0) - (c - 1.0) * cos(psi)));
+    return B * sin(psi) / (k2 * (A - B * cos(psi))) + A / k2 * F;
+  };
+  return r * (prim(theta - phi0) - prim(-phi0));
+}
+
 const std::vector<Expr>& coords(const char* fn, std::vector<Arg>& a) {
   return arrayAtLeast(fn, a, 0, 3, "x");
 }
@@ -143,6 +163,37 @@ Expr convMesh(std::vector<Arg>& a) {
   return sum - scalarArg(fn, a, 4);
 }
 
+// Arcs: centre c, radius, opening theta (degrees, from the local x axis counter-clockwise), in
+// the local xy-plane, then turned by `angle` degrees about `axis` (through the centre, right-hand
+// rule). The point is taken into the arc's frame by the inverse rotation (Rodrigues).
+Expr convArc(std::vector<Arg>& a) {
+  const char* fn = "hfConvArc";
+  Vec3 x = at(coords(fn, a), 0);
+  auto& S = arrayArg(fn, a, 6);
+  size_t n = S.size();
+  std::string per = " (one per element of " + argName(a, 6, "S") + ")";
+  std::string per3 = " (3 per element of " + argName(a, 6, "S") + ")";
+  auto& c = arrayExactly(fn, a, 1, 3 * n, per3);
+  auto& radius = arrayExactly(fn, a, 2, n, per);
+  auto& theta = arrayExactly(fn, a, 3, n, per);
+  auto& axis = arrayExactly(fn, a, 4, 3 * n, per3);
+  auto& angle = arrayExactly(fn, a, 5, n, per);
+  const double deg = kPi / 180.0;
+  Expr sum = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    Vec3 p = minus(x, at(c, 3 * i)), ax = at(axis, 3 * i);
+    Expr len = sqrt(norm2(ax));
+    Vec3 u = {ax.x / len, ax.y / len, ax.z / len};
+    Expr cb = cos(angle[i] * deg), sb = sin(angle[i] * deg);
+    Vec3 uxp = cross(u, p);
+    Expr up = dot3(u, p) * (1.0 - cb);
+    Vec3 local = {p.x * cb - uxp.x * sb + u.x * up, p.y * cb - uxp.y * sb + u.y * up,
+                  p.z * cb - uxp.z * sb + u.z * up};
+    sum = sum + arc(local, radius[i], theta[i] * deg, S[i]);
+  }
+  return sum - scalarArg(fn, a, 7);
+}
+
 const bool registered = registerAll({
     {"hfConvPoint", "AAAS", "sum 1/(1 + S_i^2 r_i^2)^2 - T", convPoint},
     {"hfConvLine", "AAAAS", "sum of Cauchy kernel integrals over segments b_i -> e_i - T",
@@ -150,6 +201,7 @@ const bool registered = registerAll({
     {"hfConvCurve", "AAAS", "sum of Cauchy kernel integrals over polyline segments - T",
      convCurve},
     {"hfConvTriangle", "AAAS", "sum of Cauchy kernel integrals over triangles - T", convTriangle},
+    {"hfConvArc", "AAAAAAAS", "sum of Cauchy kernel integrals over arcs - T", convArc},
     {"hfConvMesh", "AAAAS", "sum of Cauchy kernel integrals over indexed triangles - T",
      convMesh},
 });

@@ -42,7 +42,6 @@ class Parser {
  private:
   // ---- token access -----------------------------------------------------------------------
   const Token& cur() const { return toks_[pos_]; }
-  const Token& peekTok(size_t k = 1) const { return toks_[std::min(pos_ + k, toks_.size() - 1)]; }
   bool at(Tok k) const { return cur().kind == k; }
   const Token& next() {
     const Token& t = toks_[pos_];
@@ -83,9 +82,10 @@ class Parser {
     expect(Tok::LBracket);
     const Token& t = cur();
     if (t.kind != Tok::Number) fail(std::string("the size of ") + arrayName + "[]");
-    if (!(t.number >= 1 && t.number <= 1e6 && t.number == std::floor(t.number)))
+    // Arrays are unrolled element by element: keep them to a size that compiles quickly.
+    if (!(t.number >= 1 && t.number <= 100000 && t.number == std::floor(t.number)))
       throw SyntaxError{t.loc, std::string("the size of ") + arrayName +
-                                   "[] must be a whole number from 1 to 1000000, not " + t.text};
+                                   "[] must be a whole number from 1 to 100000, not " + t.text};
     next();
     expect(Tok::RBracket);
     return static_cast<int>(t.number);

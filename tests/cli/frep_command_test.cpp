@@ -58,7 +58,8 @@ TEST_F(FrepTest, HelpDocumentsExitCodes) {
   RunResult r = run("--help");
   EXPECT_EQ(r.code, 0);
   EXPECT_TRUE(contains(r.out, "Exit codes: 0 ok, 1 model error (diagnostics printed), 2 bad arguments, "
-                              "3 I/O error, 4 internal error."))
+                              "3 I/O error, 4 internal error, 5 bricks poisoned (named), 6 interrupted (use "
+                              "--resume), 7 farm error."))
       << r.out;
 }
 
@@ -148,7 +149,7 @@ TEST_F(FrepTest, BadArgumentsNameTheField) {
       {"slice s.hf --res 16", "frep: error: -O/--out: the output PNG path is required"},
       {"sample s.hf --band 0 -O s.vdb", "frep: error: --band: expected an integer from 1 to 64 (voxels), got 0"},
       {"eval s.hf", "--at is required"},
-      {"frob s.hf", "frep: error: unknown verb 'frob'; the verbs are check, eval, slice and sample"},
+      {"frob s.hf", "frep: error: unknown verb 'frob'; the verbs are check, eval, slice, sample and keygen"},
       {"eval s.hf --at 0,0,0 --log-level loud", "--log-level"},
   };
   for (const Case& c : cases) {
@@ -170,7 +171,8 @@ TEST_F(FrepTest, UnwritableOutputIsAnIoErrorAndLeavesNothing) {
   RunResult dir = run("sample s.hf --res 16 -O adir");
   EXPECT_EQ(dir.code, 3) << dir.err;
   EXPECT_TRUE(contains(dir.err, "cannot rename")) << dir.err;
-  EXPECT_EQ(listing(), "adir plain s.hf");
+  // The computed bricks stay in the journal, so that --resume writes the output without work.
+  EXPECT_EQ(listing(), "adir adir.journal plain s.hf");
 }
 
 TEST_F(FrepTest, SliceWritesAHeatMapOfTheRequestedSize) {

@@ -27,7 +27,7 @@ TEST_F(FrepTest, SampleWritesALevelSetOfMinusF) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(r.out.find("wrote s.vdb: 33x33x33 voxels of 0.125, band 3 voxels\n") == 0) << r.out;
   EXPECT_NE(r.out.find("  NaN values 0\n"), std::string::npos) << r.out;
-  EXPECT_EQ(listing(), "s.hf s.vdb");
+  EXPECT_EQ(listing(), "s.hf s.vdb s.vdb.report.json");
 
   openvdb::FloatGrid::Ptr grid = readGrid(path("s.vdb"));
   ASSERT_TRUE(grid);
@@ -37,7 +37,7 @@ TEST_F(FrepTest, SampleWritesALevelSetOfMinusF) {
   EXPECT_EQ(grid->metaValue<std::string>("frep_object"), "my_model");
   EXPECT_EQ(grid->metaValue<std::string>("frep_operation"), "sample");
   EXPECT_EQ(grid->metaValue<std::string>("frep_model_hash").size(), 16u);
-  EXPECT_NE(grid->metaValue<std::string>("frep_command").find("sample s.hf -b 2 --res 33 --band 3 -O s.vdb"),
+  EXPECT_NE(grid->metaValue<std::string>("frep_command").find("sample s.hf -b 2 --res 33 --band 3"),
             std::string::npos);
   EXPECT_EQ(grid->metaValue<int32_t>("frep_band_voxels"), 3);
   EXPECT_EQ(grid->metaValue<double>("frep_band"), 0.375);

@@ -34,6 +34,13 @@ except ImportError:  # python3-yaml is in deploy/install-deps.sh
 
 RUN_TIMEOUT = 60  # seconds for one end-to-end topology
 WORKER_LEAVE_TIMEOUT = 20  # seconds for workers to exit after the master finished
+MASTER_DELAY = 1.0  # seconds between starting the workers and the master
+# The master starts computing when the first worker joins (it does not wait for
+# --expect-workers), and this test job is one brick of 0.1 s: a worker whose TCP reconnect
+# comes a little later would find the job over. frep-worker's test hook FREP_TEST_SLOW_MS
+# (docs/farm.md) makes each brick last long enough for both workers to join. It changes no
+# command line.
+WORKER_TEST_ENV = {"FREP_TEST_SLOW_MS": "500"}
 
 SPHERE = "my_model(x[3], a[1]) { my_model = 1 - x[1]^2 - x[2]^2 - x[3]^2; }\n"
 
@@ -210,28 +217,37 @@ def run_topology(what, master_argv, worker_argvs, worker_env, tmp, out_vdb):
     procs = []
     logs = []
     try:
-        mlog = os.path.join(tmp, "master.log")
-        logs.append(("master", mlog))
-        with open(mlog, "w") as f:
-            master = subprocess.Popen(master_argv, stdout=f, stderr=subprocess.STDOUT, cwd=tmp,
-                                      start_new_session=True)
-        procs.append(master)
+        # Workers first, as a cluster often does: they queue their hello until the master binds,
+        # so both are seen even if one could compute this small job alone. (The master starts
+        # computing as soon as the first worker joins.)
         workers = []
         for i, argv in enumerate(worker_argvs):
             wlog = os.path.join(tmp, f"worker{i}.log")
             logs.append((f"worker {i}", wlog))
             env = dict(os.environ)
             env.pop("FREP_MASTER", None)
+            env.update(WORKER_TEST_ENV)
             env.update(worker_env)
             with open(wlog, "w") as f:
                 w = subprocess.Popen(argv, stdout=f, stderr=subprocess.STDOUT, cwd=tmp, env=env,
                                      start_new_session=True)
             workers.append(w)
             procs.append(w)
-        try:
-            rc = master.wait(timeout=RUN_TIMEOUT)
-        except subprocess.TimeoutExpired:
-            raise AssertionError(f"{what}: the master did not finish within {RUN_TIMEOUT} s")
+        time.sleep(MASTER_DELAY)
+        mlog = os.path.join(tmp, "master.log")
+        logs.append(("master", mlog))
+        with open(mlog, "w") as f:
+            master = subprocess.Popen(master_argv, stdout=f, stderr=subprocess.STDOUT, cwd=tmp,
+                                      start_new_session=True)
+        procs.append(master)
+        deadline = time.time() + RUN_TIMEOUT
+        while master.poll() is None:
+            require(time.time() < deadline, f"{what}: the master did not finish within {RUN_TIMEOUT} s")
+            codes = [w.poll() for w in workers]
+            require(None in codes or codes == [0] * len(codes),
+                    f"{what}: every worker exited (codes {codes}) while the master still runs")
+            time.sleep(0.1)
+        rc = master.returncode
         require(rc == 0, f"{what}: master exited with {rc}")
         deadline = time.time() + WORKER_LEAVE_TIMEOUT
         for i, w in enumerate(workers):
@@ -336,8 +352,10 @@ def check_dockerfile(compose_programs):
 
     # The runtime stage installs the packages that own the libraries the programs load: run the
     # Dockerfile's own pipeline on the binaries built here.
-    m = re.search(r"RUN (ldd /usr/local/bin/frep[^\n]*(?:\\\n[^\n]*)*?> /runtime-packages\.txt)", text)
-    if m and subprocess.run(["which", "dpkg"], stdout=subprocess.DEVNULL).returncode == 0:
+    m = re.search(r"RUN ((?:for lib in \$\()?ldd /usr/local/bin/frep[^\n]*(?:\\\n[^\n]*)*?> /runtime-packages\.txt)", text)
+    if not m:
+        print("skip Dockerfile: no runtime-package pipeline (single-stage image?)")
+    elif subprocess.run(["which", "dpkg"], stdout=subprocess.DEVNULL).returncode == 0:
         with Check("Dockerfile: runtime-package pipeline finds the libraries' packages"):
             cmd = m.group(1).replace("\\\n", " ").replace("/usr/local/bin/", BIN_DIR + "/")
             cmd = cmd.replace("> /runtime-packages.txt", "")
@@ -585,21 +603,40 @@ while [ $# -gt 0 ]; do
     *) break ;;
   esac
 done
-echo "srun-stub: $n tasks: $*" >&2
+echo "srun-stub: $n tasks" >&2
+# Tasks 1..n-1 first and task 0 DELAY s later (a real srun starts them in any order; this
+# order makes sure every worker has joined before the small test job is over).
 pids=()
-for ((i = 0; i < n; i++)); do
+for i in $(seq 1 $((n - 1))) 0; do
+  [ "$i" -eq 0 ] && sleep DELAY
   log="${out:-/dev/stderr}"; log="${log//%j/${SLURM_JOB_ID:-0}}"; log="${log//%t/$i}"
   SLURM_PROCID=$i SLURM_LOCALID=$i SLURM_NODEID=0 SLURM_STEP_ID=0 "$@" >"$log" 2>&1 &
-  pids+=($!)
+  pids[$i]=$!
 done
-rc=0
+# Task 0 (the master) first; then the workers get LEAVE seconds to leave, as the test's other
+# topologies do, and are killed (status 1) if they are still there.
+wait "${pids[0]}"; rc=$?
+echo "srun-stub: task 0 exited $rc" >&2
+for ((t = 0; t < LEAVE * 10; t++)); do
+  alive=0
+  for p in "${pids[@]:1}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+  [ $alive -eq 0 ] && break
+  sleep 0.1
+done
 for i in "${!pids[@]}"; do
-  wait "${pids[$i]}"; r=$?
-  [ "$i" -eq 0 ] && rc=$r
-  echo "srun-stub: task $i exited $r" >&2
+  [ "$i" -eq 0 ] && continue
+  if kill -0 "${pids[$i]}" 2>/dev/null; then
+    echo "srun-stub: task $i still running LEAVE s after task 0 ended: killed" >&2
+    kill -KILL "${pids[$i]}"; wait "${pids[$i]}"
+    [ $rc -eq 0 ] && rc=1
+  else
+    wait "${pids[$i]}"; r=$?
+    echo "srun-stub: task $i exited $r" >&2
+    [ $r -ne 0 ] && [ $rc -eq 0 ] && rc=$r
+  fi
 done
 exit $rc
-"""
+""".replace("LEAVE", str(WORKER_LEAVE_TIMEOUT)).replace("DELAY", str(MASTER_DELAY))
 
 SCONTROL_STUB = r"""#!/usr/bin/env bash
 # Test stub for scontrol: `scontrol show hostnames LIST` prints LIST's hosts one per line
@@ -613,8 +650,9 @@ exit 1
 """
 
 
-def e2e_sbatch():
-    with Check("frep.sbatch run with stub srun/scontrol (task 0 master, tasks 1-2 workers)"):
+def e2e_sbatch(curve=False):
+    name = "frep.sbatch run with stub srun/scontrol (task 0 master, tasks 1-2 workers)"
+    with Check(name + (", FREP_CURVE_DIR" if curve else "")):
         script = os.path.join(SRC, "deploy", "slurm", "frep.sbatch")
         with tempfile.TemporaryDirectory(prefix="frep-slurm-") as tmp:
             stubs = os.path.join(tmp, "stubs")
@@ -634,13 +672,20 @@ def e2e_sbatch():
                 "SLURM_NNODES": "1", "SLURM_CPUS_PER_TASK": "1", "SLURM_SUBMIT_DIR": tmp,
                 "FREP_PORT": str(free_port()), "FREP_LOG_DIR": os.path.join(tmp, "logs"),
             })
+            env.update(WORKER_TEST_ENV)  # the master ignores it
+            if curve:
+                keys = os.path.join(tmp, "keys")
+                k = subprocess.run([os.path.join(BIN_DIR, "frep"), "keygen", keys], stdout=subprocess.PIPE,
+                                   stderr=subprocess.STDOUT, text=True, timeout=30)
+                require(k.returncode == 0, f"frep keygen failed: {k.stdout.strip()}")
+                env["FREP_CURVE_DIR"] = keys
             log = os.path.join(tmp, "sbatch.log")
             with open(log, "w") as f:
                 p = subprocess.Popen(["bash", script, model, out_vdb, "--res", "32", "-b", "1.5"], cwd=tmp, env=env,
                                      stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
             try:
                 try:
-                    rc = p.wait(timeout=RUN_TIMEOUT + WORKER_LEAVE_TIMEOUT)
+                    rc = p.wait(timeout=RUN_TIMEOUT + WORKER_LEAVE_TIMEOUT + 10)
                 except subprocess.TimeoutExpired:
                     raise AssertionError(f"the job did not finish within {RUN_TIMEOUT + WORKER_LEAVE_TIMEOUT} s")
                 require(rc == 0, f"the batch script exited with {rc}")
@@ -683,6 +728,7 @@ def main():
     e2e_compose(c)
     e2e_k8s(k)
     e2e_sbatch()
+    e2e_sbatch(curve=True)
 
     if failures:
         print(f"\n{len(failures)} check(s) failed")

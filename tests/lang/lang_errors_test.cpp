@@ -32,7 +32,7 @@ const ErrorCase kCases[] = {
     {"HeaderWrongArray", "m(y[3], a[1]) { m = 1; }", 1, 3,
      "expected 'x' (the header is 'name(x[n], a[m]' with an optional ', s[k]'), found 'y'"},
     {"HeaderZeroSize", "m(x[0], a[1]) { m = 1; }", 1, 5,
-     "the size of x[] must be a whole number from 1 to 1000000, not 0"},
+     "the size of x[] must be a whole number from 1 to 100000, not 0"},
     {"MissingBrace", "m(x[3], a[1]) m = 1; }", 1, 15,
      "expected '{' starting the body of object 'm', found 'm'"},
     {"UnclosedBody", "m(x[3], a[1]) {\n  m = 1;\n", 3, 1,
@@ -101,7 +101,7 @@ const ErrorCase kCases[] = {
     {"ObjectCallSize", "b(x[2], a[1]) { b = 1; }\nm(x[3], a[1]) {\n  m = b(x, a);\n}", 3, 9,
      "object 'b' expects x[2], but 'x' has 3 elements"},
     {"ObjectCallArgCount", "b(x[3], a[1]) { b = 1; }\nm(x[3], a[1]) {\n  m = b(x);\n}", 3, 7,
-     "object 'b' is called with its arrays: b(x, a) or b(x, a, s), not with 1 arguments"},
+     "object 'b' is called with its arrays: b(x, a) or b(x, a, s), not with 1 argument"},
     {"ObjectCallNotArray", "b(x[3], a[1]) { b = 1; }\nm(x[3], a[1]) {\n  m = b(x, 2);\n}", 3, 12,
      "argument 2 of object 'b' must be an array name (x, a, s or a declared array)"},
     {"DuplicateObject", "m(x[3], a[1]) { m = 1; }\nm(x[3], a[1]) { m = 2; }", 2, 1,
@@ -117,6 +117,9 @@ const ErrorCase kCases[] = {
     {"WhileOnX", "m(x[3], a[1]) {\n  m = 0;\n  while x[1] > m loop m = m + 1; endloop;\n}", 3, 3,
      "the condition of this 'while' depends on x; loops must have a trip count known at compile "
      "time (use 'if' for conditions on x)"},
+    {"WhileOnParameter", "m(x[3], a[1]) {\n  m = 0;\n  while m < a[1] loop m = m + 1; endloop;\n}", 3, 3,
+     "the condition of this 'while' depends on the parameters a[]; loops must have a trip count "
+     "known at compile time (give a[] values when compiling, e.g. with -a)"},
     {"EndlessLoop", "m(x[3], a[1]) {\n  i = 0;\n  while i < 1 loop m = 1; endloop;\n}", 3, 3,
      "loop does not terminate within 1000000 iterations"},
 };
@@ -179,6 +182,12 @@ TEST(LangDiagnostics, RecoversToReportSeveralErrors) {
   int lines[] = {2, 3, 4, 6, 8};
   for (int i = 0; i < 5; ++i) EXPECT_EQ(r.diagnostics[i].line, lines[i]) << allDiagnostics(r);
   EXPECT_EQ(r.diagnostics[2].message, "unknown name 'zz'");
+}
+
+TEST(LangDiagnostics, FailedConditionDoesNotCascade) {
+  CompileResult r = compile(obj("if qq > 0 then t = 1; else t = 2; endif;\nm = t;"), "c.hf");
+  ASSERT_EQ(r.diagnostics.size(), 1u) << allDiagnostics(r);
+  EXPECT_EQ(r.diagnostics[0].message, "unknown name 'qq'");
 }
 
 TEST(LangDiagnostics, ErrorInLoopReportedOnce) {

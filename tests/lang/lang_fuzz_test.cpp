@@ -1,6 +1,6 @@
 // Fuzz: thousands of random and mutated model files (fixed seed). Each must compile to either
-// a model that evaluates, or errors that all carry a location; never a crash or a hang (the loop
-// limit bounds every compile).
+// a model whose values agree with the tree-walking interpreter, or errors that all carry a
+// location; never a crash or a hang (the loop limit bounds every compile).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -8,6 +8,7 @@
 #include <random>
 
 #include "frep/lang/diagnostics.h"
+#include "frep/lang/interpret.h"
 #include "frep/lang/lexer.h"
 #include "frep/lang/library.h"
 #include "lang/lang_test_util.h"
@@ -169,6 +170,19 @@ int countLines(const std::string& s) {
   return n;
 }
 
+// Compiled and interpreted values agree: both NaN, equal infinities, or within 1e-9 relative.
+void expectSame(double compiled, double interpreted, const std::string& src) {
+  if (std::isnan(compiled) || std::isnan(interpreted)) {
+    EXPECT_EQ(std::isnan(compiled), std::isnan(interpreted)) << src;
+    return;
+  }
+  if (std::isinf(compiled) || std::isinf(interpreted)) {
+    EXPECT_EQ(compiled, interpreted) << src;
+    return;
+  }
+  EXPECT_NEAR(compiled, interpreted, 1e-9 * std::max(1.0, std::fabs(interpreted))) << src;
+}
+
 struct Tally {
   int models = 0, errors = 0;
 };
@@ -182,8 +196,13 @@ void check(const std::string& src, Tally& tally) {
     ASSERT_GE(r.model.xSize, 1) << src;
     ASSERT_LE(numVars(r.model.field), static_cast<uint32_t>(r.model.xSize)) << src;
     ASSERT_LE(numParams(r.model.field), static_cast<uint32_t>(r.model.aSize)) << src;
-    double v = evalModel(r.model, std::vector<double>(r.model.xSize, 0.25), {0.5});
-    (void)v;  // any value, NaN included, is a valid answer
+    // Any value, NaN included, is a valid answer, but it must be the interpreter's answer.
+    Interpreter in(src, opt);
+    for (const auto& p : {std::vector<double>{0.3, -0.7, 1.1}, std::vector<double>{-1.9, 0.45, 0.05}}) {
+      std::vector<double> x(r.model.xSize);
+      for (size_t i = 0; i < x.size(); ++i) x[i] = p[i % 3];
+      expectSame(evalModel(r.model, x, {0.5}), in.eval(x, {0.5}), src);
+    }
     for (const auto& d : r.diagnostics) ASSERT_NE(d.severity, Diagnostic::Severity::Error);
     return;
   }

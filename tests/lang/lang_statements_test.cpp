@@ -103,6 +103,34 @@ TEST(LangStatements, NestedLoops) {
   EXPECT_CLOSE(evalModel(m, {2}), 12.0);  // 0+1+2+3 = 6, times 2
 }
 
+TEST(LangStatements, FixedParametersLetLoopsDependOnA) {
+  const char* src = R"(m(x[1], a[2]) {
+    i = 0; acc = 0;
+    while i < a[1] loop acc = acc + x[1]; i = i + 1; endloop;
+    m = acc + a[2];
+  })";
+  CompileResult r = compile(src, "p.hf");
+  EXPECT_FALSE(r.ok);  // a[1] unknown at compile time
+  CompileOptions opt;
+  opt.params = {4};    // a[2] stays a parameter
+  Model m = compileOk(src, opt);
+  EXPECT_EQ(numParams(m.field), 2u);
+  EXPECT_CLOSE(evalModel(m, {1.5}, {0, 10}), 4 * 1.5 + 10);
+}
+
+TEST(LangStatements, FixedParametersBelongToTheSelectedObjectOnly) {
+  CompileOptions opt;
+  opt.params = {100};
+  Model m = compileOk(R"(
+    f(x[1], a[1]) { f = a[1]; }
+    my_model(x[1], a[1]) {
+      array q[1];
+      q[1] = 7;
+      my_model = f(x, q) + a[1];
+    })", opt);
+  EXPECT_CLOSE(evalModel(m, {0}), 107.0);
+}
+
 TEST(LangStatements, ConstantIfPicksOneBranch) {
   Model m = compileOk(R"(m(x[1], a[1]) {
     k = 3;
@@ -239,6 +267,21 @@ TEST(LangStatements, MultipleObjectsAndCalls) {
   double e = (0.5 + 2 - std::sqrt(0.25 + 4)) - 0.5;
   EXPECT_CLOSE(evalModel(m, {3.5, 0.5, 0}, {3}), e);
   EXPECT_EQ(numParams(m.field), 1u);
+}
+
+TEST(LangStatements, CallWithAttributeArray) {
+  Model m = compileOk(R"(
+    col(x[2], a[1], s[2]) { s[1] = 0.5; col = x[1] - a[1]; }
+    my_model(x[2], a[1], s[2]) { my_model = col(x, a, s) * 2; }
+  )");
+  EXPECT_CLOSE(evalModel(m, {3, 0}, {1}), 4.0);
+  CompileResult bad = compile(R"(
+    col(x[2], a[1], s[2]) { col = 1; }
+    my_model(x[2], a[1], s[3]) { my_model = col(x, a, s); }
+  )", "s.hf");
+  EXPECT_FALSE(bad.ok);
+  ASSERT_EQ(bad.diagnostics.size(), 1u);
+  EXPECT_EQ(bad.diagnostics[0].message, "object 'col' expects s[2], but 's' has 3 elements");
 }
 
 TEST(LangStatements, CallPassesCallersParametersAndCoordinates) {

@@ -3,12 +3,31 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "frep/interval.h"
 #include "frep/tape.h"
 
 namespace frep {
+
+class ExtremumSolver;  // extremum.h
+
+// The search engines an evaluator needs for a tape's Op::Extremum instructions, one per entry
+// of the tape's extremum table, created on first use and rebuilt when the evaluator moves to
+// another root tape. Copies start empty (a solver holds its own evaluators).
+class ExtremumSlots {
+ public:
+  ExtremumSlots();
+  ~ExtremumSlots();
+  ExtremumSlots(const ExtremumSlots&);
+  ExtremumSlots& operator=(const ExtremumSlots&);
+  ExtremumSolver& get(const Tape& tape, uint32_t entry);
+
+ private:
+  uint64_t rootId_ = 0;
+  std::vector<std::unique_ptr<ExtremumSolver>> solvers_;
+};
 
 // 1. Point evaluation in double precision: the reference.
 class PointEvaluator {
@@ -18,10 +37,15 @@ class PointEvaluator {
  private:
   std::vector<double> regs_;
   uint64_t boundId_ = 0;
+  ExtremumSlots extrema_;
+  std::vector<double> xbuf_;
 };
 
 // 2. Batch evaluation over up to kBatch points in structure-of-arrays form.
 //    Usage: fill in(i)[k] for var i and point k < count, call eval, read out()[k].
+//    Extremum instructions run one search per lane, each lane warm-started from the previous
+//    lane's arg-extremum within the same eval call (neighbouring voxels); nothing carries over
+//    between calls, so results do not depend on the order of calls (determinism).
 template <typename T>
 class BatchEvaluator {
  public:
@@ -32,9 +56,12 @@ class BatchEvaluator {
 
  private:
   void bind(const Tape& tape);
+  void runExtremum(const Tape& tape, const Instr& ins, size_t count);
   std::vector<T> regs_;  // numRegs * kBatch, register-major
   uint64_t boundId_ = 0;
   uint32_t numUniformsBound_ = 0;
+  ExtremumSlots extrema_;
+  std::vector<double> xbuf_, warm_, res_;
 };
 extern template class BatchEvaluator<float>;
 extern template class BatchEvaluator<double>;
@@ -47,14 +74,22 @@ class IntervalEvaluator {
   const std::vector<Choice>& choices() const { return choices_; }
   // Shortened tape valid inside the last evaluated box (self: the tape last evaluated).
   TapePtr pruned(const TapePtr& self) const { return self->prune(choices_, self); }
+  // Extremum nodes: by default their bound stops refining as soon as its sign is decided (all
+  // that inside/outside classification needs). An outer search needs tight upper bounds
+  // instead: signOnly = false (the extremum solver sets it for its body).
+  void setExtremumSignOnly(bool signOnly) { extremumSignOnly_ = signOnly; }
 
  private:
   std::vector<Interval> regs_;
   std::vector<Choice> choices_;
   uint64_t boundId_ = 0;
+  ExtremumSlots extrema_;
+  std::vector<Interval> xbuf_;
+  bool extremumSignOnly_ = true;
 };
 
-// 4. Forward-mode gradient: value and d/dx[i] for every coordinate of the tape.
+// 4. Forward-mode gradient: value and d/dx[i] for every coordinate of the tape. An extremum
+//    node's derivative follows Danskin's theorem: d/dX max_u g = dg/dX at the maximiser.
 class GradientEvaluator {
  public:
   // grad must hold tape.numVars() doubles.
@@ -63,6 +98,8 @@ class GradientEvaluator {
  private:
   std::vector<double> val_, der_;  // der_: numRegs * numVars
   uint64_t boundId_ = 0;
+  ExtremumSlots extrema_;
+  std::vector<double> xbuf_, gbuf_, row_;
 };
 
 }  // namespace frep

@@ -22,6 +22,10 @@ namespace frep {
 enum class Op : uint8_t {
   // leaves
   Const, Var, Param,
+  // max/min over hidden variables (extremum.h). Its children are not in Node::args but in
+  // Node::spec->inputs (any number); opArity() reports 0, so generic code that only looks at
+  // args must special-case it (forEachNode, remap, bindParams, toString already do).
+  Extremum,
   // unary
   Neg, Abs, Sqrt, Exp, Log, Log10, Sin, Cos, Tan, Asin, Acos, Atan, Sinh, Cosh, Tanh,
   Floor, Ceil, Trunc, Frac, PowI /* integer power, exponent in Node::value */, Not,
@@ -40,6 +44,7 @@ int opArity(Op op);
 constexpr double kLogFloor = 1e-300;
 
 struct Node;
+struct ExtremumSpec;  // extremum.h
 using NodePtr = std::shared_ptr<const Node>;
 
 struct Node {
@@ -49,7 +54,12 @@ struct Node {
   NodePtr args[3];
   size_t hash = 0;
   uint32_t depth = 0;      // longest path to a leaf (used for stable ordering)
+  std::shared_ptr<const ExtremumSpec> spec;  // Op::Extremum only (body, domain, inputs)
 };
+
+// Children of a node: args[0..arity) for ordinary ops, spec->inputs for Op::Extremum.
+size_t numChildren(const Node& n);
+const Node& child(const Node& n, size_t i);
 
 class Expr {
  public:
@@ -75,6 +85,8 @@ class Expr {
   static Expr make(Op op, const Expr& a, const Expr& b);
   static Expr make(Op op, const Expr& a, const Expr& b, const Expr& c);
   static Expr powi(const Expr& a, int n);
+  // The extremum node of a validated spec (use frep::extremum() in extremum.h, which checks it).
+  static Expr makeExtremum(std::shared_ptr<const ExtremumSpec> spec);
 
  private:
   NodePtr n_;
@@ -135,6 +147,9 @@ Expr remap(const Expr& e, const std::vector<Expr>& vars);
 // Replaces Param(i) by params[i].
 Expr bindParams(const Expr& e, const std::vector<Expr>& params);
 // Symbolic partial derivative d e / d x[var] (piecewise ops differentiate their active branch).
+// An extremum node whose inputs depend on x[var] has no closed-form derivative (Danskin's
+// theorem needs the maximiser): derivative() throws std::logic_error for it; use the
+// GradientEvaluator, which applies Danskin numerically.
 Expr derivative(const Expr& e, uint32_t var);
 // Stable 64-bit structural hash (independent of addresses; for caches and metadata).
 uint64_t structuralHash(const Expr& e);

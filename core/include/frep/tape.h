@@ -27,6 +27,14 @@ enum class Choice : uint8_t { Both = 0, KeepA = 1, KeepB = 2 };
 class Tape;
 using TapePtr = std::shared_ptr<const Tape>;
 
+// An Op::Extremum instruction's `a` indexes the tape's table of these (shared by pruned tapes):
+// the spec, the registers holding its n inputs, and its body compiled to its own tape.
+struct ExtremumEntry {
+  std::shared_ptr<const ExtremumSpec> spec;
+  std::vector<uint32_t> inputRegs;
+  TapePtr body;
+};
+
 class Tape {
  public:
   // Compiles e. Parameters must have been bound (bindParams) before; a Param left in e is an
@@ -45,6 +53,9 @@ class Tape {
   uint32_t numChoices() const { return numChoices_; }
   const Tape* root() const { return root_ ? root_.get() : this; }
   uint64_t id() const { return id_; }  // unique per tape object (evaluator caches)
+  // Extremum instructions (an extremum is not a choice: interval pruning leaves it in place).
+  const std::vector<ExtremumEntry>& extrema() const { return *extrema_; }
+  bool hasExtrema() const { return !extrema_->empty(); }
 
   // A shorter tape, valid wherever the choices hold: decided min/max/select become copies of the
   // kept input, and instructions whose results are no longer read are dropped.
@@ -55,6 +66,7 @@ class Tape {
   Tape() = default;
   uint32_t numVars_ = 0, numRegs_ = 0, result_ = 0, numChoices_ = 0;
   std::shared_ptr<const std::vector<double>> uniforms_;
+  std::shared_ptr<const std::vector<ExtremumEntry>> extrema_;
   std::vector<Instr> code_;
   TapePtr root_;  // the compiled tape this one was pruned from (keeps uniforms alive)
   uint64_t id_ = 0;

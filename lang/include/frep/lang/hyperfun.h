@@ -43,6 +43,9 @@ struct CompileOptions {
   std::string object;  // object to select: this name, else "my_model", else the first
   // Loop unrolling limit: total loop iterations per object before "loop does not terminate".
   long maxLoopIterations = 1000000;
+  // Values of a[1..]: when given, a[i] is that constant at compile time (so loop conditions and
+  // indices may depend on it) instead of Expr::param(i). Missing entries stay parameters.
+  std::vector<double> params;
 };
 
 CompileResult compile(const std::string& source, const std::string& fileName,

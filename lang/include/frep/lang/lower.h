@@ -16,6 +16,10 @@ struct LoweredObject {
   Expr field;       // f(x, a): Expr::x(i), Expr::param(i)
 };
 
+// Index of the object compile() selects: options.object, else "my_model", else the first
+// (-1 when there is none). Names compare case-insensitively.
+int selectedObject(const Program& program, const CompileOptions& options);
+
 // Lowers every object in file order (an object may call the objects before it).
 std::vector<LoweredObject> lowerProgram(const Program& program, const CompileOptions& options,
                                         DiagnosticSink& diags);

@@ -1,0 +1,168 @@
+// `frep sample` on the farm, end to end through the built binaries: identical bytes for any
+// worker count and brick size, a master killed and resumed, SIGTERM, poisoned bricks, CURVE.
+#include <signal.h>
+
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "frep_runner.h"
+
+using namespace frep_cli_test;
+
+namespace {
+
+const char* kPart =
+    "-- a block with a spherical bite and a soft bump\n"
+    "my_model(x[3], a[1]) {\n"
+    "  array c[3], v[3];\n"
+    "  c = [0.3, 0.2, 0.4];\n"
+    "  v = [-0.7, -0.6, -0.5];\n"
+    "  b = hfBlock(x, v, 1.4, 1.2, 1.0);\n"
+    "  ball = hfSphere(x, c, 0.45);\n"
+    "  my_model = b \\ ball;\n"
+    "}\n";
+
+class FarmCli : public FrepTest {
+ protected:
+  void SetUp() override {
+    FrepTest::SetUp();
+    write("part.hf", kPart);
+  }
+  std::string sampleArgs(const std::string& out) const {
+    return "sample part.hf -b 1 --res 96 --no-progress --heartbeat-ms 100 -O " + out;
+  }
+  // Starts frep in the background; returns its pid.
+  pid_t start(const std::string& args, const std::string& env = "") const {
+    std::string cmd = "cd '" + dir_ + "' && " + env + " exec '" FREP_BINARY "' " + args + " >" + path(".bg.out") +
+                      " 2>" + path(".bg.err");
+    pid_t pid = fork();
+    if (pid == 0) {
+      execl("/bin/sh", "sh", "-c", cmd.c_str(), (char*)nullptr);
+      _exit(127);
+    }
+    return pid;
+  }
+  static int waitFor(pid_t pid) {
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  }
+  // Number of bricks recorded in a journal (12-byte header, records of 20 bytes + payload).
+  size_t journalRecords(const std::string& name) const {
+    std::string j = readText(path(name));
+    size_t pos = 12, n = 0;
+    while (pos + 20 <= j.size()) {
+      uint64_t size;
+      std::memcpy(&size, j.data() + pos + 12, 8);
+      if (pos + 20 + size > j.size()) break;
+      pos += 20 + size;
+      ++n;
+    }
+    return n;
+  }
+  static long jsonNumber(const std::string& json, const std::string& key) {
+    size_t at = json.find("\"" + key + "\"");
+    if (at == std::string::npos) return -1;
+    return std::strtol(json.c_str() + json.find(':', at) + 1, nullptr, 10);
+  }
+};
+
+}  // namespace
+
+TEST_F(FarmCli, SameBytesForAnyWorkerCountAndBrickSize) {
+  ASSERT_EQ(run(sampleArgs("w0.vdb") + " --workers 0").code, 0);
+  const std::string reference = readText(path("w0.vdb"));
+  ASSERT_GT(reference.size(), 1000u);
+  for (const char* variant : {"--workers 1", "--workers 2", "--workers 4", "--workers 2 --brick 32",
+                              "--workers 0 --brick 16"}) {
+    SCOPED_TRACE(variant);
+    RunResult r = run(sampleArgs("w.vdb") + " " + variant);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(readText(path("w.vdb")) == reference) << "output bytes differ";
+    std::string report = readText(path("w.vdb.report.json"));
+    EXPECT_NE(report.find("\"poisoned\": []"), std::string::npos) << report;
+  }
+  EXPECT_FALSE(fileExists(path("w.vdb.journal")));  // removed once the output is complete
+}
+
+TEST_F(FarmCli, MasterKilledHalfwayResumesFromItsJournal) {
+  RunResult full = run(sampleArgs("ref.vdb") + " --workers 0");
+  ASSERT_EQ(full.code, 0);
+  long totalEvals = jsonNumber(readText(path("ref.vdb.report.json")), "point");
+  // Slow workers, so that the kill lands mid-job.
+  pid_t master = start(sampleArgs("out.vdb") + " --workers 2 --brick 32", "FREP_TEST_SLOW_MS=150");
+  for (int i = 0; i < 200 && journalRecords("out.vdb.journal") < 6; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  kill(master, SIGKILL);
+  waitFor(master);
+  size_t journaled = journalRecords("out.vdb.journal");
+  ASSERT_GE(journaled, 6u);
+  ASSERT_LT(journaled, 27u);
+  EXPECT_FALSE(fileExists(path("out.vdb")));
+  RunResult resumed = run(sampleArgs("out.vdb") + " --workers 2 --brick 32 --resume");
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  std::string report = readText(path("out.vdb.report.json"));
+  EXPECT_EQ(jsonNumber(report, "from_journal"), long(journaled)) << report;
+  EXPECT_EQ(jsonNumber(report, "computed"), 27 - long(journaled));
+  EXPECT_LT(jsonNumber(report, "point"), totalEvals);  // journaled bricks were not recomputed
+  RunResult again = run(sampleArgs("ref32.vdb") + " --workers 0 --brick 32");
+  ASSERT_EQ(again.code, 0);
+  EXPECT_TRUE(readText(path("out.vdb")) == readText(path("ref32.vdb")));
+}
+
+TEST_F(FarmCli, SigtermStopsTheMasterWhichResumesLater) {
+  pid_t master = start(sampleArgs("out.vdb") + " --workers 2 --brick 32", "FREP_TEST_SLOW_MS=150");
+  for (int i = 0; i < 200 && journalRecords("out.vdb.journal") < 3; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  kill(master, SIGTERM);
+  EXPECT_EQ(waitFor(master), 6);
+  EXPECT_NE(readText(path(".bg.err")).find("--resume"), std::string::npos);
+  EXPECT_FALSE(fileExists(path("out.vdb")));
+  RunResult resumed = run(sampleArgs("out.vdb") + " --workers 2 --brick 32 --resume");
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  EXPECT_GT(jsonNumber(readText(path("out.vdb.report.json")), "from_journal"), 0);
+}
+
+TEST_F(FarmCli, PoisonedBrickExitsFiveAndIsNamed) {
+  std::string cmd = "FREP_TEST_CRASH_BRICK=2 '" FREP_BINARY "' " + sampleArgs("out.vdb") + " --workers 2 --brick 32";
+  RunResult r;
+  {
+    std::string full = "cd '" + dir_ + "' && " + cmd + " >" + path(".out") + " 2>" + path(".err");
+    int status = std::system(full.c_str());
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.err = readText(path(".err"));
+  }
+  EXPECT_EQ(r.code, 5);
+  EXPECT_NE(r.err.find("brick 2 voxels [0,0,64)-(32,32,96)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fileExists(path("out.vdb")));
+  EXPECT_TRUE(fileExists(path("out.vdb.journal")));
+}
+
+TEST_F(FarmCli, CurveKeysProtectTheLocalFarm) {
+  ASSERT_EQ(run("keygen keys").code, 0);
+  for (const char* f : {"master.pub", "master.key", "worker.pub", "worker.key", "authorized"})
+    EXPECT_TRUE(fileExists(path(std::string("keys/") + f))) << f;
+  ASSERT_EQ(run(sampleArgs("plain.vdb") + " --workers 0").code, 0);
+  RunResult r = run(sampleArgs("curve.vdb") + " --workers 2 --curve keys");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(readText(path("curve.vdb")) == readText(path("plain.vdb")));
+  EXPECT_EQ(run(sampleArgs("x.vdb") + " --workers 2 --curve missing").code, 7);
+}
+
+TEST_F(FarmCli, BadFarmArgumentsAreNamed) {
+  RunResult r = run(sampleArgs("x.vdb") + " --brick 12");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--brick"), std::string::npos);
+  r = run(sampleArgs("x.vdb") + " --listen localhost:5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--listen"), std::string::npos);
+}
+
+TEST_F(FarmCli, JsonProgressEventsForBatchSystems) {
+  RunResult r = run(sampleArgs("j.vdb") + " --workers 2 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("{\"event\":\"listening\""), std::string::npos);
+  EXPECT_NE(r.out.find("{\"event\":\"progress\""), std::string::npos);
+  EXPECT_NE(r.out.find("{\"event\":\"done\""), std::string::npos);
+}

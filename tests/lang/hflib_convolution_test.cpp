@@ -1,0 +1,184 @@
+// hf* convolution surfaces: closed forms checked against direct numerical integration of the
+// Cauchy kernel 1/(1 + S^2 r^2)^2 (Gauss-Legendre, converged far below 1e-9 for these points).
+#include "lang/hflib_test_util.h"
+
+using namespace hftest;
+
+namespace {
+
+struct P3 {
+  double x, y, z;
+};
+P3 lerp(P3 a, P3 b, double t) {
+  return {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z)};
+}
+double dist2(P3 a, P3 b) {
+  return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z);
+}
+double kernel(double S, double r2) { return 1.0 / ((1 + S * S * r2) * (1 + S * S * r2)); }
+
+// Gauss-Legendre nodes and weights on [0, 1].
+void gaussLegendre(int n, std::vector<double>& t, std::vector<double>& w) {
+  t.assign(n, 0);
+  w.assign(n, 0);
+  for (int i = 0; i < n; ++i) {
+    double x = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 0;
+    for (int it = 0; it < 100; ++it) {
+      double p0 = 1, p1 = x;
+      for (int k = 2; k <= n; ++k) {
+        double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
+        p0 = p1;
+        p1 = p2;
+      }
+      dp = n * (x * p1 - p0) / (x * x - 1);
+      double dx = p1 / dp;
+      x -= dx;
+      if (std::fabs(dx) < 1e-16) break;
+    }
+    t[i] = 0.5 * (1 - x);
+    w[i] = 1.0 / ((1 - x * x) * dp * dp);  // = 2/((1-x^2)p'^2) scaled by 1/2 for [0,1]
+  }
+}
+
+// Kernel integrated along a -> b, split into pieces for accuracy.
+double lineIntegral(P3 x, P3 a, P3 b, double S) {
+  std::vector<double> t, w;
+  gaussLegendre(40, t, w);
+  double len = std::sqrt(dist2(a, b)), sum = 0;
+  const int pieces = 16;
+  for (int p = 0; p < pieces; ++p)
+    for (size_t i = 0; i < t.size(); ++i) {
+      double u = (p + t[i]) / pieces;
+      sum += w[i] / pieces * kernel(S, dist2(x, lerp(a, b, u)));
+    }
+  return sum * len;
+}
+
+// Kernel integrated over a triangle (collapsed square map, Jacobian 2A (1-u)).
+double triangleIntegral(P3 x, P3 a, P3 b, P3 c, double S) {
+  std::vector<double> t, w;
+  gaussLegendre(60, t, w);
+  P3 ab = {b.x - a.x, b.y - a.y, b.z - a.z}, ac = {c.x - a.x, c.y - a.y, c.z - a.z};
+  P3 n = {ab.y * ac.z - ab.z * ac.y, ab.z * ac.x - ab.x * ac.z, ab.x * ac.y - ab.y * ac.x};
+  double twoArea = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z), sum = 0;
+  for (size_t i = 0; i < t.size(); ++i)
+    for (size_t j = 0; j < t.size(); ++j) {
+      double u = t[i], v = t[j] * (1 - u);
+      P3 q = {a.x + u * ab.x + v * ac.x, a.y + u * ab.y + v * ac.y, a.z + u * ab.z + v * ac.z};
+      sum += w[i] * w[j] * (1 - u) * kernel(S, dist2(x, q));
+    }
+  return sum * twoArea;
+}
+
+// Kernel integrated along an arc: radius r, opening theta (radians) in the local xy-plane,
+// turned by beta about the unit axis u (right-hand rule), centred at c.
+double arcIntegral(P3 x, P3 c, double r, double theta, P3 u, double beta, double S) {
+  std::vector<double> t, w;
+  gaussLegendre(40, t, w);
+  const int pieces = 32;
+  double sum = 0;
+  for (int p = 0; p < pieces; ++p)
+    for (size_t i = 0; i < t.size(); ++i) {
+      double phi = theta * (p + t[i]) / pieces;
+      P3 l = {r * std::cos(phi), r * std::sin(phi), 0};
+      double cb = std::cos(beta), sb = std::sin(beta), ul = u.x * l.x + u.y * l.y + u.z * l.z;
+      P3 uxl = {u.y * l.z - u.z * l.y, u.z * l.x - u.x * l.z, u.x * l.y - u.y * l.x};
+      P3 q = {c.x + l.x * cb + uxl.x * sb + u.x * ul * (1 - cb),
+              c.y + l.y * cb + uxl.y * sb + u.y * ul * (1 - cb),
+              c.z + l.z * cb + uxl.z * sb + u.z * ul * (1 - cb)};
+      sum += w[i] / pieces * kernel(S, dist2(x, q));
+    }
+  return sum * theta * r;
+}
+
+}  // namespace
+
+TEST(HfLibConvolution, Point) {
+  auto x = xyz();
+  auto v = vals({0, 0, 0, 1, 0, 0}), S = vals({1, 2});
+  Expr f = call("hfConvPoint", {arr(x), arr(v), arr(S), sc(0.5)});
+  expectClose(at(f, 0, 1, 0), 1.0 / 4 + 1.0 / 81 - 0.5);
+  expectClose(at(f, 0, 0, 0), 1.0 + 1.0 / 25 - 0.5);
+  auto bad = vals({0, 0, 0, 1, 0});
+  auto err = errorOf("hfConvPoint", {arr(x), arr(bad, "v"), arr(S, "s"), sc(0.5)});
+  EXPECT_EQ(err.first, "hfConvPoint: array v must have 6 elements (3 per element of s) (got 5)");
+  EXPECT_EQ(err.second, 1);
+}
+
+TEST(HfLibConvolution, LineMatchesNumericalIntegral) {
+  auto x = xyz();
+  auto b = vals({0, 0, 0, 1, 1, 1}), e = vals({2, 0, 0, 1, 3, 1}), S = vals({1.5, 0.7});
+  Expr f = call("hfConvLine", {arr(x), arr(b), arr(e), arr(S), sc(0.25)});
+  for (P3 p : {P3{0.5, 0.5, 0.2}, P3{-1, 2, 0.5}, P3{3, 0, 0}, P3{1, 0, 0}}) {
+    double expect = lineIntegral(p, {0, 0, 0}, {2, 0, 0}, 1.5) +
+                    lineIntegral(p, {1, 1, 1}, {1, 3, 1}, 0.7) - 0.25;
+    expectClose(at(f, p.x, p.y, p.z), expect);
+  }
+  auto shortE = vals({2, 0, 0});
+  auto err = errorOf("hfConvLine", {arr(x), arr(b), arr(shortE, "e"), arr(S, "s"), sc(0.25)});
+  EXPECT_EQ(err.first, "hfConvLine: array e must have 6 elements (3 per element of s) (got 3)");
+}
+
+TEST(HfLibConvolution, CurveIsAPolyline) {
+  auto x = xyz();
+  auto v = vals({0, 0, 0, 1, 0, 0, 1, 2, 0}), S = vals({1, 2});
+  Expr f = call("hfConvCurve", {arr(x), arr(v), arr(S), sc(0.1)});
+  P3 p = {0.5, 1, 0.5};
+  double expect =
+      lineIntegral(p, {0, 0, 0}, {1, 0, 0}, 1) + lineIntegral(p, {1, 0, 0}, {1, 2, 0}, 2) - 0.1;
+  expectClose(at(f, p.x, p.y, p.z), expect);
+  auto err = errorOf("hfConvCurve", {arr(x), arr(S, "s"), arr(S, "s"), sc(0.1)});
+  EXPECT_EQ(err.second, 1);
+}
+
+TEST(HfLibConvolution, TriangleMatchesNumericalIntegral) {
+  auto x = xyz();
+  auto v = vals({0, 0, 0, 2, 0, 0, 0, 1, 0.5}), S = vals({1.2});
+  Expr f = call("hfConvTriangle", {arr(x), arr(v), arr(S), sc(0.3)});
+  for (P3 p : {P3{0.5, 0.3, 0.6}, P3{3, -1, 1}, P3{-0.5, 0.5, -0.7}, P3{0.6, 0.2, 0.1}}) {
+    double expect = triangleIntegral(p, {0, 0, 0}, {2, 0, 0}, {0, 1, 0.5}, 1.2) - 0.3;
+    expectClose(at(f, p.x, p.y, p.z), expect);
+  }
+  // Orientation does not matter.
+  auto rev = vals({0, 1, 0.5, 2, 0, 0, 0, 0, 0});
+  Expr g = call("hfConvTriangle", {arr(x), arr(rev), arr(S), sc(0.3)});
+  expectClose(at(g, 3, -1, 1), at(f, 3, -1, 1));
+}
+
+TEST(HfLibConvolution, MeshSumsIndexedTriangles) {
+  auto x = xyz();
+  auto v = vals({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 1}), tri = vals({1, 2, 3, 2, 4, 3}),
+       S = vals({1, 2});
+  Expr f = call("hfConvMesh", {arr(x), arr(v), arr(tri), arr(S), sc(0.2)});
+  P3 p = {0.2, 0.4, 0.9};
+  double expect = triangleIntegral(p, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 1) +
+                  triangleIntegral(p, {1, 0, 0}, {1, 1, 1}, {0, 1, 0}, 2) - 0.2;
+  expectClose(at(f, p.x, p.y, p.z), expect);
+  auto badTri = vals({1, 2, 5, 2, 4, 3});
+  auto err = errorOf("hfConvMesh", {arr(x), arr(v), arr(badTri), arr(S), sc(0.2)});
+  EXPECT_EQ(err.first, "hfConvMesh: triangle index 5 out of range 1..4");
+  EXPECT_EQ(err.second, 2);
+}
+
+TEST(HfLibConvolution, ArcMatchesNumericalIntegral) {
+  auto x = xyz();
+  // Arc 1: 270 degrees, radius 2, centre (1,0,0), turned 90 degrees about x (into the xz-plane).
+  // Arc 2: full circle of radius 1 at (0,0,3), not turned.
+  auto c = vals({1, 0, 0, 0, 0, 3}), rad = vals({2, 1}), th = vals({270, 360}),
+       ax = vals({1, 0, 0, 0, 1, 0}), ang = vals({90, 0}), S = vals({1.1, 0.8});
+  Expr f = call("hfConvArc", {arr(x), arr(c), arr(rad), arr(th), arr(ax), arr(ang), arr(S), sc(0.3)});
+  for (P3 p : {P3{1, 0.5, 1.5}, P3{-1, -0.5, 0.2}, P3{0.3, 0.2, 3.1}, P3{2.5, 1, -1}}) {
+    double expect = arcIntegral(p, {1, 0, 0}, 2, 1.5 * kPi, {1, 0, 0}, kPi / 2, 1.1) +
+                    arcIntegral(p, {0, 0, 3}, 1, 2 * kPi, {0, 1, 0}, 0, 0.8) - 0.3;
+    expectClose(at(f, p.x, p.y, p.z), expect);
+  }
+  // On the axis of the full circle the integrand is constant: 2 pi r / (1 + S^2 (r^2 + h^2))^2.
+  double onAxis = 2 * kPi / std::pow(1 + 0.64 * (1 + 4), 2);
+  expectClose(at(f, 0, 0, 5), onAxis + arcIntegral({0, 0, 5}, {1, 0, 0}, 2, 1.5 * kPi,
+                                                    {1, 0, 0}, kPi / 2, 1.1) - 0.3);
+  auto shortTheta = vals({270});
+  auto err = errorOf("hfConvArc", {arr(x), arr(c), arr(rad), arr(shortTheta, "th"), arr(ax),
+                                   arr(ang), arr(S, "s"), sc(0.3)});
+  EXPECT_EQ(err.first, "hfConvArc: array th must have 2 elements (one per element of s) (got 1)");
+  EXPECT_EQ(err.second, 3);
+}
