@@ -168,6 +168,7 @@ void steiner(int res) {
 
 int main(int argc, char** argv) {
   const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   std::printf("Extremum node: fast (B&B) vs the paper's grid search at equal error bound, single thread\n");
   fastVsGrid(64, true);
   if (!quick) fastVsGrid(128, false);

@@ -128,7 +128,7 @@ class Master {
     report_.bricks = bricks_.size();
     size_t leaves = 0;
     for (auto& br : bricks_) leaves = std::max(leaves, br.maxLeaves);
-    payloadLimit_ = 12 + leaves * (12 + 64 + 2048) + leaves * 8 * 20 + 4096;
+    payloadLimit_ = 12 + leaves * (16 + 64 + 2048) + leaves * 8 * 20 + 4096;
   }
 
   // A brick's result is final: keep it, journal it, count it.

@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -92,15 +93,34 @@ struct Reader {
     p += sizeof v;
     return true;
   }
+  bool bytes(void* dst, size_t n) {
+    if (size_t(end - p) < n) return false;
+    std::memcpy(dst, p, n);
+    p += n;
+    return true;
+  }
 };
-constexpr size_t kTileBytes = 5 * 4;
-constexpr size_t kLeafBytes = 3 * 4 + 8 * 8 + kLeafVoxels * 4;
+constexpr uint32_t kCompact = 1;  // leaf flag: inactive voxels are +-magnitude, only active values sent
+
+// A leaf's inactive voxels all hold +m or -m (the sampler's band value): then only the signs of
+// the inactive voxels and the active values travel, about half the bytes of a surface leaf.
+bool compactable(const LeafBlock& l, float& magnitude) {
+  bool found = false;
+  for (int i = 0; i < kLeafVoxels; ++i) {
+    if (l.isActive(i)) continue;
+    float m = std::fabs(l.values[size_t(i)]);
+    if (!found) magnitude = m, found = true;
+    else if (m != magnitude) return false;
+  }
+  if (!found) magnitude = 0;
+  return true;
+}
 }  // namespace
 
 std::string encodeBrick(const BrickOutput& out) {
   std::string s;
-  s.reserve(12 + out.tiles.size() * kTileBytes + out.leaves.size() * kLeafBytes);
-  s.append("FRB1", 4);
+  s.reserve(12 + out.tiles.size() * 20 + out.leaves.size() * 1200);
+  s.append("FRB2", 4);
   put(s, uint32_t(out.leaves.size()));
   put(s, uint32_t(out.tiles.size()));
   for (const Tile& t : out.tiles) {
@@ -110,8 +130,21 @@ std::string encodeBrick(const BrickOutput& out) {
   }
   for (const LeafBlock& l : out.leaves) {
     for (int a = 0; a < 3; ++a) put(s, l.origin[a]);
+    float magnitude = 0;
+    const bool compact = compactable(l, magnitude);
+    put(s, compact ? kCompact : 0u);
     s.append(reinterpret_cast<const char*>(l.active.data()), sizeof l.active);
-    s.append(reinterpret_cast<const char*>(l.values.data()), sizeof l.values);
+    if (!compact) {
+      s.append(reinterpret_cast<const char*>(l.values.data()), sizeof l.values);
+      continue;
+    }
+    std::array<uint64_t, kLeafVoxels / 64> positive{};
+    for (int i = 0; i < kLeafVoxels; ++i)
+      if (!l.isActive(i) && l.values[size_t(i)] > 0) positive[size_t(i >> 6)] |= uint64_t(1) << (i & 63);
+    s.append(reinterpret_cast<const char*>(positive.data()), sizeof positive);
+    put(s, magnitude);
+    for (int i = 0; i < kLeafVoxels; ++i)
+      if (l.isActive(i)) put(s, l.values[size_t(i)]);
   }
   return s;
 }
@@ -122,34 +155,45 @@ bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* e
     return false;
   };
   Reader r{static_cast<const char*>(data), static_cast<const char*>(data) + size};
-  if (size < 12 || std::memcmp(data, "FRB1", 4) != 0) return fail("payload: bad magic");
+  if (size < 12 || std::memcmp(data, "FRB2", 4) != 0) return fail("payload: bad magic");
   r.p += 4;
   uint32_t nl = 0, nt = 0;
   r.get(nl);
   r.get(nt);
-  if (uint64_t(nt) * kTileBytes + uint64_t(nl) * kLeafBytes != size - 12) return fail("payload: size does not match counts");
+  // Every leaf takes at least 92 bytes: reject absurd counts before allocating.
+  if (uint64_t(nt) * 20 + uint64_t(nl) * 92 > size - 12) return fail("payload: counts exceed its size");
   out.tiles.resize(nt);
   for (Tile& t : out.tiles) {
     int32_t inside = 0;
-    r.get(t.origin[0]);
-    r.get(t.origin[1]);
-    r.get(t.origin[2]);
-    r.get(t.size);
-    r.get(inside);
+    if (!r.get(t.origin[0]) || !r.get(t.origin[1]) || !r.get(t.origin[2]) || !r.get(t.size) || !r.get(inside))
+      return fail("payload: truncated tile");
     if (t.size < kLeafDim || (t.size & (t.size - 1)) != 0) return fail("payload: bad tile size");
     t.inside = inside != 0;
   }
   out.leaves.resize(nl);
   for (LeafBlock& l : out.leaves) {
-    r.get(l.origin[0]);
-    r.get(l.origin[1]);
-    r.get(l.origin[2]);
+    uint32_t flags = 0;
+    if (!r.get(l.origin[0]) || !r.get(l.origin[1]) || !r.get(l.origin[2]) || !r.get(flags) ||
+        !r.bytes(l.active.data(), sizeof l.active))
+      return fail("payload: truncated leaf");
     if ((l.origin[0] | l.origin[1] | l.origin[2]) & 7) return fail("payload: leaf origin not a multiple of 8");
-    std::memcpy(l.active.data(), r.p, sizeof l.active);
-    r.p += sizeof l.active;
-    std::memcpy(l.values.data(), r.p, sizeof l.values);
-    r.p += sizeof l.values;
+    if (flags & ~kCompact) return fail("payload: unknown leaf flags");
+    if (!(flags & kCompact)) {
+      if (!r.bytes(l.values.data(), sizeof l.values)) return fail("payload: truncated leaf values");
+      continue;
+    }
+    std::array<uint64_t, kLeafVoxels / 64> positive{};
+    float magnitude = 0;
+    if (!r.bytes(positive.data(), sizeof positive) || !r.get(magnitude)) return fail("payload: truncated leaf");
+    for (int i = 0; i < kLeafVoxels; ++i) {
+      if (l.isActive(i)) {
+        if (!r.get(l.values[size_t(i)])) return fail("payload: truncated leaf values");
+      } else {
+        l.values[size_t(i)] = ((positive[size_t(i >> 6)] >> (i & 63)) & 1u) ? magnitude : -magnitude;
+      }
+    }
   }
+  if (r.p != r.end) return fail("payload: trailing bytes");
   return true;
 }
 

@@ -45,8 +45,10 @@ class ModelCache {
 BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::array<int32_t, 3>& lo,
                          const std::array<int32_t, 3>& hi, int threads);
 
-// Payload frame codec (little-endian): "FRB1", u32 leaves, u32 tiles, tiles (origin[3], size,
-// inside as i32 each), leaves (origin[3] i32, active mask 8 x u64, 512 float values).
+// Payload frame codec (little-endian): "FRB2", u32 leaves, u32 tiles, tiles (origin[3], size,
+// inside as i32 each), leaves (origin[3] i32, u32 flags, active mask 8 x u64, then either 512
+// float values, or when every inactive voxel holds +-m (flag 1): a mask of the positive
+// inactive voxels (8 x u64), m as a float, and the active voxels' values only).
 std::string encodeBrick(const BrickOutput& out);
 // Returns false (with a reason) on a malformed payload; never reads out of bounds.
 bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* error);

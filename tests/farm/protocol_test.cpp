@@ -189,8 +189,31 @@ TEST(Protocol, PayloadCodecRejectsMalformedInput) {
   ASSERT_TRUE(decodeBrick(s.data(), s.size(), back, &err));
   EXPECT_EQ(back.leaves[0].values, l.values);
   EXPECT_FALSE(decodeBrick(s.data(), s.size() - 1, back, &err));
-  EXPECT_FALSE(decodeBrick("FRB1", 4, back, &err));
+  EXPECT_FALSE(decodeBrick("FRB2", 4, back, &err));
   std::string bad = s;
   bad[12 + 20] = 3;  // leaf origin x = 3: not a multiple of 8
   EXPECT_FALSE(decodeBrick(bad.data(), bad.size(), back, &err));
+  // A surface leaf: half active; inactive voxels +-0.25 travel as signs only.
+  LeafBlock half{};
+  half.origin = {0, 0, 0};
+  for (int i = 0; i < kLeafVoxels; ++i) {
+    bool active = (i % 2) == 0;
+    if (active) half.active[size_t(i >> 6)] |= uint64_t(1) << (i & 63);
+    half.values[size_t(i)] = active ? float(i) * 0.001f : (i % 4 == 1 ? 0.25f : -0.25f);
+  }
+  BrickOutput h;
+  h.leaves.push_back(half);
+  std::string hs = encodeBrick(h);
+  EXPECT_LT(hs.size(), 12 + 92 + 64 + 4 + 256 * 4 + 1);
+  ASSERT_TRUE(decodeBrick(hs.data(), hs.size(), back, &err)) << err;
+  EXPECT_EQ(back.leaves[0].values, half.values);
+  EXPECT_EQ(back.leaves[0].active, half.active);
+  // Random corruption never crashes the decoder.
+  std::mt19937 rng(3);
+  for (int k = 0; k < 2000; ++k) {
+    std::string m = hs;
+    for (int j = 0; j < 4; ++j) m[rng() % m.size()] = char(rng());
+    m.resize(rng() % (m.size() + 1));
+    decodeBrick(m.data(), m.size(), back, &err);
+  }
 }
