@@ -75,6 +75,12 @@ Expr frOffset(std::vector<Arg>& a) {
   return offsetConst(scalarArg("frOffset", a, 0), scalarArg("frOffset", a, 1));
 }
 
+// frOffsetNormal(f, D): f(X + D grad f / |grad f|), the survey's offset along the normal; f is
+// the object's field as an expression of x, differentiated symbolically.
+Expr frOffsetNormal(std::vector<Arg>& a) {
+  return offsetNormal(scalarArg("frOffsetNormal", a, 0), scalarArg("frOffsetNormal", a, 1));
+}
+
 Expr frMorph(std::vector<Arg>& a) {
   const char* fn = "frMorph";
   return morph(scalarArg(fn, a, 0), scalarArg(fn, a, 1), scalarArg(fn, a, 2));
@@ -126,6 +132,7 @@ const bool registered = registerAll({
     blendOp("frBlendIntersection", blendIntersection,
             "f1 & f2 + a0 / (1 + (f1/a1)^2 + (f2/a2)^2)"),
     {"frOffset", "SS", "f + C", frOffset},
+    {"frOffsetNormal", "SS", "f(X + D grad f / |grad f|)", frOffsetNormal},
     {"frMorph", "SSS", "f1 (1 - g) + f2 g", frMorph},
     {"frBend", "ASSS", "bend axis `along` (1-3) around radius R toward axis `toward`", frBend},
     {"frTwist", "ASSSSS", "turn about axis (1-3) by theta lerped from theta1 at u1 to theta2 at u2",

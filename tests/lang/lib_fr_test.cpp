@@ -88,3 +88,15 @@ TEST(FrLibrary, TransformErrorsNameTheArgument) {
   EXPECT_EQ(errorOf("frTaper", {arr(shortXt), sc(3.0), sc(0.0), sc(1.0), sc(1.0), sc(2.0)}).second,
             0);
 }
+
+TEST(FrLibrary, OffsetAlongTheNormalMovesTheSurfaceByD) {
+  // Unit sphere f = 1 - |x|^2 offset by D = 0.5 along its normal: the surface is at radius 1.5.
+  Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  Expr f = call("frOffsetNormal", {sc(1.0 - x * x - y * y - z * z), sc(0.5)});
+  auto tape = frep::Tape::compile(f, 3);
+  frep::PointEvaluator pe;
+  double on[3] = {1.5, 0, 0}, in[3] = {0, 1.4, 0}, out[3] = {0, 0, -1.6};
+  EXPECT_NEAR(pe.eval(*tape, on), 0.0, 1e-12);
+  EXPECT_GT(pe.eval(*tape, in), 0.0);
+  EXPECT_LT(pe.eval(*tape, out), 0.0);
+}
