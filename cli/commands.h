@@ -58,6 +58,16 @@ struct SampleRequest {
 };
 int runSample(const SampleRequest& request);
 
+// frep mesh: in-process for now (the farm comes later); --brick and --threads never change
+// the output file.
+struct MeshRequest {
+  ModelRequest model;
+  RegionRequest region;
+  int brick = 64;   // region edge in voxels (a multiple of 8)
+  int threads = 0;  // 0: all cores
+};
+int runMesh(const MeshRequest& request);
+
 int runKeygen(const std::string& dir);
 
 }  // namespace frep::cli

@@ -137,11 +137,18 @@ int main(int argc, char** argv) {
   sampleCmd->add_flag("--no-progress", sample.farm.noProgress, "No progress bar");
   sampleCmd->add_option("--curve", sample.farm.curveDir, "Require CURVE keys from DIR (see frep keygen)");
 
+  MeshRequest mesh;
+  CLI::App* meshCmd = app.add_subcommand("mesh", "Watertight triangle mesh of a model's surface (in-process)");
+  addModelOptions(meshCmd, mesh.model, true);
+  addRegionOptions(meshCmd, mesh.region, "Output mesh: .ply (binary), .obj or .stl (binary)", 128);
+  meshCmd->add_option("--brick", mesh.brick, "Region edge in voxels, a multiple of 8 (default 64; same output)");
+  meshCmd->add_option("--threads", mesh.threads, "Threads (default 0: all cores; same output)");
+
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
   keygenCmd->add_option("dir", keygenDir, "Directory for the keys")->required();
 
-  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd}) sub->fallthrough();
+  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd}) sub->fallthrough();
 
   try {
     app.parse(argc, argv);
@@ -169,6 +176,10 @@ int main(int argc, char** argv) {
       return runSlice(slice);
     }
     if (keygenCmd->parsed()) return runKeygen(keygenDir);
+    if (meshCmd->parsed()) {
+      checkObjectIsNotAFile(mesh.model);
+      return runMesh(mesh);
+    }
     checkObjectIsNotAFile(sample.model);
     sample.commandLine = recordedCommandLine(argc, argv);
     sample.logLevel = logLevel;

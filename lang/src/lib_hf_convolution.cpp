@@ -194,6 +194,37 @@ Expr convArc(std::vector<Arg>& a) {
   return sum - scalarArg(fn, a, 7);
 }
 
+// hfConvLineR(x, b, e, R): segments b_i -> e_i with one kernel width S = 1/R if R < 1, else 1,
+// whose summed field is capped at 1 (hfp adds the segments in order and stops at 1; all terms
+// are positive, so that is min(1, sum)). The threshold is the field of one segment at distance
+// R from its start point, perpendicular to it (t = 0 in segment()):
+//   T = l/(2 pT^2 qT^2) + atan(S l/pT)/(2 S pT^3), pT^2 = 1 + S^2 R^2, qT^2 = 1 + S^2 (R^2 + l^2),
+// with l the length of the LAST segment (hfp recomputes T in its loop). So for one segment the
+// surface passes at distance R from b on the plane through b perpendicular to the segment, and
+// further out elsewhere (the field is larger near the middle).
+Expr convLineR(std::vector<Arg>& a) {
+  const char* fn = "hfConvLineR";
+  Vec3 x = at(coords(fn, a), 0);
+  auto& e = arrayArg(fn, a, 2);
+  if (e.empty() || e.size() % 3 != 0)
+    throw LibraryError(std::string(fn) + ": array " + argName(a, 2, "e") +
+                           " size must be a positive multiple of 3 (got " +
+                           std::to_string(e.size()) + ")",
+                       2);
+  auto& b = arrayExactly(fn, a, 1, e.size(), " (as many as " + argName(a, 2, "e") + ")");
+  Expr R = scalarArg(fn, a, 3);
+  Expr S = select(lt(R, 1.0), 1.0 / R, 1.0);
+  size_t n = e.size() / 3;
+  Expr sum = 0.0;
+  for (size_t i = 0; i < n; ++i) sum = sum + segment(x, at(b, 3 * i), at(e, 3 * i), S);
+  Expr l = sqrt(norm2(minus(at(e, 3 * (n - 1)), at(b, 3 * (n - 1)))));
+  Expr S2 = S * S;
+  Expr pT2 = 1.0 + S2 * R * R, qT2 = 1.0 + S2 * (R * R + l * l);
+  Expr pT = sqrt(pT2);
+  Expr T = l / (2.0 * pT2 * qT2) + atan(S * l / pT) / (2.0 * S * pT2 * pT);
+  return min(sum, 1.0) - T;
+}
+
 const bool registered = registerAll({
     {"hfConvPoint", "AAAS", "sum 1/(1 + S_i^2 r_i^2)^2 - T", convPoint},
     {"hfConvLine", "AAAAS", "sum of Cauchy kernel integrals over segments b_i -> e_i - T",
@@ -204,6 +235,9 @@ const bool registered = registerAll({
     {"hfConvArc", "AAAAAAAS", "sum of Cauchy kernel integrals over arcs - T", convArc},
     {"hfConvMesh", "AAAAS", "sum of Cauchy kernel integrals over indexed triangles - T",
      convMesh},
+    {"hfConvLineR", "AAAS",
+     "min(1, sum of segment integrals, S = 1/R if R < 1 else 1) - field at distance R",
+     convLineR},
 });
 
 }  // namespace

@@ -1,5 +1,6 @@
-// HyperFun's distance primitives (hfD*: signed Euclidean distance, + inside) and blends
-// (hfBlendUni/Int on R-functions, hfDBlendUni/Int on distances).
+// HyperFun's distance primitives (hfD*: signed Euclidean distance, + inside), blends
+// (hfBlendUni/Int on R-functions, hfDBlendUni/Int on distances) and the SARDF set operations
+// hfDUni/hfDInt/hfDSub.
 #include <array>
 #include <string>
 
@@ -120,6 +121,75 @@ Expr dBlend(const char* fn, std::vector<Arg>& a, bool uni) {
   return select(le(abs(f2 - f1), r), fillet, sharp);
 }
 
+// SARDF set operations on signed approximate distances (+ inside): P.-A. Fayolle, A. Pasko,
+// B. Schmitt, "SARDF: Signed Approximate Real Distance Functions in Heterogeneous Objects
+// Modeling" (HOMA 2008, LNCS 4889) and Fayolle, Pasko, Schmitt, Mirenkov, "Constructive
+// heterogeneous object modeling using signed approximate real distance functions", JCISE 6(3)
+// 2006. The union of x = f1 and y = f2 is max(x, y) except that the corner of each level curve
+// (at x = y = d) is replaced by a circular arc tangent to the lines x = d and y = d, which makes
+// the function C1. Piecewise in the (x, y) plane, as hfp's hfDUni(f1, f2, R, alpha):
+//  - quadrants II and IV and the axes: max(x, y);
+//  - quadrant I ("unbounded", angle alpha, t = tan alpha): where t < x/y < 1/t the level-d curve
+//    is the circle (x - td)^2 + (y - td)^2 = ((1 - t) d)^2, touching x = d and y = d where
+//    x/y = 1/t and t, so d is the smaller root of (t^2 + 2t - 1) d^2 - 2t(x + y) d + x^2 + y^2 = 0,
+//    written d = (x^2 + y^2) / (t(x + y) + sqrt(2t^2 xy - (2t - 1)(x^2 + y^2))) (no cancellation,
+//    no 0/0 at alpha = pi/8); outside that wedge x if x/y >= 1/t, else y;
+//  - quadrant III ("bounded", radius R): the arc of level d < 0 has radius rho(d), centre
+//    (d - rho, d - rho), with rho = 2 sqrt(R|d|) - |d| for -R <= d (rho and rho' continuous at
+//    d = -R) and rho = R for d <= -R. Beyond the level -R curve that is the fixed fillet
+//    (x + R - d)^2 + (y + R - d)^2 = R^2: d = R + ((x + y) - sqrt(2R^2 - (x - y)^2)) / 2 where
+//    |x - y| <= R, max(x, y) elsewhere. Inside it, with d = -m^2 and s = sqrt(R), the arc is
+//    |(x, y) - (-2sm, -2sm)| = 2sm - m^2 (hfp's quartic m^4 - 4sm^3 - 4Rm^2 - 4s(x+y)m
+//    - (x^2+y^2) = 0), used between the parabolas x = -y^2/(4R), y = -x^2/(4R) traced by its
+//    tangent points; max(x, y) outside them. m is the root of phi(m) = 2sm - m^2 - |(x + 2sm,
+//    y + 2sm)| with m >= m1 = max(-x, -y)/(2s) (the arc's centre beyond the point, where phi is
+//    concave and decreasing): Newton from m_hi = min(s, -(x + y)/(2s(2 - sqrt 2))) >= root,
+//    clamped at m1. 16 steps: max relative error of d 5e-14 against a 3000-step bisection on
+//    random points of that zone with R in [1e-3, 1e3] and |x|, |y| from 1e-140 R to 3R.
+// Intersection is the dual -union(-x, -y) (hfDInt: hfp's int_sardef with R in quadrant I and
+// alpha in quadrant III) and subtraction is intersection(x, -y) (hfDSub).
+constexpr int kSardfNewtonSteps = 16;
+
+Expr sardfUnion(const Expr& x, const Expr& y, const Expr& R, const Expr& alpha) {
+  Expr q = x * x + y * y;
+  // Quadrant I.
+  Expr t = tan(alpha);
+  Expr ratio = x / y;
+  Expr wedge = q / (t * (x + y) + sqrt(2.0 * t * t * x * y - (2.0 * t - 1.0) * q));
+  Expr quad1 = select(logicalAnd(lt(ratio, 1.0 / t), gt(ratio, t)), wedge,
+                      select(ge(ratio, 1.0 / t), x, y));
+  // Quadrant III beyond the level -R curve: fixed radius R.
+  Expr fillet = R + 0.5 * ((x + y) - sqrt(2.0 * R * R - square(x - y)));
+  Expr beyond = select(le(abs(y - x), R), fillet, max(x, y));
+  // Quadrant III inside the level -R curve: radius 2 sqrt(R|d|) - |d|.
+  Expr s = sqrt(R);
+  Expr m1 = max(-x, -y) / (2.0 * s);
+  Expr m = min(s, -(x + y) / (2.0 * s * (2.0 - std::sqrt(2.0))));
+  for (int k = 0; k < kSardfNewtonSteps; ++k) {
+    Expr u = x + 2.0 * s * m, v = y + 2.0 * s * m;
+    Expr dist = sqrt(u * u + v * v);
+    Expr phi = 2.0 * s * m - m * m - dist;
+    Expr dphi = 2.0 * s - 2.0 * m - 2.0 * s * (u + v) / max(dist, 1e-300);
+    m = max(m - phi / dphi, m1);
+  }
+  Expr px = -(x * x) / (4.0 * R), py = -(y * y) / (4.0 * R);
+  Expr within = select(logicalAnd(le(x, py), le(y, px)), -(m * m), select(gt(y, px), y, x));
+  Expr insideLevelR =
+      logicalOr(logicalOr(ge(x, -R), ge(y, -R)),
+                logicalAnd(logicalAnd(ge(x, -2.0 * R), ge(y, -2.0 * R)),
+                           ge(square(x + 2.0 * R) + square(y + 2.0 * R), R * R)));
+  Expr quad3 = select(insideLevelR, within, beyond);
+  return select(logicalAnd(gt(x, 0.0), gt(y, 0.0)), quad1,
+                select(logicalAnd(lt(x, 0.0), lt(y, 0.0)), quad3, max(x, y)));
+}
+
+Expr sardf(const char* fn, std::vector<Arg>& a, int op) {
+  Expr f1 = scalarArg(fn, a, 0), f2 = scalarArg(fn, a, 1);
+  Expr R = scalarArg(fn, a, 2), alpha = scalarArg(fn, a, 3);
+  if (op == 0) return sardfUnion(f1, f2, R, alpha);
+  return -sardfUnion(-f1, op == 1 ? -f2 : f2, R, alpha);  // 1: f1 & f2, 2: f1 & -f2
+}
+
 std::vector<LibraryFunction> all() {
   std::vector<LibraryFunction> fns = {
       {"hfDCylinder", "AAAS", "R - distance to the line c + s u", dCylinder},
@@ -133,6 +203,12 @@ std::vector<LibraryFunction> all() {
        [](std::vector<Arg>& a) { return dBlend("hfDBlendUni", a, true); }},
       {"hfDBlendInt", "SSS", "circular fillet of radius r where |f1 - f2| <= r, else min",
        [](std::vector<Arg>& a) { return dBlend("hfDBlendInt", a, false); }},
+      {"hfDUni", "SSSS", "SARDF union: max(f1, f2) with C1 rounded corners (alpha, R)",
+       [](std::vector<Arg>& a) { return sardf("hfDUni", a, 0); }},
+      {"hfDInt", "SSSS", "SARDF intersection: -hfDUni(-f1, -f2, R, alpha)",
+       [](std::vector<Arg>& a) { return sardf("hfDInt", a, 1); }},
+      {"hfDSub", "SSSS", "SARDF subtraction: hfDInt(f1, -f2, R, alpha)",
+       [](std::vector<Arg>& a) { return sardf("hfDSub", a, 2); }},
   };
   for (int axis = 0; axis < 3; ++axis) {
     std::string ax = kAxisName[axis];

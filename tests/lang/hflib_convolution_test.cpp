@@ -1,6 +1,7 @@
 // hf* convolution surfaces: closed forms checked against direct numerical integration of the
 // Cauchy kernel 1/(1 + S^2 r^2)^2 (Gauss-Legendre, converged far below 1e-9 for these points).
 #include "lang/hflib_test_util.h"
+#include "lang/lang_test_util.h"
 
 using namespace hftest;
 
@@ -181,4 +182,72 @@ TEST(HfLibConvolution, ArcMatchesNumericalIntegral) {
                                    arr(ang), arr(S, "s"), sc(0.3)});
   EXPECT_EQ(err.first, "hfConvArc: array th must have 2 elements (one per element of s) (got 1)");
   EXPECT_EQ(err.second, 3);
+}
+
+// hfConvLineR: min(1, sum of segment fields) - T, S = 1/R if R < 1 else 1, T the field of the
+// last segment at distance R from its start point, perpendicular to it. Expected values use the
+// numerical line integral above.
+TEST(HfLibConvolution, LineRHandPoints) {
+  auto x = xyz();
+  // One segment, R < 1 so S = 1/R = 2.
+  auto b = vals({0, 0, 0}), e = vals({2, 0, 0});
+  Expr f = call("hfConvLineR", {arr(x), arr(b), arr(e), sc(0.5)});
+  double T = lineIntegral({0, 0.5, 0}, {0, 0, 0}, {2, 0, 0}, 2);
+  for (P3 p : {P3{1, 0.7, 0.2}, P3{-0.5, 0.3, 0}, P3{2.5, 1, -1}}) {
+    double expect = std::min(1.0, lineIntegral(p, {0, 0, 0}, {2, 0, 0}, 2)) - T;
+    expectClose(at(f, p.x, p.y, p.z), expect);
+  }
+  // R >= 1 so S = 1; two segments, T from the last one (length 3).
+  auto b2 = vals({0, 0, 0, 0, 0, 1}), e2 = vals({2, 0, 0, 0, 3, 1});
+  Expr g = call("hfConvLineR", {arr(x), arr(b2), arr(e2), sc(1.5)});
+  double T2 = lineIntegral({1.5, 0, 1}, {0, 0, 1}, {0, 3, 1}, 1);
+  for (P3 p : {P3{1, 2, 3}, P3{4, 0.5, -1}, P3{-2, -2, 2}}) {
+    double sum = lineIntegral(p, {0, 0, 0}, {2, 0, 0}, 1) + lineIntegral(p, {0, 0, 1}, {0, 3, 1}, 1);
+    expectClose(at(g, p.x, p.y, p.z), std::min(1.0, sum) - T2);
+  }
+  // The sum is capped at 1: on the axis of a long segment the field is near pi/2 (S = 1).
+  auto bl = vals({-10, 0, 0}), el = vals({10, 0, 0});
+  Expr h = call("hfConvLineR", {arr(x), arr(bl), arr(el), sc(2.0)});
+  ASSERT_GT(lineIntegral({0, 0.1, 0}, {-10, 0, 0}, {10, 0, 0}, 1), 1.0);
+  expectClose(at(h, 0, 0.1, 0), 1.0 - lineIntegral({-10, 2, 0}, {-10, 0, 0}, {10, 0, 0}, 1));
+}
+
+TEST(HfLibConvolution, LineRSurfaceAtDistanceRFromTheStartPoint) {
+  auto x = xyz();
+  auto b = vals({1, 1, 0}), e = vals({1, 1, 4});
+  for (double R : {0.4, 1.0, 2.5}) {
+    Expr f = call("hfConvLineR", {arr(x), arr(b), arr(e), sc(R)});
+    // The plane through b perpendicular to the segment: zero exactly at distance R, inside
+    // (> 0) nearer, outside farther.
+    for (double phi : {0.0, 1.0, 2.5}) {
+      double cx = std::cos(phi), cy = std::sin(phi);
+      EXPECT_NEAR(at(f, 1 + R * cx, 1 + R * cy, 0), 0.0, 1e-12);
+      EXPECT_GT(at(f, 1 + 0.9 * R * cx, 1 + 0.9 * R * cy, 0), 0.0);
+      EXPECT_LT(at(f, 1 + 1.1 * R * cx, 1 + 1.1 * R * cy, 0), 0.0);
+    }
+    // hfp's threshold is taken at the start point, not the middle: on the midpoint's
+    // perpendicular the field at distance R exceeds it, so the surface lies farther out there.
+    EXPECT_GT(at(f, 1 + R, 1, 2), 0.0);
+  }
+  auto bad = vals({0, 0, 0, 1});
+  auto err = errorOf("hfConvLineR", {arr(x), arr(bad, "b"), arr(bad, "e"), sc(1.0)});
+  EXPECT_EQ(err.first, "hfConvLineR: array e size must be a positive multiple of 3 (got 4)");
+  EXPECT_EQ(err.second, 2);
+  auto e6 = vals({1, 0, 0, 2, 0, 0});
+  err = errorOf("hfConvLineR", {arr(x), arr(b, "b"), arr(e6, "e"), sc(1.0)});
+  EXPECT_EQ(err.first, "hfConvLineR: array b must have 6 elements (as many as e) (got 3)");
+  EXPECT_EQ(err.second, 1);
+}
+
+TEST(HfLibConvolution, LineRFromHyperFunSource) {
+  const char* src = R"(my_model(x[3], a[1]) {
+    array b[3], e[3];
+    b = [0, 0, 0]; e = [2, 0, 0];
+    my_model = hfConvLineR(x, b, e, 0.5);
+  })";
+  frep::lang::Model m = frep::lang::testing::compileOk(src);
+  double T = lineIntegral({0, 0.5, 0}, {0, 0, 0}, {2, 0, 0}, 2);
+  expectClose(frep::lang::testing::evalModel(m, {1, 0.7, 0.2}),
+              std::min(1.0, lineIntegral({1, 0.7, 0.2}, {0, 0, 0}, {2, 0, 0}, 2)) - T);
+  EXPECT_NEAR(frep::lang::testing::evalModel(m, {0, 0, 0.5}), 0.0, 1e-12);
 }

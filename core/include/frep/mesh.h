@@ -1,0 +1,95 @@
+// Polygonisation of a model: a watertight, consistently oriented triangle mesh of {f = 0} that
+// is the same, vertex for vertex and triangle for triangle, whatever the split of the grid into
+// regions and the order in which the regions' pieces are merged (docs/mesh.md).
+//
+// Method: marching tetrahedra on the Kuhn (Freudenthal) decomposition of every grid cell into
+// six tetrahedra around its main diagonal. Neighbouring cells triangulate their shared faces
+// the same way, so the surface is closed and manifold by construction, with no ambiguous case.
+// Only cells near the surface are visited (the sparse sampler's interval classification, band
+// 1 voxel). Every vertex lies on a sign-changing grid edge (axis edge, face diagonal or body
+// diagonal) and is keyed by that GLOBAL edge; its position comes from root finding on the model
+// along the edge (Illinois, with bisection as the fallback), its normal from the gradient
+// evaluator (outward = -grad f, inside is f >= 0).
+//
+// Sign rule: a grid point is inside when its value's sign bit is clear (+0 is inside, -0, NaN
+// and negative values are outside), so every edge has a strict sign change or none.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "frep/sample.h"
+#include "frep/tape.h"
+
+namespace frep {
+
+// A grid edge from point (i, j, k) to (i, j, k) + d, where d's bits are the axis steps
+// (bit 0: +x, bit 1: +y, bit 2: +z; 1..7). Keys order edges by (i, j, k, d), i.e. the
+// vertex order of merged meshes. Indices must be below 2^19 per axis.
+using EdgeKey = uint64_t;
+inline EdgeKey edgeKey(int64_t i, int64_t j, int64_t k, int dir) {
+  return (uint64_t(i) << 41) | (uint64_t(j) << 22) | (uint64_t(k) << 3) | uint64_t(dir);
+}
+inline std::array<int64_t, 4> edgeKeyParts(EdgeKey key) {
+  return {int64_t(key >> 41), int64_t((key >> 22) & 0x7ffff), int64_t((key >> 3) & 0x7ffff), int64_t(key & 7)};
+}
+constexpr int64_t kMaxMeshGridPoints = int64_t(1) << 19;
+
+struct MeshVertex {
+  EdgeKey key;
+  std::array<double, 3> position;
+  std::array<double, 3> normal;  // unit, outward (towards decreasing f)
+};
+
+struct MeshStats {
+  uint64_t cellsVisited = 0;    // cells whose 8 corner signs were examined
+  uint64_t cellsCrossed = 0;    // cells with a sign change
+  uint64_t rootEvals = 0;       // model evaluations of the edge root finding
+  uint64_t gradientEvals = 0;   // normals
+  uint64_t samplePointEvals = 0;  // evaluations of the band sampling (grid points)
+  uint64_t fallbackEdges = 0;   // edges whose end values disagreed with their signs (bisection)
+};
+
+// The triangles of one region: vertices keyed by global edges (sorted by key, unique), triangles
+// as key triples (winding outward). Pieces of adjacent regions share the vertices of the edges
+// on their common boundary, with identical positions and normals.
+struct MeshPiece {
+  std::array<int32_t, 3> regionLo{0, 0, 0};
+  std::vector<MeshVertex> vertices;
+  std::vector<std::array<EdgeKey, 3>> triangles;
+  MeshStats stats;
+};
+
+// One indexed mesh. Vertex order is the order of their keys, triangle order is the order of
+// their key triples (each rotated to start at its smallest key, winding kept).
+struct Mesh {
+  std::vector<std::array<double, 3>> positions;
+  std::vector<std::array<double, 3>> normals;
+  std::vector<std::array<uint32_t, 3>> triangles;
+  std::vector<EdgeKey> keys;  // the global edge of each vertex
+  MeshStats stats;            // sums over the pieces
+};
+
+struct MeshOptions {
+  std::vector<double> fixedCoords;  // values of x[3], x[4], ... for models of dimension > 3
+  int threads = 0;                  // 0: TBB's default; 1: serial (the result is the same)
+  int rootIterations = 10;          // Illinois steps per edge after its two end values
+  // Roots are kept at least this fraction of the edge away from its ends, so no two vertices
+  // coincide and no triangle is degenerate (the surface moves by at most this much).
+  double endGuard = 1e-3;
+};
+
+// Triangles of the cells whose minimum corner is in [lo, hi) (index space; lo a multiple of 8,
+// hi clipped to the grid). Each cell belongs to exactly one region, so the pieces of a partition
+// of the grid never produce a triangle twice.
+MeshPiece meshRegion(const TapePtr& tape, const GridSpec& grid, const std::array<int32_t, 3>& lo,
+                     const std::array<int32_t, 3>& hi, const MeshOptions& options = {});
+
+// Stitches pieces by key into one mesh, independent of the pieces' order and of the split.
+Mesh mergePieces(const std::vector<MeshPiece>& pieces);
+
+// The whole grid, split into cubic regions of `brick` voxels (a multiple of 8; 0: one region).
+Mesh meshGrid(const TapePtr& tape, const GridSpec& grid, const MeshOptions& options = {}, int brick = 0);
+
+}  // namespace frep

@@ -1,0 +1,290 @@
+// The mesher (mesh.h) on models with known answers: watertight and consistently oriented,
+// no degenerate triangles, Euler characteristic, volume and area against formulas, vertices on
+// the surface, outward normals, and the same mesh whatever the split into regions.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <cstdio>
+#include <random>
+
+#include "core/mesh_checks.h"
+#include "frep/eval.h"
+#include "frep/mesh.h"
+#include "frep/ops.h"
+
+using namespace frep;
+namespace mc = mesh_checks;
+
+namespace {
+
+Expr X() { return Expr::x(0); }
+Expr Y() { return Expr::x(1); }
+Expr Z() { return Expr::x(2); }
+
+Expr sphereAt(double cx, double cy, double cz, double r) {
+  return r * r - square(X() - cx) - square(Y() - cy) - square(Z() - cz);
+}
+// hfBlock-like: min of the six half-spaces, centre c, half sizes h.
+Expr blockAt(double cx, double cy, double cz, double hx, double hy, double hz) {
+  return min(min(min(hx - (X() - cx), hx + (X() - cx)), min(hy - (Y() - cy), hy + (Y() - cy))),
+             min(hz - (Z() - cz), hz + (Z() - cz)));
+}
+Expr torusZ(double R, double r) {
+  return r * r - square(sqrt(square(X()) + square(Y())) - R) - square(Z());
+}
+
+constexpr double kPi = 3.14159265358979323846;
+
+GridSpec cubeGrid(double half, int res) { return GridSpec::fromBounds({-half, -half, -half}, {half, half, half}, res); }
+
+struct Checked {
+  Mesh mesh;
+  long euler = 0;
+  int components = 0;
+  double volume = 0, area = 0, minArea = 0;
+};
+
+Checked meshAndCheck(const Expr& model, const GridSpec& g, int brick = 0) {
+  Checked c;
+  TapePtr tape = Tape::compile(model, 3);
+  c.mesh = meshGrid(tape, g, {}, brick);
+  const Mesh& m = c.mesh;
+  EXPECT_GT(m.triangles.size(), 0u);
+  EXPECT_EQ(mc::checkEdgePairs(m.triangles, m.positions.size()), "");
+  c.euler = mc::eulerCharacteristic(m.triangles, m.positions.size());
+  c.components = mc::components(m.triangles, m.positions.size());
+  c.volume = mc::enclosedVolume(m.positions, m.triangles);
+  c.area = mc::surfaceArea(m.positions, m.triangles);
+  c.minArea = mc::minTriangleArea(m.positions, m.triangles);
+  // No degenerate triangles: far above rounding noise (voxel^2 * 1e-9).
+  EXPECT_GT(c.minArea, 1e-9 * g.voxel * g.voxel);
+  // Every vertex used by some triangle.
+  std::vector<char> used(m.positions.size(), 0);
+  for (const auto& t : m.triangles)
+    for (uint32_t v : t) used[v] = 1;
+  EXPECT_EQ(std::count(used.begin(), used.end(), 0), 0);
+  return c;
+}
+
+// Printed for the record (docs/mesh.md quotes them).
+void figures(const char* name, const Checked& c, double volume, double area) {
+  std::printf("[figures] %-36s V %7zu F %7zu  volume %.6f (err %+.3f%%)  area %.6f (err %+.3f%%)  min area %.2e\n",
+              name, c.mesh.positions.size(), c.mesh.triangles.size(), c.volume, 100 * (c.volume / volume - 1),
+              c.area, 100 * (c.area / area - 1), c.minArea);
+}
+
+// Newton projection onto {f = 0}: every vertex converges to |f| < 1e-10 within half a voxel.
+void checkVerticesOnSurface(const Expr& model, const Mesh& m, double voxel) {
+  TapePtr tape = Tape::compile(model, 3);
+  GradientEvaluator ge;
+  double worstMove = 0, worstStart = 0;
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    std::array<double, 3> x = m.positions[i], g;
+    double f0 = ge.eval(*tape, x.data(), g.data());
+    double f = f0;
+    for (int it = 0; it < 8 && std::abs(f) > 1e-13; ++it) {
+      double gg = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+      ASSERT_GT(gg, 0) << "vertex " << i;
+      for (int c = 0; c < 3; ++c) x[c] -= f * g[c] / gg;
+      f = ge.eval(*tape, x.data(), g.data());
+    }
+    EXPECT_LT(std::abs(f), 1e-10) << "vertex " << i;
+    worstMove = std::max(worstMove, mc::norm(mc::sub(x, m.positions[i])));
+    worstStart = std::max(worstStart, std::abs(f0));
+  }
+  EXPECT_LT(worstMove, 0.5 * voxel);
+}
+
+void checkNormals(const Mesh& m, const std::function<mc::Vec3(const mc::Vec3&)>& outward) {
+  double worst = 2;
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    mc::Vec3 n = outward(m.positions[i]);
+    double len = mc::norm(n);
+    worst = std::min(worst, mc::dot(m.normals[i], n) / len);
+    EXPECT_NEAR(mc::norm(m.normals[i]), 1.0, 1e-12);
+  }
+  EXPECT_GT(worst, 0.9);
+}
+
+void expectIdentical(const Mesh& a, const Mesh& b) {
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  ASSERT_EQ(a.triangles.size(), b.triangles.size());
+  EXPECT_TRUE(a.keys == b.keys);
+  EXPECT_TRUE(a.positions == b.positions);  // bit for bit
+  EXPECT_TRUE(a.normals == b.normals);
+  EXPECT_TRUE(a.triangles == b.triangles);
+}
+
+}  // namespace
+
+TEST(Mesh, TablesGiveOneClosedSurfacePerCell) {
+  // A single inside point: the closed surface around it is an octahedron-like fan; the mesh of
+  // a tiny sphere around a grid point must be closed with Euler characteristic 2.
+  GridSpec g = cubeGrid(1.0, 17);  // voxel 0.125, point 8 at the origin
+  Checked c = meshAndCheck(sphereAt(0, 0, 0, 0.05), g);
+  EXPECT_EQ(c.euler, 2);
+  EXPECT_EQ(c.components, 1);
+  EXPECT_GT(c.volume, 0);
+}
+
+TEST(Mesh, Sphere) {
+  const double r = 0.8;
+  GridSpec g = cubeGrid(1.0, 64);
+  Expr s = sphereAt(0.03, 0.02, -0.01, r);
+  Checked c = meshAndCheck(s, g);
+  EXPECT_EQ(c.euler, 2);
+  EXPECT_EQ(c.components, 1);
+  EXPECT_NEAR(c.volume, 4.0 / 3.0 * kPi * r * r * r, 0.01 * 4.0 / 3.0 * kPi * r * r * r);
+  EXPECT_NEAR(c.area, 4 * kPi * r * r, 0.01 * 4 * kPi * r * r);
+  figures("sphere 64^3", c, 4.0 / 3.0 * kPi * r * r * r, 4 * kPi * r * r);
+  checkVerticesOnSurface(s, c.mesh, g.voxel);
+  checkNormals(c.mesh, [](const mc::Vec3& p) { return mc::Vec3{p[0] - 0.03, p[1] - 0.02, p[2] + 0.01}; });
+}
+
+TEST(Mesh, Block) {
+  GridSpec g = cubeGrid(1.0, 64);
+  Expr b = blockAt(0.01, -0.02, 0.015, 0.6, 0.5, 0.4);
+  Checked c = meshAndCheck(b, g);
+  EXPECT_EQ(c.euler, 2);
+  EXPECT_EQ(c.components, 1);
+  const double vol = 8 * 0.6 * 0.5 * 0.4, area = 8 * (0.6 * 0.5 + 0.6 * 0.4 + 0.5 * 0.4);
+  // Edges and corners are cut off (no sharp-feature placement yet): within 1% and 2%.
+  EXPECT_NEAR(c.volume, vol, 0.01 * vol);
+  EXPECT_NEAR(c.area, area, 0.02 * area);
+  figures("block 64^3", c, vol, area);
+  checkVerticesOnSurface(b, c.mesh, g.voxel);
+}
+
+TEST(Mesh, GridAlignedBlockHasNoDegenerateTriangles) {
+  // Faces exactly on grid planes: many values are exactly 0 and roots fall on grid points.
+  GridSpec g = cubeGrid(1.0, 65);  // voxel 1/32: +-0.5 are grid planes
+  Expr b = blockAt(0, 0, 0, 0.5, 0.5, 0.5);
+  Checked c = meshAndCheck(b, g);  // watertight and min area checked inside
+  EXPECT_EQ(c.euler, 2);
+  EXPECT_NEAR(c.volume, 1.0, 0.01);
+  // A sphere through grid points too (r = 0.5: (0.5, 0, 0) is on the surface).
+  Checked s = meshAndCheck(sphereAt(0, 0, 0, 0.5), g);
+  EXPECT_EQ(s.euler, 2);
+  EXPECT_NEAR(s.volume, 4.0 / 3.0 * kPi * 0.125, 0.01 * 4.0 / 3.0 * kPi * 0.125);
+}
+
+TEST(Mesh, Torus) {
+  const double R = 0.6, r = 0.25;
+  GridSpec g = cubeGrid(1.0, 64);
+  Expr t = torusZ(R, r);
+  Checked c = meshAndCheck(t, g);
+  EXPECT_EQ(c.euler, 0);  // genus 1
+  EXPECT_EQ(c.components, 1);
+  EXPECT_NEAR(c.volume, 2 * kPi * kPi * R * r * r, 0.01 * 2 * kPi * kPi * R * r * r);
+  EXPECT_NEAR(c.area, 4 * kPi * kPi * R * r, 0.01 * 4 * kPi * kPi * R * r);
+  figures("torus 64^3", c, 2 * kPi * kPi * R * r * r, 4 * kPi * kPi * R * r);
+  checkVerticesOnSurface(t, c.mesh, g.voxel);
+  checkNormals(c.mesh, [&](const mc::Vec3& p) {
+    double q = std::sqrt(p[0] * p[0] + p[1] * p[1]);
+    return mc::Vec3{p[0] - R * p[0] / q, p[1] - R * p[1] / q, p[2]};
+  });
+}
+
+TEST(Mesh, BlockMinusSphere) {
+  // The sphere is centred on a corner of the block: it removes one eighth of a ball.
+  const double h = 0.6, r = 0.45;
+  GridSpec g = cubeGrid(1.0, 64);
+  Expr m = min(blockAt(0, 0, 0, h, h, h), -sphereAt(h, h, h, r));
+  Checked c = meshAndCheck(m, g);
+  EXPECT_EQ(c.euler, 2);
+  const double vol = 8 * h * h * h - kPi * r * r * r / 6;
+  const double area = 24 * h * h - 3 * kPi * r * r / 4 + kPi * r * r / 2;
+  EXPECT_NEAR(c.volume, vol, 0.01 * vol);
+  EXPECT_NEAR(c.area, area, 0.02 * area);
+  figures("block minus sphere 64^3", c, vol, area);
+  checkVerticesOnSurface(m, c.mesh, g.voxel);
+}
+
+TEST(Mesh, BlendedUnion) {
+  Expr a = sphereAt(-0.35, 0, 0, 0.4), b = sphereAt(0.35, 0, 0, 0.4);
+  Expr m = blendUnion(a, b, 0.1, 0.3, 0.3);
+  GridSpec g = cubeGrid(1.0, 64);
+  Checked c = meshAndCheck(m, g);
+  EXPECT_EQ(c.euler, 2);
+  EXPECT_EQ(c.components, 1);
+  // More than the plain union of the two balls (the blend adds material); no closed form, so
+  // the volume must agree with a finer mesh (96^3) within 1%.
+  const double cap = kPi * 0.05 * 0.05 * (3 * 0.4 - 0.05) / 3;  // overlap lens half
+  EXPECT_GT(c.volume, 2 * (4.0 / 3.0 * kPi * 0.064) - 2 * cap);
+  Checked fine = meshAndCheck(m, cubeGrid(1.0, 96));
+  EXPECT_NEAR(c.volume, fine.volume, 0.01 * fine.volume);
+  EXPECT_NEAR(c.area, fine.area, 0.01 * fine.area);
+  figures("blended union (96^3 as reference)", c, fine.volume, fine.area);
+  checkVerticesOnSurface(m, c.mesh, g.voxel);
+}
+
+TEST(Mesh, TwistedBlockKeepsItsVolume) {
+  // A twist about z preserves volume: the block's volume, 0.8 * 0.8 * 1.2.
+  Expr b = twistRate(blockAt(0, 0, 0, 0.4, 0.4, 0.6), Axis::Z, 1.2);
+  GridSpec g = cubeGrid(1.0, 64);
+  Checked c = meshAndCheck(b, g);
+  EXPECT_EQ(c.euler, 2);
+  EXPECT_EQ(c.components, 1);
+  EXPECT_NEAR(c.volume, 0.768, 0.01 * 0.768);
+  figures("twisted block 64^3 (area: none)", c, 0.768, c.area);
+  checkVerticesOnSurface(b, c.mesh, g.voxel);
+}
+
+TEST(Mesh, TwoBodies) {
+  Expr m = max(sphereAt(-0.5, 0, 0, 0.35), blockAt(0.5, 0.1, 0, 0.3, 0.3, 0.3));
+  GridSpec g = cubeGrid(1.0, 64);
+  Checked c = meshAndCheck(m, g);
+  EXPECT_EQ(c.components, 2);
+  EXPECT_EQ(c.euler, 4);
+  const double vol = 4.0 / 3.0 * kPi * 0.35 * 0.35 * 0.35 + 0.216;
+  EXPECT_NEAR(c.volume, vol, 0.01 * vol);
+  figures("two bodies 64^3 (area: none)", c, vol, c.area);
+}
+
+TEST(Mesh, SameMeshWhateverTheSplitAndOrder) {
+  Expr m = max(torusZ(0.55, 0.22), min(blockAt(0.1, 0.1, 0.1, 0.5, 0.3, 0.4), -sphereAt(0.4, 0.3, 0.4, 0.3)));
+  TapePtr tape = Tape::compile(m, 3);
+  GridSpec g = cubeGrid(1.0, 61);  // 61 points: regions end off the multiples of 8
+  Mesh whole = meshGrid(tape, g, {}, 0);
+  ASSERT_GT(whole.triangles.size(), 1000u);
+  EXPECT_EQ(mc::checkEdgePairs(whole.triangles, whole.positions.size()), "");
+  for (int brick : {8, 16, 24, 40}) {
+    SCOPED_TRACE("brick " + std::to_string(brick));
+    expectIdentical(whole, meshGrid(tape, g, {}, brick));
+  }
+  // Uneven splits (3 x 2 x 1 regions of different sizes) merged in shuffled orders.
+  std::vector<MeshPiece> pieces;
+  const int xs[] = {0, 16, 40, 61}, ys[] = {0, 24, 61};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 2; ++j) pieces.push_back(meshRegion(tape, g, {xs[i], ys[j], 0}, {xs[i + 1], ys[j + 1], 61}));
+  std::mt19937 rng(7);
+  for (int round = 0; round < 3; ++round) {
+    std::shuffle(pieces.begin(), pieces.end(), rng);
+    expectIdentical(whole, mergePieces(pieces));
+  }
+  // Serial and threaded runs agree.
+  MeshOptions serial;
+  serial.threads = 1;
+  expectIdentical(whole, meshGrid(tape, g, serial, 0));
+}
+
+TEST(Mesh, PiecesNeverRepeatATriangle) {
+  TapePtr tape = Tape::compile(sphereAt(0, 0, 0, 0.7), 3);
+  GridSpec g = cubeGrid(1.0, 48);
+  size_t total = 0;
+  for (int x = 0; x < 48; x += 16)
+    for (int y = 0; y < 48; y += 16)
+      for (int z = 0; z < 48; z += 16) total += meshRegion(tape, g, {x, y, z}, {x + 16, y + 16, z + 16}).triangles.size();
+  EXPECT_EQ(total, meshGrid(tape, g).triangles.size());
+}
+
+TEST(Mesh, RejectsBadRegions) {
+  TapePtr tape = Tape::compile(sphereAt(0, 0, 0, 0.7), 3);
+  GridSpec g = cubeGrid(1.0, 32);
+  EXPECT_THROW(meshRegion(tape, g, {4, 0, 0}, {16, 16, 16}), std::invalid_argument);
+  EXPECT_THROW(meshGrid(tape, g, {}, 12), std::invalid_argument);
+  MeshPiece empty = meshRegion(tape, g, {32, 0, 0}, {40, 8, 8});
+  EXPECT_TRUE(empty.triangles.empty());
+}
