@@ -2,10 +2,13 @@
 
 #include <cmath>
 
+#include "frep/ops.h"
+
 namespace frep::lang {
 
-Expr hfUnion(const Expr& a, const Expr& b) { return a + b + sqrt(square(a) + square(b)); }
-Expr hfIntersection(const Expr& a, const Expr& b) { return a + b - sqrt(square(a) + square(b)); }
+// HyperFun's | and & are the core's a = 0 R-functions (one implementation for both layers).
+Expr hfUnion(const Expr& a, const Expr& b) { return rUnion(a, b, 0.0); }
+Expr hfIntersection(const Expr& a, const Expr& b) { return rIntersection(a, b, 0.0); }
 Expr hfDifference(const Expr& a, const Expr& b) { return hfIntersection(a, -b); }
 
 Expr hfPower(const Expr& base, const Expr& exponent) {

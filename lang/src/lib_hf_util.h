@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "frep/expr.h"
+#include "frep/ops.h"
 #include "frep/lang/library.h"
 
 namespace frep::lang::hf {
@@ -71,8 +72,8 @@ inline Expr dot3(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + 
 inline Expr norm2(const Vec3& a) { return dot3(a, a); }
 
 // HyperFun's set operations with alpha = 0 (int_calc.c semantics, see docs/language.md).
-inline Expr rUnion0(const Expr& a, const Expr& b) { return a + b + sqrt(a * a + b * b); }
-inline Expr rInter0(const Expr& a, const Expr& b) { return a + b - sqrt(a * a + b * b); }
+inline Expr rUnion0(const Expr& a, const Expr& b) { return rUnion(a, b, 0.0); }
+inline Expr rInter0(const Expr& a, const Expr& b) { return rIntersection(a, b, 0.0); }
 
 constexpr double kPi = 3.14159265358979323846;
 
