@@ -129,7 +129,7 @@ int main(int argc, char** argv) {
   sampleCmd->add_option("--listen", sample.farm.listen,
                         "Cluster mode: bind here (e.g. tcp://*:5555), start no workers; they connect with "
                         "frep-worker --connect");
-  sampleCmd->add_option("--expect-workers", sample.farm.expectWorkers, "Cluster mode: workers expected (progress)");
+  sampleCmd->add_option("--expect-workers", sample.farm.expectWorkers, "Cluster mode: workers expected; dispatch waits up to 5 s after the first one joins for the rest");
   sampleCmd->add_option("--brick", sample.farm.brick, "Brick edge in voxels, a multiple of 8 (default 64)");
   sampleCmd->add_option("--heartbeat-ms", sample.farm.heartbeatMs, "Heartbeat interval both ways (default 500)");
   sampleCmd->add_flag("--resume", sample.farm.resume, "Continue a stopped job from OUT.journal");

@@ -502,6 +502,13 @@ class Master {
 
   void dispatch(zmq::socket_t& router, Clock::time_point now) {
     routerForCancel_ = &router;
+    // Cluster mode: give the expected workers a short grace period to join, so that the first
+    // bricks spread over the whole farm instead of queuing on the earliest worker.
+    if (opt_.expectWorkers > 0 && int(peers_.size()) < opt_.expectWorkers) {
+      if (peers_.empty()) return;
+      if (!firstJoin_) firstJoin_ = now;
+      if (now - *firstJoin_ < std::chrono::seconds(5)) return;
+    }
     // Peers in routing-id order: dispatch order never changes the output, only the schedule.
     std::vector<std::string> rids;
     for (auto& [rid, p] : peers_) rids.push_back(rid);
@@ -582,6 +589,7 @@ class Master {
   std::unique_ptr<Journal> journal_;
   std::unique_ptr<Progress> progress_;
   zmq::socket_t* routerForCancel_ = nullptr;
+  std::optional<Clock::time_point> firstJoin_;
   Clock::time_point start_;
 };
 

@@ -143,6 +143,8 @@ struct CellOutput {
 };
 
 struct RootWorker {
+  IntervalEvaluator interval;
+  std::vector<Interval> box;
   BatchEvaluator<double> batch;
   PointEvaluator point;
   GradientEvaluator grad;
@@ -211,16 +213,36 @@ class RegionMesher {
                             [](const CrossEdge& a, const CrossEdge& b) { return a.key == b.key; }),
                 edges.end());
 
-    // Vertices: roots along the edges, normals from the gradient.
+    // Vertices: roots along the edges, normals from the gradient. Each edge is solved with the
+    // tape pruned over the 8^3 block of its base point (a box that depends on the edge only,
+    // never on the region), in groups of edges sharing that block.
     piece.vertices.resize(edges.size());
+    std::vector<std::pair<uint64_t, uint32_t>> order(edges.size());  // (block of base, edge index)
+    for (size_t i = 0; i < edges.size(); ++i) {
+      auto e = edgeKeyParts(edges[i].key);
+      order[i] = {edgeKey(e[0] & ~7, e[1] & ~7, e[2] & ~7, 0), uint32_t(i)};
+    }
+    std::sort(order.begin(), order.end());
+    std::vector<size_t> groupStart;
+    for (size_t i = 0; i < order.size(); ++i)
+      if (i == 0 || order[i].first != order[i - 1].first) groupStart.push_back(i);
+    groupStart.push_back(order.size());
     tbb::enumerable_thread_specific<RootWorker> workers;
     constexpr size_t B = BatchEvaluator<double>::kBatch;
-    const size_t chunks = (edges.size() + B - 1) / B;
-    parallelChunks(chunks, 1, opt_.threads, [&](size_t b, size_t e) {
+    parallelChunks(groupStart.size() - 1, 1, opt_.threads, [&](size_t gb, size_t ge) {
       RootWorker& w = workers.local();
-      for (size_t c = b; c < e; ++c) {
-        size_t start = c * B, count = std::min(B, edges.size() - start);
-        solveRoots(w, edges.data() + start, piece.vertices.data() + start, count);
+      for (size_t g = gb; g < ge; ++g) {
+        TapePtr tape = blockTape(w, order[groupStart[g]].first);
+        for (size_t start = groupStart[g]; start < groupStart[g + 1]; start += B) {
+          size_t count = std::min(B, groupStart[g + 1] - start);
+          const CrossEdge* ep[B];
+          MeshVertex* vp[B];
+          for (size_t l = 0; l < count; ++l) {
+            ep[l] = &edges[order[start + l].second];
+            vp[l] = &piece.vertices[order[start + l].second];
+          }
+          solveRoots(w, *tape, ep, vp, count);
+        }
       }
     });
     for (RootWorker& w : workers) {
@@ -365,44 +387,66 @@ class RegionMesher {
   // Illinois false position on t in [0, 1] from the inside end (t = 0) to the outside end,
   // bisection when the end values contradict their signs. The same steps for every edge, so a
   // vertex depends on its edge only.
-  void solveRoots(RootWorker& w, const CrossEdge* edges, MeshVertex* verts, size_t count) {
+  // The root tape pruned by interval evaluation over the block [o, o + 8]^3 (world box).
+  TapePtr blockTape(RootWorker& w, uint64_t blockKey) {
+    if (tape_->numChoices() == 0) return tape_;
+    auto o = edgeKeyParts(blockKey);
+    w.box.resize(std::max<uint32_t>(nvars_, 1));
+    for (uint32_t v = 0; v < nvars_; ++v) {
+      if (v < 3) {
+        double lo = grid_.origin[v] + double(o[v]) * grid_.voxel;
+        double hi = grid_.origin[v] + double(o[v] + kLeafDim) * grid_.voxel;
+        w.box[v] = Interval(lo, hi);
+      } else {
+        w.box[v] = Interval(opt_.fixedCoords[v - 3]);
+      }
+    }
+    w.interval.eval(*tape_, w.box.data());
+    return w.interval.pruned(tape_);
+  }
+
+  void solveRoots(RootWorker& w, const Tape& tape, const CrossEdge* const* edgePtrs, MeshVertex* const* vertPtrs,
+                  size_t count) {
     constexpr size_t B = BatchEvaluator<double>::kBatch;
     double pin[B][3], dp[B][3];
     double a[B], b[B], fa[B], fb[B], ra[B], rb[B];
     int8_t last[B];
-    bool illinois[B];
+    bool illinois[B], done[B];
+    double prevT[B];
     for (size_t l = 0; l < count; ++l) {
-      auto parts = edgeKeyParts(edges[l].key);
+      const CrossEdge& edge = *edgePtrs[l];
+      auto parts = edgeKeyParts(edge.key);
       auto p0 = grid_.world(parts[0], parts[1], parts[2]);
       int d = int(parts[3]);
       auto p1 = grid_.world(parts[0] + (d & 1), parts[1] + ((d >> 1) & 1), parts[2] + ((d >> 2) & 1));
-      const auto& pi = edges[l].inAtBase ? p0 : p1;
-      const auto& po = edges[l].inAtBase ? p1 : p0;
+      const auto& pi = edge.inAtBase ? p0 : p1;
+      const auto& po = edge.inAtBase ? p1 : p0;
       for (int c = 0; c < 3; ++c) {
         pin[l][c] = pi[c];
         dp[l][c] = po[c] - pi[c];
       }
+      done[l] = false;
       a[l] = 0;
       b[l] = 1;
       last[l] = 0;
     }
-    const bool useBatch = !tape_->hasExtrema();  // batch extremum lanes warm-start each other
+    const bool useBatch = !tape.hasExtrema();  // batch extremum lanes warm-start each other
     std::vector<double> tv(count), fv(count);
     auto evalAt = [&]() {
       w.rootEvals += count;
       if (useBatch) {
-        w.batch.reserve(*tape_);
+        w.batch.reserve(tape);
         for (size_t l = 0; l < count; ++l)
           for (uint32_t v = 0; v < nvars_; ++v)
             w.batch.in(v)[l] = v < 3 ? pin[l][v] + tv[l] * dp[l][v] : opt_.fixedCoords[v - 3];
-        const double* f = w.batch.eval(*tape_, count);
+        const double* f = w.batch.eval(tape, count);
         std::copy(f, f + count, fv.begin());
       } else {
         w.x.resize(std::max<uint32_t>(nvars_, 3));
         for (size_t l = 0; l < count; ++l) {
           for (uint32_t v = 0; v < nvars_; ++v)
             w.x[v] = v < 3 ? pin[l][v] + tv[l] * dp[l][v] : opt_.fixedCoords[v - 3];
-          fv[l] = w.point.eval(*tape_, w.x.data());
+          fv[l] = w.point.eval(tape, w.x.data());
         }
       }
     };
@@ -417,6 +461,11 @@ class RegionMesher {
       if (!illinois[l]) ++w.fallbacks;
     }
     for (int it = 0; it < opt_.rootIterations; ++it) {
+      // A lane is done when its step moved t by less than 1e-10 of the edge: it depends on the
+      // lane alone, so stopping early keeps every vertex a function of its edge.
+      size_t active = 0;
+      for (size_t l = 0; l < count; ++l) active += !done[l];
+      if (active == 0) break;
       for (size_t l = 0; l < count; ++l) {
         double t = 0.5 * (a[l] + b[l]);
         if (illinois[l] && fa[l] != fb[l]) {
@@ -428,7 +477,13 @@ class RegionMesher {
       evalAt();
       for (size_t l = 0; l < count; ++l) {
         double t = tv[l], f = fv[l];
-        if (!(t > a[l] && t < b[l])) continue;  // converged to a point
+        if (done[l]) continue;
+        if (!(t > a[l] && t < b[l])) {  // converged to a point
+          done[l] = true;
+          continue;
+        }
+        if (it > 0 && std::abs(t - prevT[l]) < 1e-10) done[l] = true;
+        prevT[l] = t;
         if (std::isnan(f)) illinois[l] = false;
         if (insideValue(f)) {
           a[l] = t;
@@ -449,15 +504,15 @@ class RegionMesher {
       if (illinois[l] && std::isfinite(ra[l]) && std::isfinite(rb[l]) && ra[l] >= 0 && rb[l] < 0)
         t = a[l] + (b[l] - a[l]) * ra[l] / (ra[l] - rb[l]);
       t = std::min(std::max(t, guard), 1.0 - guard);
-      MeshVertex& v = verts[l];
-      v.key = edges[l].key;
+      MeshVertex& v = *vertPtrs[l];
+      v.key = edgePtrs[l]->key;
       for (int c = 0; c < 3; ++c) v.position[c] = pin[l][c] + t * dp[l][c];
       // Normal: -grad f, or the edge direction where the gradient is unusable.
       w.x.resize(std::max<uint32_t>(nvars_, 3));
       w.g.resize(std::max<uint32_t>(nvars_, 3));
       for (uint32_t c = 0; c < nvars_; ++c) w.x[c] = c < 3 ? v.position[c] : opt_.fixedCoords[c - 3];
       std::fill(w.g.begin(), w.g.end(), 0.0);
-      w.grad.eval(*tape_, w.x.data(), w.g.data());
+      w.grad.eval(tape, w.x.data(), w.g.data());
       ++w.gradientEvals;
       double n[3] = {-w.g[0], -w.g[1], -w.g[2]};
       double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
