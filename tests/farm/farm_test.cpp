@@ -260,3 +260,21 @@ TEST(Farm, JournalOfAnotherJobIsRefused) {
   EXPECT_THROW(runSampleJob(job(48), o), std::runtime_error);
   std::filesystem::remove(journal);
 }
+
+TEST(Farm, StragglerBrickIsIssuedOnceMoreToAnIdleWorker) {
+  JobSpec j = job(64);
+  FarmOutcome ref = runSampleJob(j, fast(0));
+  FarmOptions o = fast(0);
+  o.listen = "tcp://127.0.0.1:" + std::to_string(freePort());
+  MasterThread m(j, o);
+  // The slow worker joins first and takes the first bricks; the fast one finishes the rest,
+  // then gets a copy of the oldest brick still running (after max(1 s, 2 x median)).
+  WorkerProcess slow(o.listen, {"FREP_TEST_SLOW_MS=4000"});
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  WorkerProcess quick(o.listen);
+  m.join();
+  ASSERT_EQ(m.error, "");
+  expectSame(ref.result, m.outcome.result);
+  EXPECT_GE(m.outcome.report.stragglerReissues, 1u);
+  EXPECT_EQ(m.outcome.report.retries, 0u);  // nothing failed: the copies were backups
+}
