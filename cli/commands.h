@@ -65,6 +65,7 @@ struct MeshRequest {
   RegionRequest region;
   int brick = 64;   // region edge in voxels (a multiple of 8)
   int threads = 0;  // 0: all cores
+  bool sharp = false;  // --sharp: MeshOptions::sharpFeatures
 };
 int runMesh(const MeshRequest& request);
 

@@ -143,6 +143,7 @@ int main(int argc, char** argv) {
   addRegionOptions(meshCmd, mesh.region, "Output mesh: .ply (binary), .obj or .stl (binary)", 128);
   meshCmd->add_option("--brick", mesh.brick, "Region edge in voxels, a multiple of 8 (default 64; same output)");
   meshCmd->add_option("--threads", mesh.threads, "Threads (default 0: all cores; same output)");
+  meshCmd->add_flag("--sharp", mesh.sharp, "Experimental: QEF vertices on edges and corners (docs/mesh.md)");
 
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
@@ -156,7 +157,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample and keygen";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }

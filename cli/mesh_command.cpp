@@ -42,6 +42,7 @@ int runMesh(const MeshRequest& request) {
   TapePtr tape = Tape::compile(m.field, 3);
   MeshOptions options;
   options.threads = request.threads;
+  options.sharpFeatures = request.sharp;
   Mesh mesh = meshGrid(tape, grid, options, request.brick);
   const double meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::string comment = "frep mesh of '" + m.model.objectName + "', grid " + std::to_string(grid.dims[0]) + "x" +
@@ -59,6 +60,7 @@ int runMesh(const MeshRequest& request) {
             << formatNumber(grid.voxel) << ", cells examined " << s.cellsVisited << " ("
             << formatNumber(std::round(1e4 * double(s.cellsVisited) / dense) / 100) << "% of " << uint64_t(dense)
             << "), crossed " << s.cellsCrossed << "\n"
+            << (request.sharp ? "  feature vertices " + std::to_string(s.featureCells) + "\n" : std::string())
             << "  evaluations: grid points " << s.samplePointEvals << ", root finding " << s.rootEvals
             << ", gradients " << s.gradientEvals << "\n"
             << "  time " << formatNumber(std::round(meshSeconds * 1000) / 1000) << " s meshing, "

@@ -77,6 +77,7 @@ struct ExtremumSolver::Impl {
   // branch-and-bound storage: boxes as 2p doubles in a pool, heap of (upper, index)
   std::vector<double> pool;
   std::vector<std::pair<double, uint32_t>> heap;
+  std::vector<TapePtr> tapes;  // B&B: the body pruned to each box (interval choices of its parent)
   std::vector<double> gv;          // grid values
 
   Impl(const ExtremumSpec& spec, TapePtr b) : s(spec), body(std::move(b)) {
@@ -138,17 +139,17 @@ struct ExtremumSolver::Impl {
     u[m - 1] = r;
   }
 
-  double evalPoint(const double* X, const double* t) {
+  double evalPoint(const double* X, const double* t, const Tape* tape = nullptr) {
     for (uint32_t k = 0; k < n; ++k) x[k] = X[k];
     toU(t, x.data() + n);
-    return sign * pe.eval(*body, x.data());
+    return sign * pe.eval(tape ? *tape : *body, x.data());
   }
   // Interval of sign * g over (X box) x u(t box).
-  Interval evalBox(const Interval* X, const double* tlo, const double* thi) {
+  Interval evalBox(const Interval* X, const double* tlo, const double* thi, const Tape* tape = nullptr) {
     for (uint32_t k = 0; k < n; ++k) xi[k] = X[k];
     for (uint32_t k = 0; k < p; ++k) ti[k] = Interval(tlo[k], thi[k]);
     toU(ti.data(), xi.data() + n);
-    Interval v = ie.eval(*body, xi.data());
+    Interval v = ie.eval(tape ? *tape : *body, xi.data());
     if (std::isnan(v.lo) || std::isnan(v.hi)) return Interval::everything();
     return sign > 0 ? v : Interval(-v.hi, -v.lo);
   }
@@ -277,8 +278,8 @@ struct ExtremumSolver::Impl {
     for (uint32_t k = 0; k < n; ++k) Xi[k] = Interval(X[k]);
     std::vector<double> bestT(p), c(p);
     double bestV = -kInf;
-    auto tryPoint = [&](const double* t) {
-      const double v = evalPoint(X, t);
+    auto tryPoint = [&](const double* t, const Tape* tape = nullptr) {
+      const double v = evalPoint(X, t, tape);
       ++r.pointEvals;
       if (v > bestV) {
         bestV = v;
@@ -298,19 +299,24 @@ struct ExtremumSolver::Impl {
     auto cmp = [](const std::pair<double, uint32_t>& a, const std::pair<double, uint32_t>& b) {
       return a.first < b.first;
     };
-    auto push = [&](const double* lo, const double* hi, double ub) {
+    tapes.clear();
+    auto push = [&](const double* lo, const double* hi, double ub, TapePtr tape) {
       const uint32_t id = static_cast<uint32_t>(pool.size() / (2 * p));
       pool.insert(pool.end(), lo, lo + p);
       pool.insert(pool.end(), hi, hi + p);
+      tapes.push_back(std::move(tape));
       heap.emplace_back(ub, id);
       std::push_heap(heap.begin(), heap.end(), cmp);
     };
+    // Each box carries the body pruned by its own interval evaluation (min/max/select decided
+    // over the box), so deeper boxes walk shorter tapes; values are bit-identical inside.
+    const bool prune = body->numChoices() > 0;
     double prunedHi = -kInf;
     {
       Interval root = evalBox(Xi.data(), plo.data(), phi.data());
       ++r.intervalEvals;
       if (root.hi <= bestV + tol) prunedHi = root.hi;
-      else push(plo.data(), phi.data(), root.hi);
+      else push(plo.data(), phi.data(), root.hi, prune ? ie.pruned(body) : body);
     }
     std::vector<double> lo(p), hi(p), clo(p), chi(p);
     uint32_t splits = 0;
@@ -329,10 +335,21 @@ struct ExtremumSolver::Impl {
         certified = false;
         break;
       }
-      ++splits;
       const double* blo = &pool[size_t(top.second) * 2 * p];
       std::copy(blo, blo + p, lo.begin());
       std::copy(blo + p, blo + 2 * p, hi.begin());
+      // The incumbent improves at the centres of the most promising boxes, evaluated when the
+      // box comes off the heap (once per split rather than once per child).
+      const TapePtr boxTape = tapes[top.second];
+      if (top.second != 0) {
+        for (uint32_t k = 0; k < p; ++k) c[k] = 0.5 * (lo[k] + hi[k]);
+        tryPoint(c.data(), boxTape.get());
+        if (top.first <= bestV + tol) {
+          prunedHi = std::max(prunedHi, top.first);
+          continue;
+        }
+      }
+      ++splits;
       const uint32_t d = widestDim(lo.data(), hi.data());
       const double mid = 0.5 * (lo[d] + hi[d]);
       if (!(mid > lo[d] && mid < hi[d])) {  // cannot split further: keep its bound
@@ -345,19 +362,13 @@ struct ExtremumSolver::Impl {
         chi = hi;
         if (half == 0) chi[d] = mid;
         else clo[d] = mid;
-        Interval iv = evalBox(Xi.data(), clo.data(), chi.data());
+        Interval iv = evalBox(Xi.data(), clo.data(), chi.data(), boxTape.get());
         ++r.intervalEvals;
         if (iv.hi <= bestV + tol) {
           prunedHi = std::max(prunedHi, iv.hi);
           continue;
         }
-        for (uint32_t k = 0; k < p; ++k) c[k] = 0.5 * (clo[k] + chi[k]);
-        tryPoint(c.data());
-        if (iv.hi <= bestV + tol) {
-          prunedHi = std::max(prunedHi, iv.hi);
-          continue;
-        }
-        push(clo.data(), chi.data(), iv.hi);
+        push(clo.data(), chi.data(), iv.hi, prune && boxTape->numChoices() > 0 ? ie.pruned(boxTape) : boxTape);
       }
     }
     double hiAll = std::max({hiBound, prunedHi, bestV});

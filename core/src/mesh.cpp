@@ -21,6 +21,7 @@
 #include <unordered_map>
 
 #include "frep/eval.h"
+#include "mesh_features.h"
 
 namespace frep {
 
@@ -123,10 +124,40 @@ void parallelChunks(size_t n, size_t grain, int threads, Fn&& fn) {
   }
 }
 
-inline void canonicalRotate(std::array<EdgeKey, 3>& t) {
+inline void canonicalRotate(std::array<uint32_t, 3>& t) {
   if (t[1] < t[0] && t[1] < t[2]) t = {t[1], t[2], t[0]};
   else if (t[2] < t[0] && t[2] < t[1]) t = {t[2], t[0], t[1]};
 }
+
+// Edge key -> index, open addressing (keys are never ~0: the top bits of a key are unused).
+class KeyIndex {
+ public:
+  explicit KeyIndex(const std::vector<MeshVertex>& verts) {
+    size_t cap = 16;
+    while (cap < 2 * verts.size()) cap *= 2;
+    mask_ = cap - 1;
+    keys_.assign(cap, ~uint64_t(0));
+    vals_.resize(cap);
+    for (size_t i = 0; i < verts.size(); ++i) {
+      size_t h = slot(verts[i].key);
+      while (keys_[h] != ~uint64_t(0)) h = (h + 1) & mask_;
+      keys_[h] = verts[i].key;
+      vals_[h] = uint32_t(i);
+    }
+  }
+  uint32_t at(EdgeKey k) const {
+    for (size_t h = slot(k);; h = (h + 1) & mask_) {
+      if (keys_[h] == k) return vals_[h];
+      if (keys_[h] == ~uint64_t(0)) throw std::logic_error("mesh: a triangle's vertex is missing");
+    }
+  }
+
+ private:
+  size_t slot(uint64_t k) const { return size_t((k * 0x9E3779B97F4A7C15ull) >> 20) & mask_; }
+  size_t mask_ = 0;
+  std::vector<uint64_t> keys_;
+  std::vector<uint32_t> vals_;
+};
 
 struct CrossEdge {
   EdgeKey key;
@@ -196,16 +227,25 @@ class RegionMesher {
     tbb::enumerable_thread_specific<CellOutput> outs;
     parallelChunks(sampled_.leaves.size(), 1, opt_.threads, [&](size_t b, size_t e) {
       CellOutput& out = outs.local();
-      for (size_t i = b; i < e; ++i) leafCells(out, sampled_.leaves[i]);
+      for (size_t i = b; i < e; ++i) {
+        size_t first = out.edges.size();
+        leafCells(out, sampled_.leaves[i]);
+        // Most repeats of an edge come from the same leaf: drop them while they are few.
+        std::sort(out.edges.begin() + long(first), out.edges.end());
+        out.edges.erase(std::unique(out.edges.begin() + long(first), out.edges.end(),
+                                    [](const CrossEdge& x, const CrossEdge& y) { return x.key == y.key; }),
+                        out.edges.end());
+      }
     });
     std::vector<CrossEdge> edges;
+    std::vector<std::array<EdgeKey, 3>> keyTris;
     std::vector<std::array<EdgeKey, 4>> quads;
     for (CellOutput& o : outs) {
       piece.stats.cellsVisited += o.cellsVisited;
       piece.stats.cellsCrossed += o.cellsCrossed;
       piece.stats.samplePointEvals += o.directEvals;
       edges.insert(edges.end(), o.edges.begin(), o.edges.end());
-      piece.triangles.insert(piece.triangles.end(), o.tris.begin(), o.tris.end());
+      keyTris.insert(keyTris.end(), o.tris.begin(), o.tris.end());
       quads.insert(quads.end(), o.quads.begin(), o.quads.end());
     }
     std::sort(edges.begin(), edges.end());
@@ -251,29 +291,35 @@ class RegionMesher {
       piece.stats.fallbackEdges += w.fallbacks;
     }
 
+    // Triangles as local indices (vertices are sorted by key, so index order is key order).
     // Quads: split along the shorter diagonal (ties: 0-2), a choice made from the quad alone.
-    auto position = [&](EdgeKey k) -> const std::array<double, 3>& {
-      auto it = std::lower_bound(piece.vertices.begin(), piece.vertices.end(), k,
-                                 [](const MeshVertex& v, EdgeKey key) { return v.key < key; });
-      return it->position;
-    };
-    auto dist2 = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    KeyIndex index(piece.vertices);
+    std::vector<std::array<uint32_t, 3>> tris;
+    tris.reserve(keyTris.size() + 2 * quads.size());
+    for (const auto& t : keyTris) tris.push_back({index.at(t[0]), index.at(t[1]), index.at(t[2])});
+    auto dist2 = [&](uint32_t i, uint32_t j) {
+      const auto &a = piece.vertices[i].position, &b = piece.vertices[j].position;
       double s = 0;
-      for (int i = 0; i < 3; ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
+      for (int c = 0; c < 3; ++c) s += (a[c] - b[c]) * (a[c] - b[c]);
       return s;
     };
     for (const auto& q : quads) {
-      double d02 = dist2(position(q[0]), position(q[2])), d13 = dist2(position(q[1]), position(q[3]));
-      if (d02 <= d13) {
-        piece.triangles.push_back({q[0], q[1], q[2]});
-        piece.triangles.push_back({q[0], q[2], q[3]});
+      uint32_t v[4] = {index.at(q[0]), index.at(q[1]), index.at(q[2]), index.at(q[3])};
+      if (dist2(v[0], v[2]) <= dist2(v[1], v[3])) {
+        tris.push_back({v[0], v[1], v[2]});
+        tris.push_back({v[0], v[2], v[3]});
       } else {
-        piece.triangles.push_back({q[1], q[2], q[3]});
-        piece.triangles.push_back({q[1], q[3], q[0]});
+        tris.push_back({v[1], v[2], v[3]});
+        tris.push_back({v[1], v[3], v[0]});
       }
     }
-    for (auto& t : piece.triangles) canonicalRotate(t);
-    std::sort(piece.triangles.begin(), piece.triangles.end());
+    if (opt_.sharpFeatures) {
+      FeatureContext fc{grid_, *tape_, opt_.fixedCoords, opt_.featureCos};
+      piece.stats.featureCells += placeFeatureVertices(fc, piece.vertices, tris);
+    }
+    for (auto& t : tris) canonicalRotate(t);
+    std::sort(tris.begin(), tris.end());
+    piece.triangles = std::move(tris);
     return piece;
   }
 
@@ -432,18 +478,26 @@ class RegionMesher {
     }
     const bool useBatch = !tape.hasExtrema();  // batch extremum lanes warm-start each other
     std::vector<double> tv(count), fv(count);
+    // Evaluates f at tv for the lanes not done, packed together (a lane's value never depends on
+    // the other lanes: batches of extremum tapes are avoided, their lanes warm-start each other).
     auto evalAt = [&]() {
-      w.rootEvals += count;
+      size_t idx[B], k = 0;
+      for (size_t l = 0; l < count; ++l)
+        if (!done[l]) idx[k++] = l;
+      w.rootEvals += k;
       if (useBatch) {
         w.batch.reserve(tape);
-        for (size_t l = 0; l < count; ++l)
+        for (size_t j = 0; j < k; ++j) {
+          size_t l = idx[j];
           for (uint32_t v = 0; v < nvars_; ++v)
-            w.batch.in(v)[l] = v < 3 ? pin[l][v] + tv[l] * dp[l][v] : opt_.fixedCoords[v - 3];
-        const double* f = w.batch.eval(tape, count);
-        std::copy(f, f + count, fv.begin());
+            w.batch.in(v)[j] = v < 3 ? pin[l][v] + tv[l] * dp[l][v] : opt_.fixedCoords[v - 3];
+        }
+        const double* f = w.batch.eval(tape, k);
+        for (size_t j = 0; j < k; ++j) fv[idx[j]] = f[j];
       } else {
         w.x.resize(std::max<uint32_t>(nvars_, 3));
-        for (size_t l = 0; l < count; ++l) {
+        for (size_t j = 0; j < k; ++j) {
+          size_t l = idx[j];
           for (uint32_t v = 0; v < nvars_; ++v)
             w.x[v] = v < 3 ? pin[l][v] + tv[l] * dp[l][v] : opt_.fixedCoords[v - 3];
           fv[l] = w.point.eval(tape, w.x.data());
@@ -543,12 +597,12 @@ MeshPiece meshRegion(const TapePtr& tape, const GridSpec& grid, const std::array
 }
 
 Mesh mergePieces(const std::vector<MeshPiece>& pieces) {
-  std::vector<MeshVertex> verts;
-  std::vector<std::array<EdgeKey, 3>> tris;
   Mesh mesh;
+  std::vector<MeshVertex> verts;
+  size_t ntris = 0;
   for (const MeshPiece& p : pieces) {
     verts.insert(verts.end(), p.vertices.begin(), p.vertices.end());
-    tris.insert(tris.end(), p.triangles.begin(), p.triangles.end());
+    ntris += p.triangles.size();
     MeshStats& s = mesh.stats;
     s.cellsVisited += p.stats.cellsVisited;
     s.cellsCrossed += p.stats.cellsCrossed;
@@ -556,6 +610,7 @@ Mesh mergePieces(const std::vector<MeshPiece>& pieces) {
     s.gradientEvals += p.stats.gradientEvals;
     s.samplePointEvals += p.stats.samplePointEvals;
     s.fallbackEdges += p.stats.fallbackEdges;
+    s.featureCells += p.stats.featureCells;
   }
   // Shared vertices are computed identically by each piece; should they ever differ, the
   // smallest record wins, so the result still does not depend on the order of the pieces.
@@ -567,9 +622,6 @@ Mesh mergePieces(const std::vector<MeshPiece>& pieces) {
   verts.erase(std::unique(verts.begin(), verts.end(),
                           [](const MeshVertex& a, const MeshVertex& b) { return a.key == b.key; }),
               verts.end());
-  for (auto& t : tris) canonicalRotate(t);
-  std::sort(tris.begin(), tris.end());
-  tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
   mesh.positions.reserve(verts.size());
   mesh.normals.reserve(verts.size());
   mesh.keys.reserve(verts.size());
@@ -578,16 +630,42 @@ Mesh mergePieces(const std::vector<MeshPiece>& pieces) {
     mesh.normals.push_back(v.normal);
     mesh.keys.push_back(v.key);
   }
-  mesh.triangles.reserve(tris.size());
-  for (const auto& t : tris) {
-    std::array<uint32_t, 3> idx;
-    for (int c = 0; c < 3; ++c) {
-      auto it = std::lower_bound(mesh.keys.begin(), mesh.keys.end(), t[c]);
-      if (it == mesh.keys.end() || *it != t[c]) throw std::logic_error("mergePieces: a triangle's vertex is missing");
-      idx[c] = uint32_t(it - mesh.keys.begin());
+  // Local -> global indices by walking each piece's sorted keys along the global ones. Global
+  // indices are in key order, so sorting index triples sorts by key triples.
+  std::vector<std::array<uint32_t, 3>> tris;
+  tris.reserve(ntris);
+  std::vector<uint32_t> remap;
+  std::vector<size_t> runs{0};  // each piece's triangles stay sorted under the monotone remap
+  for (const MeshPiece& p : pieces) {
+    remap.resize(p.vertices.size());
+    size_t g = 0;
+    for (size_t i = 0; i < p.vertices.size(); ++i) {
+      EdgeKey k = p.vertices[i].key;
+      if (i > 0 && k <= p.vertices[i - 1].key) throw std::invalid_argument("mergePieces: piece vertices not sorted by key");
+      while (mesh.keys[g] < k) ++g;
+      remap[i] = uint32_t(g);
     }
-    mesh.triangles.push_back(idx);
+    for (const auto& t : p.triangles) {
+      std::array<uint32_t, 3> r{remap.at(t[0]), remap.at(t[1]), remap.at(t[2])};
+      canonicalRotate(r);
+      tris.push_back(r);
+    }
+    if (!std::is_sorted(tris.begin() + long(runs.back()), tris.end()))
+      std::sort(tris.begin() + long(runs.back()), tris.end());
+    runs.push_back(tris.size());
   }
+  while (runs.size() > 2) {  // merge sorted runs pairwise
+    std::vector<size_t> next{0};
+    for (size_t i = 0; i + 1 < runs.size(); i += 2) {
+      size_t end = i + 2 < runs.size() ? runs[i + 2] : runs[i + 1];
+      if (i + 2 < runs.size())
+        std::inplace_merge(tris.begin() + long(runs[i]), tris.begin() + long(runs[i + 1]), tris.begin() + long(end));
+      next.push_back(end);
+    }
+    runs = std::move(next);
+  }
+  tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
+  mesh.triangles = std::move(tris);
   return mesh;
 }
 

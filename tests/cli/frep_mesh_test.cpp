@@ -138,6 +138,7 @@ TEST_F(FrepTest, MeshWritesPlyObjStlThatReadBackWatertight) {
   EXPECT_TRUE(contains(r.out, " s meshing")) << r.out;
   EXPECT_EQ(mc::checkEdgePairs(ply.triangles, ply.positions.size()), "");
   EXPECT_EQ(mc::eulerCharacteristic(ply.triangles, ply.positions.size()), 2);
+  EXPECT_EQ(mc::selfIntersections(ply.positions, ply.triangles), 0u);  // after rounding to float
   const double volume = 4.0 / 3.0 * kPi;
   EXPECT_NEAR(mc::enclosedVolume(ply.positions, ply.triangles), volume, 0.01 * volume);
   EXPECT_NEAR(mc::surfaceArea(ply.positions, ply.triangles), 4 * kPi, 0.01 * 4 * kPi);
@@ -181,6 +182,22 @@ TEST_F(FrepTest, MeshBytesDoNotDependOnBrickOrThreads) {
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(readText(path("b.ply")) == ref) << opts;
   }
+}
+
+TEST_F(FrepTest, MeshSharpFeaturesStayWatertightAndSplitInvariant) {
+  write("b.hf",
+        "my_model(x[3], a[1]) {\n  array c[3];\n  c = [-0.61, -0.52, -0.43];\n"
+        "  my_model = hfBlock(x, c, 1.2, 1.0, 0.8);\n}\n");
+  RunResult r = run("mesh b.hf -b 1 --res 40 --sharp -O s.ply");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "feature vertices ")) << r.out;
+  ReadMesh m = readPly(readText(path("s.ply")));
+  EXPECT_EQ(mc::checkEdgePairs(m.triangles, m.positions.size()), "");
+  EXPECT_EQ(mc::eulerCharacteristic(m.triangles, m.positions.size()), 2);
+  EXPECT_EQ(mc::selfIntersections(m.positions, m.triangles), 0u);
+  EXPECT_NEAR(mc::enclosedVolume(m.positions, m.triangles), 0.96, 0.005 * 0.96);
+  ASSERT_EQ(run("mesh b.hf -b 1 --res 40 --sharp --brick 8 -O t.ply").code, 0);
+  EXPECT_TRUE(readText(path("s.ply")) == readText(path("t.ply")));
 }
 
 TEST_F(FrepTest, MeshRejectsBadArguments) {

@@ -11,6 +11,7 @@
 
 #include "core/mesh_checks.h"
 #include "frep/eval.h"
+#include "frep/extremum.h"
 #include "frep/mesh.h"
 #include "frep/ops.h"
 
@@ -46,10 +47,10 @@ struct Checked {
   double volume = 0, area = 0, minArea = 0;
 };
 
-Checked meshAndCheck(const Expr& model, const GridSpec& g, int brick = 0) {
+Checked meshAndCheck(const Expr& model, const GridSpec& g, int brick = 0, const MeshOptions& opt = {}) {
   Checked c;
   TapePtr tape = Tape::compile(model, 3);
-  c.mesh = meshGrid(tape, g, {}, brick);
+  c.mesh = meshGrid(tape, g, opt, brick);
   const Mesh& m = c.mesh;
   EXPECT_GT(m.triangles.size(), 0u);
   EXPECT_EQ(mc::checkEdgePairs(m.triangles, m.positions.size()), "");
@@ -58,9 +59,11 @@ Checked meshAndCheck(const Expr& model, const GridSpec& g, int brick = 0) {
   c.volume = mc::enclosedVolume(m.positions, m.triangles);
   c.area = mc::surfaceArea(m.positions, m.triangles);
   c.minArea = mc::minTriangleArea(m.positions, m.triangles);
-  // No degenerate triangles: far above rounding noise (voxel^2 * 1e-9).
-  EXPECT_GT(c.minArea, 1e-9 * g.voxel * g.voxel);
+  // No degenerate triangles: vertices stay endGuard (1e-3) of an edge away from grid points,
+  // which bounds every triangle's area below by 0.4 * endGuard^2 voxel^2 (docs/mesh.md).
+  EXPECT_GT(c.minArea, 0.3 * 1e-6 * g.voxel * g.voxel);
   // Every vertex used by some triangle.
+  EXPECT_EQ(mc::selfIntersections(m.positions, m.triangles), 0u);
   std::vector<char> used(m.positions.size(), 0);
   for (const auto& t : m.triangles)
     for (uint32_t v : t) used[v] = 1;
@@ -76,7 +79,9 @@ void figures(const char* name, const Checked& c, double volume, double area) {
 }
 
 // Newton projection onto {f = 0}: every vertex converges to |f| < 1e-10 within half a voxel.
-void checkVerticesOnSurface(const Expr& model, const Mesh& m, double voxel) {
+// (Feature vertices sit on creases, where Newton's steps alternate between the two branches of
+// a min/max and settle more slowly: callers pass a looser fTol for them.)
+void checkVerticesOnSurface(const Expr& model, const Mesh& m, double voxel, double fTol = 1e-10) {
   TapePtr tape = Tape::compile(model, 3);
   GradientEvaluator ge;
   double worstMove = 0, worstStart = 0;
@@ -90,11 +95,37 @@ void checkVerticesOnSurface(const Expr& model, const Mesh& m, double voxel) {
       for (int c = 0; c < 3; ++c) x[c] -= f * g[c] / gg;
       f = ge.eval(*tape, x.data(), g.data());
     }
-    EXPECT_LT(std::abs(f), 1e-10) << "vertex " << i;
+    EXPECT_LT(std::abs(f), fTol) << "vertex " << i;
     worstMove = std::max(worstMove, mc::norm(mc::sub(x, m.positions[i])));
     worstStart = std::max(worstStart, std::abs(f0));
   }
   EXPECT_LT(worstMove, 0.5 * voxel);
+}
+
+// A certificate that works on creases too: within 0.49 voxel of the vertex (itself, +-normal,
+// or one of 26 grid directions) there is a point with f >= 0 and one with f < 0, so the segment
+// between them, inside that ball, crosses the surface: the vertex is within half a voxel of it.
+void checkVerticesNearSurface(const Expr& model, const Mesh& m, double voxel) {
+  TapePtr tape = Tape::compile(model, 3);
+  PointEvaluator pe;
+  size_t bad = 0;
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    bool in = false, out = false;
+    auto probe = [&](double dx, double dy, double dz) {
+      double len = std::sqrt(dx * dx + dy * dy + dz * dz);
+      double s = len > 0 ? 0.49 * voxel / len : 0;
+      std::array<double, 3> p{m.positions[i][0] + s * dx, m.positions[i][1] + s * dy, m.positions[i][2] + s * dz};
+      double f = pe.eval(*tape, p.data());
+      (f >= 0 ? in : out) = true;
+    };
+    probe(0, 0, 0);
+    probe(m.normals[i][0], m.normals[i][1], m.normals[i][2]);
+    probe(-m.normals[i][0], -m.normals[i][1], -m.normals[i][2]);
+    for (int d = 0; d < 27 && !(in && out); ++d)
+      if (d != 13) probe(d / 9 - 1, (d / 3) % 3 - 1, d % 3 - 1);
+    bad += !(in && out);
+  }
+  EXPECT_EQ(bad, 0u);
 }
 
 void checkNormals(const Mesh& m, const std::function<mc::Vec3(const mc::Vec3&)>& outward) {
@@ -287,4 +318,187 @@ TEST(Mesh, RejectsBadRegions) {
   EXPECT_THROW(meshGrid(tape, g, {}, 12), std::invalid_argument);
   MeshPiece empty = meshRegion(tape, g, {32, 0, 0}, {40, 8, 8});
   EXPECT_TRUE(empty.triangles.empty());
+}
+
+TEST(Mesh, ExtremumModelIsSplitInvariant) {
+  // Offset of a block by a ball of radius 0.2 (max over u in the ball of block(X - u)):
+  // evaluated by branch and bound, which the root finder runs lane by lane.
+  Expr body = remap(blockAt(0, 0, 0, 0.3, 0.3, 0.3), {Expr::x(0) - Expr::x(3), Expr::x(1) - Expr::x(4), Expr::x(2) - Expr::x(5)});
+  ExtremumSpec spec;
+  spec.body = body;
+  spec.inputs = {X(), Y(), Z()};
+  spec.hidden = 3;
+  spec.domain = DomainKind::Ball;
+  spec.radius = 0.2;
+  spec.tolerance = 1e-3;
+  Expr m = extremum(spec);
+  TapePtr tape = Tape::compile(m, 3);
+  GridSpec g = cubeGrid(0.8, 15);
+  Mesh whole = meshGrid(tape, g, {}, 0);
+  ASSERT_GT(whole.triangles.size(), 100u);
+  EXPECT_EQ(mc::checkEdgePairs(whole.triangles, whole.positions.size()), "");
+  EXPECT_EQ(mc::eulerCharacteristic(whole.triangles, whole.positions.size()), 2);
+  expectIdentical(whole, meshGrid(tape, g, {}, 8));
+  // Volume of the rounded block: cube + 6 slabs + 12 quarter cylinders + 8 ball eighths.
+  const double a = 0.6, r = 0.2;
+  const double vol = a * a * a + 6 * a * a * r + 3 * kPi * r * r * a + 4.0 / 3.0 * kPi * r * r * r;
+  EXPECT_NEAR(mc::enclosedVolume(whole.positions, whole.triangles), vol, 0.03 * vol);
+}
+
+TEST(Mesh, SelfIntersectionCheckFindsCrossings) {
+  // Two triangles crossing each other, one touching another at an interior point, a folded
+  // pair sharing an edge, and a clean pair sharing a vertex.
+  std::vector<mc::Vec3> p = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {0.5, 0.5, -1}, {0.5, 0.5, 1}, {3, 3, 0}};
+  EXPECT_EQ(mc::selfIntersections(p, {{0, 1, 2}, {3, 4, 5}}), 1u);
+  std::vector<mc::Vec3> touch = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {0.5, 0.5, 0}, {0.5, 0.5, 1}, {1.5, 1.5, 1}};
+  EXPECT_EQ(mc::selfIntersections(touch, {{0, 1, 2}, {3, 4, 5}}), 1u);
+  std::vector<mc::Vec3> fold = {{0, 0, 0}, {2, 0, 0}, {1, 1, 0}, {1, 2, 0}};
+  EXPECT_EQ(mc::selfIntersections(fold, {{0, 1, 2}, {1, 0, 3}}), 1u);
+  std::vector<mc::Vec3> flat = {{0, 0, 0}, {2, 0, 0}, {1, 1, 0}, {1, -1, 0}};
+  EXPECT_EQ(mc::selfIntersections(flat, {{0, 1, 2}, {1, 0, 3}}), 0u);
+  std::vector<mc::Vec3> corner = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0.5}, {0, -1, 0.5}};
+  EXPECT_EQ(mc::selfIntersections(corner, {{0, 1, 2}, {0, 3, 4}}), 0u);
+  std::vector<mc::Vec3> overlapCorner = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0.2, 1, 0}};
+  EXPECT_EQ(mc::selfIntersections(overlapCorner, {{0, 1, 2}, {0, 3, 4}}), 1u);
+}
+
+TEST(Mesh, SelfIntersectionCheckFindsAPulledVertex) {
+  // A sphere's vertex pulled through the far side: its fan crosses the surface.
+  TapePtr tape = Tape::compile(sphereAt(0, 0, 0, 0.7), 3);
+  Mesh m = meshGrid(tape, cubeGrid(1.0, 24));
+  ASSERT_EQ(mc::selfIntersections(m.positions, m.triangles), 0u);
+  for (int c = 0; c < 3; ++c) m.positions[0][c] *= -1.3;
+  EXPECT_GT(mc::selfIntersections(m.positions, m.triangles), 0u);
+}
+
+TEST(Mesh, SphereAndTorusAt128) {
+  // The resolution: tighter tolerances (0.1%).
+  GridSpec g = cubeGrid(1.0, 128);
+  Checked s = meshAndCheck(sphereAt(0.03, 0.02, -0.01, 0.8), g);
+  const double vs = 4.0 / 3.0 * kPi * 0.512, as = 4 * kPi * 0.64;
+  EXPECT_EQ(s.euler, 2);
+  EXPECT_NEAR(s.volume, vs, 0.001 * vs);
+  EXPECT_NEAR(s.area, as, 0.001 * as);
+  figures("sphere 128^3", s, vs, as);
+  Checked t = meshAndCheck(torusZ(0.6, 0.25), g);
+  const double vt = 2 * kPi * kPi * 0.6 * 0.0625, at = 4 * kPi * kPi * 0.6 * 0.25;
+  EXPECT_EQ(t.euler, 0);
+  EXPECT_NEAR(t.volume, vt, 0.001 * vt);
+  EXPECT_NEAR(t.area, at, 0.001 * at);
+  figures("torus 128^3", t, vt, at);
+}
+
+TEST(Mesh, RandomCsgModelsAreClosedEmbeddedAndSplitInvariant) {
+  // Random unions, intersections and differences of balls, blocks and tori on grids with odd
+  // sizes and offsets (surfaces through grid points included: dyadic radii and centres).
+  std::mt19937 rng(20261126);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  auto dyadic = [&](double v) { return std::round(v * 16) / 16; };
+  auto primitive = [&](int kind) -> Expr {
+    double cx = u(rng), cy = u(rng), cz = u(rng);
+    if (rng() % 2) cx = dyadic(cx), cy = dyadic(cy), cz = dyadic(cz);
+    switch (kind % 3) {
+      case 0: return sphereAt(cx, cy, cz, 0.2 + 0.3 * std::abs(u(rng)));
+      case 1: return blockAt(cx, cy, cz, 0.15 + 0.3 * std::abs(u(rng)), 0.15 + 0.3 * std::abs(u(rng)), 0.15 + 0.3 * std::abs(u(rng)));
+      default: return remap(torusZ(0.3, 0.1), {X() - cx, Z() - cy, Y() - cz});
+    }
+  };
+  int meshed = 0;
+  for (int round = 0; round < 24; ++round) {
+    SCOPED_TRACE("round " + std::to_string(round));
+    Expr m = primitive(int(rng()));
+    for (int k = 0; k < 3; ++k) {
+      Expr p = primitive(int(rng()));
+      unsigned op = rng() % 10;
+      if (op < 5) m = max(m, p);        // union
+      else if (op < 7) m = min(m, p);   // intersection
+      else m = min(m, -p);              // difference
+    }
+    TapePtr tape = Tape::compile(m, 3);
+    const int res = 25 + int(rng() % 20);
+    GridSpec g = GridSpec::fromBounds({-1 - 0.01 * u(rng), -1, -1}, {1, 1 + 0.01 * u(rng), 1}, res);
+    Mesh whole = meshGrid(tape, g);
+    if (whole.triangles.empty()) continue;
+    ++meshed;
+    EXPECT_EQ(mc::checkEdgePairs(whole.triangles, whole.positions.size()), "");
+    EXPECT_EQ(mc::selfIntersections(whole.positions, whole.triangles), 0u);
+    EXPECT_GT(mc::enclosedVolume(whole.positions, whole.triangles), 0.0);
+    EXPECT_EQ(mc::eulerCharacteristic(whole.triangles, whole.positions.size()) % 2, 0);
+    expectIdentical(whole, meshGrid(tape, g, {}, 8 * int(1 + rng() % 3)));
+    MeshOptions sharp;
+    sharp.sharpFeatures = true;
+    Mesh featured = meshGrid(tape, g, sharp);
+    EXPECT_EQ(mc::checkEdgePairs(featured.triangles, featured.positions.size()), "");
+    EXPECT_EQ(mc::selfIntersections(featured.positions, featured.triangles), 0u);
+    EXPECT_EQ(mc::eulerCharacteristic(featured.triangles, featured.positions.size()),
+              mc::eulerCharacteristic(whole.triangles, whole.positions.size()));
+    expectIdentical(featured, meshGrid(tape, g, sharp, 8 * int(1 + rng() % 3)));
+    checkVerticesNearSurface(m, featured, g.voxel);
+  }
+  EXPECT_GE(meshed, 15);
+}
+
+// ---- Sharp features (experimental, MeshOptions::sharpFeatures) -------------------------------
+
+TEST(MeshFeatures, BlockCornersAreExactAndTheMeshStaysClosedAndEmbedded) {
+  MeshOptions sharp;
+  sharp.sharpFeatures = true;
+  GridSpec g = cubeGrid(1.0, 64);
+  const double hx = 0.6, hy = 0.5, hz = 0.4, cx = 0.01, cy = -0.02, cz = 0.015;
+  Expr b = blockAt(cx, cy, cz, hx, hy, hz);
+  Checked plain = meshAndCheck(b, g);
+  Checked c = meshAndCheck(b, g, 0, sharp);  // closed, oriented, embedded, no degenerate triangle
+  EXPECT_GT(c.mesh.stats.featureCells, 0u);
+  EXPECT_EQ(c.euler, 2);
+  const double vol = 8 * hx * hy * hz, area = 8 * (hx * hy + hx * hz + hy * hz);
+  figures("block 64^3, sharp features", c, vol, area);
+  EXPECT_LT(std::abs(c.volume - vol), std::abs(plain.volume - vol));
+  EXPECT_LT(std::abs(c.area - area), std::abs(plain.area - area));
+  // Corners become vertices (to 1e-9) where the fan around the QEF point is valid: here 5 of
+  // the 8; the other 3 lie close to a cell face, where the cell's boundary loop is not
+  // star-shaped from the corner (edge flips across cells would fix that: not done yet).
+  int exact = 0;
+  for (int k = 0; k < 8; ++k) {
+    mc::Vec3 corner{cx + (k & 1 ? hx : -hx), cy + (k & 2 ? hy : -hy), cz + (k & 4 ? hz : -hz)};
+    double best = INFINITY;
+    for (const auto& p : c.mesh.positions) best = std::min(best, mc::norm(mc::sub(p, corner)));
+    exact += best < 1e-9;
+    EXPECT_LT(best, g.voxel) << "corner " << k;
+  }
+  EXPECT_GE(exact, 5);
+  checkVerticesOnSurface(b, c.mesh, g.voxel, 1e-8);
+  checkVerticesNearSurface(b, c.mesh, g.voxel);
+}
+
+TEST(MeshFeatures, SmoothModelsAreUnchanged) {
+  MeshOptions sharp;
+  sharp.sharpFeatures = true;
+  TapePtr tape = Tape::compile(sphereAt(0.03, 0.02, -0.01, 0.8), 3);
+  GridSpec g = cubeGrid(1.0, 64);
+  Mesh m = meshGrid(tape, g, sharp);
+  EXPECT_EQ(m.stats.featureCells, 0u);
+  expectIdentical(meshGrid(tape, g), m);
+}
+
+TEST(MeshFeatures, ClosedEmbeddedAndSplitInvariantOnCsg) {
+  MeshOptions sharp;
+  sharp.sharpFeatures = true;
+  GridSpec g = cubeGrid(1.0, 61);
+  const Expr models[] = {
+      min(blockAt(0, 0, 0, 0.6, 0.6, 0.6), -sphereAt(0.6, 0.6, 0.6, 0.45)),
+      twistRate(blockAt(0, 0, 0, 0.4, 0.4, 0.6), Axis::Z, 1.2),
+      max(sphereAt(-0.5, 0, 0, 0.35), blockAt(0.5, 0.1, 0, 0.3, 0.3, 0.3)),
+      max(torusZ(0.55, 0.22), min(blockAt(0.1, 0.1, 0.1, 0.5, 0.3, 0.4), -sphereAt(0.4, 0.3, 0.4, 0.3))),
+  };
+  const long euler[] = {2, 2, 4, 0};
+  for (int i = 0; i < 4; ++i) {
+    SCOPED_TRACE("model " + std::to_string(i));
+    Checked c = meshAndCheck(models[i], g, 0, sharp);
+    EXPECT_GT(c.mesh.stats.featureCells, 0u);
+    EXPECT_EQ(c.euler, euler[i]);
+    TapePtr tape = Tape::compile(models[i], 3);
+    expectIdentical(c.mesh, meshGrid(tape, g, sharp, 16));
+    expectIdentical(c.mesh, meshGrid(tape, g, sharp, 24));
+    checkVerticesNearSurface(models[i], c.mesh, g.voxel);
+  }
 }
