@@ -95,6 +95,25 @@ FREP_CLONES void runTape(const Instr* code, size_t ninstr, T* __restrict regs, s
       case Op::And: LOOP((a[i] != T(0)) & (b[i] != T(0)) ? T(1) : T(0));
       case Op::Or: LOOP((a[i] != T(0)) | (b[i] != T(0)) ? T(1) : T(0));
       case Op::Select: LOOP(a[i] != T(0) ? b[i] : c[i]);
+      case Op::RAnd: case Op::ROr: {
+        // rFunctionValue, lane by lane (same association, so the same bits as the point
+        // evaluator in double)
+        const T al = T(ins.imm), sg = ins.op == Op::ROr ? T(1) : T(-1);
+        if (ins.imm == 0.0) {
+          for (size_t i = 0; i < n; ++i) {
+            T s = a[i] * a[i] + b[i] * b[i];
+            T root = s > T(0) ? std::sqrt(s) : T(0);
+            o[i] = a[i] + b[i] + sg * root;
+          }
+        } else {
+          for (size_t i = 0; i < n; ++i) {
+            T s = a[i] * a[i] + b[i] * b[i] - T(2) * al * a[i] * b[i];
+            T root = s > T(0) ? std::sqrt(s) : T(0);
+            o[i] = (a[i] + b[i] + sg * root) / (T(1) + al);
+          }
+        }
+        break;
+      }
       default: break;
     }
 #undef LOOP

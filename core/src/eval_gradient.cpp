@@ -48,6 +48,11 @@ Partials partials(Op op, double a, double b, double value, double imm) {
       return {b / r2, -a / r2};
     }
     case Op::Fmod: return {1.0, -std::trunc(a / b)};
+    case Op::RAnd: case Op::ROr: {
+      Partials p{};
+      rFunctionPartials(op == Op::ROr, a, b, imm, p.da, p.db);
+      return p;
+    }
     default: return {};  // floor/ceil/trunc/comparisons/logic: piecewise constant
   }
 }

@@ -29,7 +29,7 @@ const OpInfo kOps[] = {
     {"copy", 1},  {"add", 2},    {"sub", 2},   {"mul", 2},   {"div", 2},    {"pow", 2},
     {"atan2", 2}, {"min", 2},    {"max", 2},   {"fmod", 2},  {"lt", 2},     {"le", 2},
     {"gt", 2},    {"ge", 2},     {"eq", 2},    {"ne", 2},    {"and", 2},    {"or", 2},
-    {"select", 3}};
+    {"rand", 2},  {"ror", 2},    {"select", 3}};
 static_assert(sizeof(kOps) / sizeof(kOps[0]) == static_cast<size_t>(Op::Count_), "op table");
 
 uint64_t mix(uint64_t h, uint64_t v) {
@@ -183,6 +183,26 @@ double powInt(double a, int n) {
 
 }  // namespace
 
+double rFunctionValue(bool disjunction, double f1, double f2, double a) {
+  // Same association as the expanded formula, so a = 0 gives HyperFun's bits exactly.
+  double s = a == 0.0 ? f1 * f1 + f2 * f2 : f1 * f1 + f2 * f2 - 2.0 * a * f1 * f2;
+  double root = s > 0.0 ? std::sqrt(s) : 0.0;  // rounding can make s slightly negative
+  double r = disjunction ? f1 + f2 + root : f1 + f2 - root;
+  return a == 0.0 ? r : r / (1.0 + a);
+}
+
+void rFunctionPartials(bool disjunction, double f1, double f2, double a, double& d1, double& d2) {
+  double s = a == 0.0 ? f1 * f1 + f2 * f2 : f1 * f1 + f2 * f2 - 2.0 * a * f1 * f2;
+  const double sg = disjunction ? 1.0 : -1.0;
+  if (!(s > 0.0)) {
+    d1 = d2 = 0.5 / (1.0 + a);
+    return;
+  }
+  const double root = std::sqrt(s);
+  d1 = (1.0 + sg * (f1 - a * f2) / root) / (1.0 + a);
+  d2 = (1.0 + sg * (f2 - a * f1) / root) / (1.0 + a);
+}
+
 const char* opName(Op op) { return kOps[static_cast<int>(op)].name; }
 
 size_t numChildren(const Node& n) {
@@ -245,6 +265,7 @@ double applyOp(Op op, double a, double b, double c, double imm) {
     case Op::Ne: return a != b ? 1.0 : 0.0;
     case Op::And: return (a != 0.0 && b != 0.0) ? 1.0 : 0.0;
     case Op::Or: return (a != 0.0 || b != 0.0) ? 1.0 : 0.0;
+    case Op::RAnd: case Op::ROr: return rFunctionValue(op == Op::ROr, a, b, imm);
     case Op::Select: return a != 0.0 ? b : c;
     case Op::Count_: break;
   }
@@ -261,7 +282,7 @@ namespace {
 bool commutative(Op op) {
   switch (op) {
     case Op::Add: case Op::Mul: case Op::Min: case Op::Max: case Op::Eq: case Op::Ne:
-    case Op::And: case Op::Or:
+    case Op::And: case Op::Or: case Op::RAnd: case Op::ROr:
       return true;
     default:
       return false;
@@ -328,6 +349,9 @@ Expr Expr::make(Op op, const Expr& a) { return build(op, a, Expr(), Expr(), 0.0)
 Expr Expr::make(Op op, const Expr& a, const Expr& b) { return build(op, a, b, Expr(), 0.0); }
 Expr Expr::make(Op op, const Expr& a, const Expr& b, const Expr& c) { return build(op, a, b, c, 0.0); }
 Expr Expr::powi(const Expr& a, int n) { return build(Op::PowI, a, Expr(), Expr(), n); }
+Expr Expr::makeWithImm(Op op, const Expr& a, const Expr& b, double imm) { return build(op, a, b, Expr(), imm); }
+Expr rAnd(const Expr& f1, const Expr& f2, double a) { return Expr::makeWithImm(Op::RAnd, f1, f2, a); }
+Expr rOr(const Expr& f1, const Expr& f2, double a) { return Expr::makeWithImm(Op::ROr, f1, f2, a); }
 
 Expr operator+(const Expr& a, const Expr& b) { return Expr::make(Op::Add, a, b); }
 Expr operator-(const Expr& a, const Expr& b) { return Expr::make(Op::Sub, a, b); }
@@ -539,6 +563,15 @@ Expr derivative(const Expr& e, uint32_t var) {
       case Op::Max: r = select(gt(b, a), D(1), D(0)); break;
       case Op::Fmod: r = binary(1.0, -trunc(a / b)); break;
       case Op::Select: r = select(a, D(1), D(2)); break;
+      case Op::RAnd: case Op::ROr: {
+        const double al = n.value, sg = n.op == Op::ROr ? 1.0 : -1.0;
+        Expr s = al == 0.0 ? square(a) + square(b) : square(a) + square(b) - 2.0 * al * a * b;
+        Expr root = sqrt(s);
+        Expr half = 0.5 / (1.0 + al);
+        r = binary(select(gt(s, 0.0), (1.0 + sg * (a - al * b) / root) / (1.0 + al), half),
+                   select(gt(s, 0.0), (1.0 + sg * (b - al * a) / root) / (1.0 + al), half));
+        break;
+      }
       case Op::Count_: break;
     }
     d.emplace(&n, r);

@@ -201,6 +201,35 @@ Interval compare(Op op, const Interval& a, const Interval& b) {
 }
 
 // Ops whose scalar result is NaN whenever input a (resp. b) is NaN.
+// R-functions with -1 < a <= 1 are non-decreasing in both arguments (their partials
+// (1 ± (f1 − a f2)/sqrt(f1² + f2² − 2a f1 f2))/(1 + a) are >= 0 because (f1 − a f2)² <= that
+// radicand when a² <= 1), so the exact range over a box is [R(lo, lo), R(hi, hi)]. The
+// endpoint values cancel catastrophically near 0, so their rounding error is bounded by the
+// size of the operands, not of the result (see the slack below).
+Interval rFunctionInterval(bool disjunction, const Interval& a, const Interval& b, double alpha) {
+  if (!finite(a) || !finite(b)) return Interval::everything();  // inf - inf is NaN at points
+  // Monotonicity needs a in (-1, 1] and squares that do not overflow.
+  const double big = 1e150;
+  if (!(alpha > -1.0 && alpha <= 1.0) || std::max({-a.lo, a.hi, -b.lo, b.hi}) > big) return Interval::everything();
+  // Rounding: a computed value (at a corner, or at any point of the box the bound must cover)
+  // is off by the radicand's error es through the root, plus a few ulps of the operands. With
+  // F1, F2 the largest magnitudes over the box: es <= 4 eps (F1² + F2² + 2|a| F1 F2); the root
+  // is off by at most sqrt(2 es) where the radicand cancels (a != 0), by its relative rounding
+  // when it cannot (a = 0: a sum of squares). Twice that covers both the corner and the point.
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double F1 = std::max(std::fabs(a.lo), std::fabs(a.hi)), F2 = std::max(std::fabs(b.lo), std::fabs(b.hi));
+  const double s2 = F1 * F1 + F2 * F2;
+  const double rootMax = std::sqrt(s2 + 2.0 * std::fabs(alpha) * F1 * F2);
+  const double rootErr = alpha == 0.0 ? 4.0 * eps * rootMax : std::sqrt(8.0 * eps * (s2 + 2.0 * std::fabs(alpha) * F1 * F2));
+  const double slack = 2.0 * (rootErr + 8.0 * eps * (F1 + F2 + rootMax)) / std::min(1.0, 1.0 + alpha);
+  auto bound = [&](double f1, double f2, bool upper) {
+    double v = rFunctionValue(disjunction, f1, f2, alpha);
+    double w = upper ? up(v + slack, 2) : down(v - slack, 2);
+    return std::isnan(w) ? (upper ? kInf : -kInf) : w;
+  };
+  return {bound(a.lo, b.lo, false), bound(a.hi, b.hi, true)};
+}
+
 bool nanFromA(Op op) {
   switch (op) {
     case Op::Sqrt: case Op::Log: case Op::Log10: case Op::Not: case Op::PowI:
@@ -214,7 +243,7 @@ bool nanFromA(Op op) {
 bool nanFromB(Op op) {
   switch (op) {
     case Op::Add: case Op::Sub: case Op::Mul: case Op::Div: case Op::Pow: case Op::Atan2:
-    case Op::Fmod:
+    case Op::Fmod: case Op::RAnd: case Op::ROr:
       return true;
     default:
       return false;
@@ -225,6 +254,7 @@ Interval dispatch(Op op, const Interval& a, const Interval& b, const Interval& c
   using Fn = double (*)(double);
   switch (op) {
     case Op::Const: case Op::Var: case Op::Param: case Op::Copy: return a;
+    case Op::Extremum: break;  // evaluated by the extremum search, never through here
     case Op::Neg: return {-a.hi, -a.lo};
     case Op::Abs:
       if (a.lo >= 0.0) return a;
@@ -281,6 +311,7 @@ Interval dispatch(Op op, const Interval& a, const Interval& b, const Interval& c
       return compare(op, a, b);
     case Op::And: return truth(excludesZero(a) && excludesZero(b), isZero(a) || isZero(b));
     case Op::Or: return truth(excludesZero(a) || excludesZero(b), isZero(a) && isZero(b));
+    case Op::RAnd: case Op::ROr: return rFunctionInterval(op == Op::ROr, a, b, imm);
     case Op::Select:  // select(c, t, f) = c != 0 ? t : f; NaN counts as non-zero
       if (excludesZero(a)) return b;
       if (isZero(a)) return c;

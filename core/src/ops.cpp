@@ -32,6 +32,8 @@ Expr rFunction(const Expr& f1, const Expr& f2, const Expr& a, double sign) {
   // a = 1: the square root is |f1 − f2| and the R-function is exactly max / min. Emitting the
   // extremum node itself lets interval evaluation decide it and prune the tape.
   if (a.isConst(1.0)) return sign > 0 ? max(f1, f2) : min(f1, f2);
+  // A constant a: one monotone R-function node (exact interval bounds, see expr.h).
+  if (a.isConst()) return sign > 0 ? rOr(f1, f2, a.constValue()) : rAnd(f1, f2, a.constValue());
   Expr s = square(f1) + square(f2);
   bool zero = a.isConst(0.0);  // the common sqrt system: skip the dead terms
   if (!zero) s = s - 2.0 * a * f1 * f2;
@@ -43,7 +45,7 @@ Expr rFunction(const Expr& f1, const Expr& f2, const Expr& a, double sign) {
 Expr rSmooth(const Expr& f1, const Expr& f2, double m, double sign) {
   require(std::isfinite(m) && m >= 0.0, "smoothness m must be a finite number >= 0");
   Expr s = square(f1) + square(f2);
-  Expr r = sign > 0 ? f1 + f2 + sqrt(s) : f1 + f2 - sqrt(s);
+  Expr r = sign > 0 ? rOr(f1, f2, 0.0) : rAnd(f1, f2, 0.0);
   if (m == 0.0) return r;
   Expr w;
   if (m == std::floor(m) && m <= 64.0) {

@@ -32,6 +32,11 @@ enum class Op : uint8_t {
   Copy /* tapes only: out = a (a pruned min/max/select) */,
   // binary
   Add, Sub, Mul, Div, Pow, Atan2, Min, Max, Fmod, Lt, Le, Gt, Ge, Eq, Ne, And, Or,
+  // R-functions with the survey's parameter a (in Node::value), -1 < a < 1 (Pasko-Survey):
+  // RAnd = (f1 + f2 - sqrt(f1^2 + f2^2 - 2a f1 f2)) / (1 + a), ROr with +. One node instead of
+  // the expanded formula because they are monotone in both arguments, which gives exact
+  // interval bounds (the expanded formula's bounds blow up with every nesting level).
+  RAnd, ROr,
   // ternary
   Select,
   Count_
@@ -85,6 +90,8 @@ class Expr {
   static Expr make(Op op, const Expr& a, const Expr& b);
   static Expr make(Op op, const Expr& a, const Expr& b, const Expr& c);
   static Expr powi(const Expr& a, int n);
+  // A binary op carrying an immediate (RAnd / ROr and their parameter a).
+  static Expr makeWithImm(Op op, const Expr& a, const Expr& b, double imm);
   // The extremum node of a validated spec (use frep::extremum() in extremum.h, which checks it).
   static Expr makeExtremum(std::shared_ptr<const ExtremumSpec> spec);
 
@@ -134,9 +141,17 @@ Expr logicalAnd(const Expr& a, const Expr& b);
 Expr logicalOr(const Expr& a, const Expr& b);
 Expr logicalNot(const Expr& a);
 Expr select(const Expr& cond, const Expr& ifTrue, const Expr& ifFalse);
+// R-conjunction / R-disjunction with a constant parameter a in (-1, 1) (ops.h has the checked,
+// general versions; a = 1 is min/max there).
+Expr rAnd(const Expr& f1, const Expr& f2, double a);
+Expr rOr(const Expr& f1, const Expr& f2, double a);
 
 // Scalar semantics of one op (the reference every evaluator must agree with).
 double applyOp(Op op, double a, double b = 0.0, double c = 0.0, double imm = 0.0);
+// The R-function value (RAnd: disjunction = false), shared by every scalar evaluator.
+double rFunctionValue(bool disjunction, double f1, double f2, double a);
+// Its partial derivatives; at f1 = f2 = 0 (not differentiable) both are 1 / (2 (1 + a)).
+void rFunctionPartials(bool disjunction, double f1, double f2, double a, double& d1, double& d2);
 
 // Structural queries and rewrites (memoised over the DAG, so cost is linear in node count).
 uint32_t numVars(const Expr& e);    // 1 + highest Var index (0 if none)
