@@ -75,7 +75,9 @@ TEST(Extremum, BallPlusBallIsBallOfRadiusTwo) {
         double v = pe.eval(*t, p);
         // min-intersection: max_u min(1 - |X - u|^2, 1 - |u|^2) = 1 - |X|^2 / 4 exactly (inside;
         // outside the maximiser X/2 leaves the box [-1, 1]^3 and only the sign is exact).
-        if (r < 2.0) EXPECT_NEAR(v, 1.0 - r * r / 4.0, grid ? 2.0 * delta : 1e-4);
+        if (r < 2.0) {
+          EXPECT_NEAR(v, 1.0 - r * r / 4.0, grid ? 2.0 * delta : 1e-4);
+        }
         EXPECT_EQ(v >= 0, r < 2.0) << "r " << r;
       }
     }
@@ -530,7 +532,9 @@ TEST(Extremum, SamplingMatchesPointEvaluation) {
   for (const Tile& tile : r.tiles) {
     auto p = g.world(tile.origin[0], tile.origin[1], tile.origin[2]);
     double v = pe.eval(*t, p.data());
-    if (std::fabs(v) > 2e-3) EXPECT_EQ(v > 0, tile.inside);
+    if (std::fabs(v) > 2e-3) {
+      EXPECT_EQ(v > 0, tile.inside);
+    }
   }
   // the same with threads: identical values (warm starts do not cross batch calls)
   so.threads = 2;

@@ -73,7 +73,9 @@ FarmOptions clusterOptions(const std::string& ep) {
 
 TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
   JobSpec j = sphereJob();
-  FarmOutcome ref = runSampleJob(j, FarmOptions{0});
+  FarmOptions inProcess;
+  inProcess.workers = 0;
+  FarmOutcome ref = runSampleJob(j, inProcess);
   std::string ep = endpoint();
   FarmOutcome out;
   std::thread master([&] { out = runSampleJob(j, clusterOptions(ep)); });

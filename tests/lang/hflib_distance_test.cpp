@@ -223,8 +223,12 @@ TEST(HfLibDistance, SardfSignsBoundsAndMaxMinAwayFromBlend) {
           bool q1 = x > 0 && y > 0, q3 = x < 0 && y < 0;
           bool uBlend = (q1 && x / y < 1 / t && x / y > t) || (q3 && std::fabs(x - y) <= R);
           bool iBlend = (q3 && x / y < 1 / t && x / y > t) || (q1 && std::fabs(x - y) <= R);
-          if (!uBlend) EXPECT_EQ(vu, mx) << x << " " << y;
-          if (!iBlend) EXPECT_EQ(vi, mn) << x << " " << y;
+          if (!uBlend) {
+            EXPECT_EQ(vu, mx) << x << " " << y;
+          }
+          if (!iBlend) {
+            EXPECT_EQ(vi, mn) << x << " " << y;
+          }
         }
     }
 }
