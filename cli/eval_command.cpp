@@ -21,6 +21,8 @@ int runEval(const EvalRequest& request) {
 
   TapePtr tape = Tape::compile(m.field, uint32_t(m.dims));
   PointEvaluator point;
+  DomainCounts domain;
+  point.countDomainErrors(&domain);
   const double value = point.eval(*tape, at.data());
   std::vector<double> grad(tape->numVars());
   GradientEvaluator gradient;
@@ -36,6 +38,8 @@ int runEval(const EvalRequest& request) {
   std::cout << "gradient:";
   for (int i = 0; i < m.dims; ++i) std::cout << (i ? ", " : " ") << formatNumber(grad[size_t(i)]);
   std::cout << "\n";
+  if (domain.total())
+    std::cout << "domain errors: " << domain.describe() << " (documented values used, see docs/language.md)\n";
   return kExitOk;
 }
 

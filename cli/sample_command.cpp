@@ -133,6 +133,9 @@ int runSample(const SampleRequest& request) {
        << "  evaluations " << s.pointEvals << " (" << formatNumber(std::round(fraction * 1e4) / 100)
        << "% of dense " << s.denseEvals << "), interval " << s.intervalEvals << "\n"
        << "  NaN values " << s.nanValues << (s.nanValues ? " (domain errors, stored as outside)" : "") << "\n"
+       << "  domain errors " << s.domainErrors.total()
+       << (s.domainErrors.total() ? " (" + s.domainErrors.describe() + "; documented values used, see docs/language.md)" : "")
+       << "\n"
        << "  bricks " << report.bricks << " (" << report.bricksComputed << " computed, " << report.bricksFromJournal
        << " from the journal), workers " << report.workersSeen << ", retries " << report.retries << ", "
        << formatNumber(std::round(report.wallSeconds * 1000) / 1000) << " s\n"

@@ -145,6 +145,7 @@ class Master {
       report_.pointEvals += out.stats.pointEvals;
       report_.intervalEvals += out.stats.intervalEvals;
       report_.nanValues += out.stats.nanValues;
+      report_.domainErrors.add(out.stats.domainErrors);
       auto& share = report_.perWorker[who];
       ++share.bricks;
       share.pointEvals += out.stats.pointEvals;
@@ -374,6 +375,8 @@ class Master {
     out.stats.pointEvals = r.point_evals();
     out.stats.intervalEvals = r.interval_evals();
     out.stats.nanValues = r.nan_values();
+    for (int k = 0; k < r.domain_errors_size() && k < int(kDomainErrorKinds); ++k)
+      out.stats.domainErrors.n[k] = r.domain_errors(k);
     report_.perWorker[p.workerId].computeSeconds += r.compute_seconds();
     brickSeconds_.push_back(r.compute_seconds());
     if (journal_) journal_->append(id, std::string(static_cast<const char*>(payload.data()), payload.size()));
@@ -566,6 +569,7 @@ class Master {
     o.result.stats.pointEvals = report_.pointEvals;
     o.result.stats.intervalEvals = report_.intervalEvals;
     o.result.stats.nanValues = report_.nanValues;
+    o.result.stats.domainErrors = report_.domainErrors;
     o.result.stats.denseEvals = uint64_t(grid_.dims[0]) * grid_.dims[1] * grid_.dims[2];
     report_.denseEvals = o.result.stats.denseEvals;
     report_.wallSeconds = std::chrono::duration<double>(Clock::now() - start_).count();
@@ -601,6 +605,9 @@ std::string FarmReport::toJson() const {
   j["bricks"] = {{"total", bricks}, {"computed", bricksComputed}, {"from_journal", bricksFromJournal}};
   j["evaluations"] = {{"point", pointEvals}, {"interval", intervalEvals}, {"dense_equivalent", denseEvals},
                       {"nan_values", nanValues}};
+  nlohmann::json dom = nlohmann::json::object();
+  for (size_t k = 0; k < kDomainErrorKinds; ++k) dom[domainErrorName(DomainError(k))] = domainErrors.n[k];
+  j["domain_errors"] = dom;
   j["output"] = {{"leaves", leaves}, {"tiles", tiles}};
   j["faults"] = {{"retries", retries},           {"duplicates", duplicates},
                  {"late_results", lateResults},  {"malformed", malformed},

@@ -49,6 +49,7 @@ struct FarmReport {
   double wallSeconds = 0;
   uint64_t bricks = 0, bricksComputed = 0, bricksFromJournal = 0;
   uint64_t pointEvals = 0, intervalEvals = 0, denseEvals = 0, nanValues = 0;
+  DomainCounts domainErrors;
   uint64_t leaves = 0, tiles = 0;
   uint64_t retries = 0, duplicates = 0, lateResults = 0, malformed = 0, oversized = 0;
   uint64_t deadWorkers = 0, handedBack = 0, stragglerReissues = 0, leaseReissues = 0, refused = 0;

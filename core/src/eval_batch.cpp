@@ -32,8 +32,26 @@ inline T powInt(T a, int n) {
 #define FREP_CLONES
 #endif
 
+// Counts the lanes (< count) where an instruction hits a domain error; runs before the
+// instruction writes its output (which may alias an input).
 template <typename T>
-FREP_CLONES void runTape(const Instr* code, size_t ninstr, T* __restrict regs, size_t n) {
+void countDomainErrors(const Instr& ins, const T* a, const T* b, size_t count, DomainCounts& dom) {
+  uint64_t hits = 0;
+  DomainError kind;
+  switch (ins.op) {
+    case Op::Sqrt: case Op::Log: case Op::Log10: case Op::Asin: case Op::Acos: case Op::Div:
+    case Op::Pow: case Op::Fmod:
+      for (size_t i = 0; i < count; ++i) hits += isDomainError(ins.op, double(a[i]), double(b[i]), kind);
+      if (hits) dom.n[size_t(kind)] += hits;  // kind is set by every call
+      break;
+    default:
+      break;
+  }
+}
+
+template <typename T>
+FREP_CLONES void runTape(const Instr* code, size_t ninstr, T* __restrict regs, size_t n, DomainCounts* dom,
+                         size_t count) {
   constexpr size_t B = BatchEvaluator<T>::kBatch;
   for (size_t k = 0; k < ninstr; ++k) {
     const Instr& ins = code[k];
@@ -41,6 +59,7 @@ FREP_CLONES void runTape(const Instr* code, size_t ninstr, T* __restrict regs, s
     const T* a = regs + size_t(ins.a) * B;
     const T* b = regs + size_t(ins.b) * B;
     const T* c = regs + size_t(ins.c) * B;
+    if (dom) countDomainErrors(ins, a, b, count, *dom);
 #define LOOP(expr) \
   for (size_t i = 0; i < n; ++i) o[i] = (expr); \
   break
@@ -152,17 +171,17 @@ const T* BatchEvaluator<T>::eval(const Tape& tape, size_t count) {
   if (n > kBatch) n = kBatch;
   const auto& code = tape.code();
   if (!tape.hasExtrema()) {
-    runTape<T>(code.data(), code.size(), regs_.data(), n);
+    runTape<T>(code.data(), code.size(), regs_.data(), n, domain_, count);
   } else {
     // Straight-line segments between extremum instructions run vectorised as usual.
     size_t start = 0;
     for (size_t k = 0; k < code.size(); ++k) {
       if (code[k].op != Op::Extremum) continue;
-      runTape<T>(code.data() + start, k - start, regs_.data(), n);
+      runTape<T>(code.data() + start, k - start, regs_.data(), n, domain_, count);
       runExtremum(tape, code[k], count);
       start = k + 1;
     }
-    runTape<T>(code.data() + start, code.size() - start, regs_.data(), n);
+    runTape<T>(code.data() + start, code.size() - start, regs_.data(), n, domain_, count);
   }
   return regs_.data() + size_t(tape.resultReg()) * kBatch;
 }

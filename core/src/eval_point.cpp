@@ -14,10 +14,11 @@ double PointEvaluator::eval(const Tape& tape, const double* x) {
   double* r = regs_.data();
   const uint32_t v0 = tape.varReg(0);
   for (uint32_t i = 0; i < tape.numVars(); ++i) r[v0 + i] = x[i];
-  if (!tape.hasExtrema()) {
+  if (!tape.hasExtrema() && !domain_) {
     for (const Instr& ins : tape.code()) r[ins.out] = applyOp(ins.op, r[ins.a], r[ins.b], r[ins.c], ins.imm);
     return r[tape.resultReg()];
   }
+  DomainError kind;
   for (const Instr& ins : tape.code()) {
     if (ins.op == Op::Extremum) {
       const ExtremumEntry& e = tape.extrema()[ins.a];
@@ -26,6 +27,7 @@ double PointEvaluator::eval(const Tape& tape, const double* x) {
       r[ins.out] = extrema_.get(tape, ins.a).solve(xbuf_.data()).value;
       continue;
     }
+    if (domain_ && isDomainError(ins.op, r[ins.a], r[ins.b], kind)) ++domain_->n[size_t(kind)];
     r[ins.out] = applyOp(ins.op, r[ins.a], r[ins.b], r[ins.c], ins.imm);
   }
   return r[tape.resultReg()];

@@ -203,6 +203,26 @@ void rFunctionPartials(bool disjunction, double f1, double f2, double a, double&
   d2 = (1.0 + sg * (f2 - a * f1) / root) / (1.0 + a);
 }
 
+const char* domainErrorName(DomainError kind) {
+  static const char* names[] = {"sqrt of a negative", "log of a non-positive", "asin/acos outside [-1, 1]",
+                                "division by zero", "power of a negative base", "mod by zero"};
+  return names[static_cast<size_t>(kind)];
+}
+uint64_t DomainCounts::total() const {
+  uint64_t t = 0;
+  for (uint64_t v : n) t += v;
+  return t;
+}
+void DomainCounts::add(const DomainCounts& o) {
+  for (size_t i = 0; i < kDomainErrorKinds; ++i) n[i] += o.n[i];
+}
+std::string DomainCounts::describe() const {
+  std::string s;
+  for (size_t i = 0; i < kDomainErrorKinds; ++i)
+    if (n[i]) s += (s.empty() ? "" : ", ") + std::string(domainErrorName(DomainError(i))) + " " + std::to_string(n[i]);
+  return s;
+}
+
 const char* opName(Op op) { return kOps[static_cast<int>(op)].name; }
 
 size_t numChildren(const Node& n) {

@@ -102,6 +102,7 @@ class Sampler {
       res.stats.pointEvals += s.pointEvals;
       res.stats.intervalEvals += s.intervalEvals;
       res.stats.nanValues += s.nanValues;
+      res.stats.domainErrors.add(s.domainErrors);
       res.stats.tapeInstrs += s.tapeInstrs;
       res.stats.tapeBatches += s.tapeBatches;
     };
@@ -258,6 +259,7 @@ class Sampler {
   void evaluatePoints(Worker& w, LeafBlock& blk, const Tape& tape, const uint16_t* todo, size_t n) {
     constexpr size_t B = BatchEvaluator<double>::kBatch;
     w.batch.reserve(tape);
+    w.batch.countDomainErrors(&w.stats.domainErrors);
     for (size_t start = 0; start < n; start += B) {
       size_t count = std::min(B, n - start);
       for (size_t k = 0; k < count; ++k) {

@@ -111,3 +111,28 @@ TEST(RFunctionOp, BatchEqualsPointBitForBit) {
     ASSERT_EQ(out[k], pe.eval(*tape, p));
   }
 }
+
+TEST(DomainErrors, PointAndBatchCountEveryKind) {
+  Expr x = Expr::x(0);
+  // At x = -2: sqrt(-2), log(-2), asin(-2), 1/(x+2) = 1/0, (-2)^0.5, fmod(1, x+2) = fmod(1, 0).
+  Expr f = sqrt(x) + log(x) + asin(x) + 1.0 / (x + 2.0) + pow(x, Expr(0.5)) + fmod(Expr(1.0), x + 2.0);
+  auto tape = Tape::compile(f, 1);
+  PointEvaluator pe;
+  DomainCounts c;
+  pe.countDomainErrors(&c);
+  double p[1] = {-2.0};
+  pe.eval(*tape, p);
+  for (size_t k = 0; k < kDomainErrorKinds; ++k) EXPECT_EQ(c.n[k], 1u) << domainErrorName(DomainError(k));
+  double q[1] = {0.5};
+  pe.eval(*tape, q);  // no error at 0.5
+  EXPECT_EQ(c.total(), kDomainErrorKinds);
+  EXPECT_NE(c.describe().find("sqrt of a negative 1"), std::string::npos);
+
+  BatchEvaluator<double> be;
+  DomainCounts cb;
+  be.countDomainErrors(&cb);
+  be.reserve(*tape);
+  for (int k = 0; k < 10; ++k) be.in(0)[k] = k < 3 ? -2.0 : 0.5;  // three lanes hit every kind
+  be.eval(*tape, 10);
+  for (size_t k = 0; k < kDomainErrorKinds; ++k) EXPECT_EQ(cb.n[k], 3u) << domainErrorName(DomainError(k));
+}

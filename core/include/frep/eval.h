@@ -33,8 +33,11 @@ class ExtremumSlots {
 class PointEvaluator {
  public:
   double eval(const Tape& tape, const double* x);
+  // Adds every domain error of later evals to *counts (nullptr: stop counting).
+  void countDomainErrors(DomainCounts* counts) { domain_ = counts; }
 
  private:
+  DomainCounts* domain_ = nullptr;
   std::vector<double> regs_;
   uint64_t boundId_ = 0;
   ExtremumSlots extrema_;
@@ -53,8 +56,11 @@ class BatchEvaluator {
   T* in(uint32_t var);  // valid after reserve(tape) or a previous eval with that tape
   void reserve(const Tape& tape);
   const T* eval(const Tape& tape, size_t count);
+  // Adds the domain errors of later evals (lanes < count) to *counts (nullptr: stop).
+  void countDomainErrors(DomainCounts* counts) { domain_ = counts; }
 
  private:
+  DomainCounts* domain_ = nullptr;
   void bind(const Tape& tape);
   void runExtremum(const Tape& tape, const Instr& ins, size_t count);
   std::vector<T> regs_;  // numRegs * kBatch, register-major

@@ -11,6 +11,7 @@
 //   select(c, a, b) = (c != 0) ? a : b.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -148,6 +149,32 @@ Expr rOr(const Expr& f1, const Expr& f2, double a);
 
 // Scalar semantics of one op (the reference every evaluator must agree with).
 double applyOp(Op op, double a, double b = 0.0, double c = 0.0, double imm = 0.0);
+// Domain errors: evaluations that fall back on one of the documented values above. Point and
+// batch evaluators count them on request (PointEvaluator/BatchEvaluator::countDomainErrors).
+enum class DomainError : uint8_t {
+  SqrtOfNegative, LogOfNonPositive, AsinAcosOutOfRange, DivisionByZero, PowOfNegativeBase, FmodByZero, Count_
+};
+constexpr size_t kDomainErrorKinds = static_cast<size_t>(DomainError::Count_);
+const char* domainErrorName(DomainError kind);  // e.g. "sqrt of a negative"
+struct DomainCounts {
+  uint64_t n[kDomainErrorKinds] = {};
+  uint64_t total() const;
+  void add(const DomainCounts& o);
+  std::string describe() const;  // "sqrt of a negative 3, division by zero 1" or ""
+};
+// Whether op(a, b) is a domain error, and which.
+inline bool isDomainError(Op op, double a, double b, DomainError& kind) {
+  switch (op) {
+    case Op::Sqrt: kind = DomainError::SqrtOfNegative; return a < 0.0;
+    case Op::Log: case Op::Log10: kind = DomainError::LogOfNonPositive; return !(a > kLogFloor);
+    case Op::Asin: case Op::Acos: kind = DomainError::AsinAcosOutOfRange; return a < -1.0 || a > 1.0;
+    case Op::Div: kind = DomainError::DivisionByZero; return b == 0.0;
+    case Op::Pow: kind = DomainError::PowOfNegativeBase; return a < 0.0 && b != std::trunc(b);
+    case Op::Fmod: kind = DomainError::FmodByZero; return b == 0.0;
+    default: return false;
+  }
+}
+
 // The R-function value (RAnd: disjunction = false), shared by every scalar evaluator.
 double rFunctionValue(bool disjunction, double f1, double f2, double a);
 // Its partial derivatives; at f1 = f2 = 0 (not differentiable) both are 1 / (2 (1 + a)).

@@ -59,6 +59,7 @@ struct SampleStats {
   uint64_t intervalEvals = 0;  // interval evaluations over boxes
   uint64_t denseEvals = 0;     // what a dense evaluation of the region would cost
   uint64_t nanValues = 0;      // samples whose value was NaN (domain errors), stored as outside
+  DomainCounts domainErrors;   // evaluations that used a documented domain-error value
   uint64_t tapeInstrs = 0;     // sum of pruned tape lengths used for point batches ...
   uint64_t tapeBatches = 0;    // ... over this many batches (average = tapeInstrs / tapeBatches)
 };
