@@ -15,6 +15,7 @@
 
 #include "frep/eval.h"
 #include "frep/expr.h"
+#include "bench_models.h"
 #include "tree_walker.h"
 
 using namespace frep;
@@ -23,30 +24,8 @@ namespace {
 
 const Expr X = Expr::x(0), Y = Expr::x(1), Z = Expr::x(2);
 
-// R-functions with a = 0 (Pasko-Survey, the sqrt system).
-Expr rUnion0(const Expr& f, const Expr& g) { return f + g + sqrt(square(f) + square(g)); }
-Expr rInter0(const Expr& f, const Expr& g) { return f + g - sqrt(square(f) + square(g)); }
-
-Expr sphereModel() { return 1.0 - square(X) - square(Y) - square(Z); }
-
-// A 4 x 2.4 x 1 plate with a 4 x 4 grid of vertical cylindrical holes (max/min CSG), cut by an
-// a = 0 R-intersection, with three spheres R-unioned on top.
-Expr csgModel() {
-  Expr block = min(min(2.0 - abs(X), 1.2 - abs(Y)), 0.5 - abs(Z));
-  Expr holes;
-  bool first = true;
-  for (double cx : {-1.5, -0.5, 0.5, 1.5})
-    for (double cy : {-0.9, -0.3, 0.3, 0.9}) {
-      Expr cyl = 0.04 - square(X - cx) - square(Y - cy);
-      holes = first ? cyl : max(holes, cyl);
-      first = false;
-    }
-  Expr plate = rInter0(block, -holes);
-  Expr bumps = max(max(0.36 - square(X + 1.0) - square(Y) - square(Z - 0.5),
-                       0.36 - square(X - 1.0) - square(Y) - square(Z - 0.5)),
-                   0.25 - square(X) - square(Y - 0.6) - square(Z - 0.5));
-  return rUnion0(plate, bumps);
-}
+using bench::csgModel;
+using bench::sphereModel;
 
 constexpr size_t kPoints = 4096;
 

@@ -1,7 +1,10 @@
 // Models shared by the benchmarks (one definition, so every figure refers to the same shapes).
 #pragma once
 
+#include <array>
+
 #include "frep/expr.h"
+#include "frep/ops.h"
 
 namespace frep::bench {
 
@@ -9,30 +12,28 @@ inline Expr sphereModel() {
   Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
   return 0.64 - square(x) - square(y) - square(z);
 }
+inline const std::array<double, 3> kSphereLo{-1, -1, -1}, kSphereHi{1, 1, 1};
 
-// A CSG part of about 100 nodes: a plate with a 4x4 grid of drilled holes, four corner bosses
-// and a blended-in cross rib, combined with min/max (exact R-functions, a = 1) so that interval
-// evaluation can prune whole branches.
+// The CSG part (111 DAG nodes before R-function fusion): a 4 x 2.4 x 1 plate with a 4 x 4 grid
+// of vertical cylindrical holes (max/min CSG), cut by an a = 0 R-intersection, with three
+// spheres R-unioned on top (Pasko-Survey R-functions).
 inline Expr csgModel() {
-  Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
-  Expr plate = min(min(min(0.8 - x, x + 0.8), min(0.8 - y, y + 0.8)), min(0.15 - z, z + 0.15));
+  Expr X = Expr::x(0), Y = Expr::x(1), Z = Expr::x(2);
+  Expr block = min(min(2.0 - abs(X), 1.2 - abs(Y)), 0.5 - abs(Z));
   Expr holes;
   bool first = true;
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) {
-      double cx = -0.6 + 0.4 * i, cy = -0.6 + 0.4 * j;
-      Expr hole = 0.01 - square(x - cx) - square(y - cy);
-      holes = first ? hole : max(holes, hole);
+  for (double cx : {-1.5, -0.5, 0.5, 1.5})
+    for (double cy : {-0.9, -0.3, 0.3, 0.9}) {
+      Expr cyl = 0.04 - square(X - cx) - square(Y - cy);
+      holes = first ? cyl : max(holes, cyl);
       first = false;
     }
-  Expr part = min(plate, -holes);
-  for (int c = 0; c < 4; ++c) {
-    double cx = (c & 1) ? 0.55 : -0.55, cy = (c & 2) ? 0.55 : -0.55;
-    Expr boss = 0.04 - square(x - cx) - square(y - cy) - square(z - 0.2);
-    part = max(part, boss);
-  }
-  Expr rib = min(min(0.05 - abs(x), 0.6 - abs(y)), min(0.35 - z, z));
-  return max(part, rib);
+  Expr plate = rIntersection(block, -holes, 0.0);
+  Expr bumps = max(max(0.36 - square(X + 1.0) - square(Y) - square(Z - 0.5),
+                       0.36 - square(X - 1.0) - square(Y) - square(Z - 0.5)),
+                   0.25 - square(X) - square(Y - 0.6) - square(Z - 0.5));
+  return rUnion(plate, bumps, 0.0);
 }
+inline const std::array<double, 3> kCsgLo{-2.2, -2.2, -2.2}, kCsgHi{2.2, 2.2, 2.2};
 
 }  // namespace frep::bench

@@ -67,8 +67,27 @@ TapePtr ModelCache::get(const JobSpec& job, uint64_t jobId) {
   return t;
 }
 
+Operation operationOf(const JobSpec& job) {
+  if (job.operation().empty() || job.operation() == "sample") return Operation::Sample;
+  if (job.operation() == "mesh") return Operation::Mesh;
+  throw std::invalid_argument("job: unknown operation '" + job.operation() + "' (expected sample or mesh)");
+}
+
+namespace {
+uint64_t meshPointEvals(const MeshStats& s) { return s.samplePointEvals + s.rootEvals + s.gradientEvals; }
+}  // namespace
+
 BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::array<int32_t, 3>& lo,
                          const std::array<int32_t, 3>& hi, int threads) {
+  if (operationOf(job) == Operation::Mesh) {
+    MeshOptions mo;
+    mo.threads = threads;
+    mo.sharpFeatures = job.mesh().sharp_features();
+    BrickOutput out;
+    out.piece = meshRegion(tape, gridOf(job), lo, hi, mo);
+    out.stats.pointEvals = meshPointEvals(out.piece.stats);
+    return out;
+  }
   SampleOptions opt;
   opt.bandVoxels = job.band();
   opt.regionLo = lo;
@@ -194,6 +213,135 @@ bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* e
     }
   }
   if (r.p != r.end) return fail("payload: trailing bytes");
+  return true;
+}
+
+// ---- mesh pieces ----------------------------------------------------------------------------
+
+namespace {
+void putVarint(std::string& s, uint64_t v) {
+  while (v >= 0x80) {
+    s.push_back(char(uint8_t(v) | 0x80));
+    v >>= 7;
+  }
+  s.push_back(char(uint8_t(v)));
+}
+uint64_t zigzag(int64_t v) { return (uint64_t(v) << 1) ^ uint64_t(v >> 63); }
+int64_t unzigzag(uint64_t v) { return int64_t(v >> 1) ^ -int64_t(v & 1); }
+bool getVarint(Reader& r, uint64_t& v) {
+  v = 0;
+  for (int shift = 0; shift < 70; shift += 7) {
+    if (r.p == r.end) return false;
+    const uint8_t b = uint8_t(*r.p++);
+    if (shift == 63 && b > 1) return false;  // more than 64 bits
+    v |= uint64_t(b & 0x7f) << shift;
+    if (!(b & 0x80)) return true;
+  }
+  return false;
+}
+constexpr size_t kMeshHeader = 4 + 12 + 7 * 8 + 8;
+constexpr size_t kMinVertexBytes = 1 + 48;
+constexpr size_t kMinTriangleBytes = 3;
+}  // namespace
+
+std::string encodeMeshPiece(const MeshPiece& piece) {
+  std::string s;
+  s.reserve(kMeshHeader + piece.vertices.size() * 51 + piece.triangles.size() * 5);
+  s.append("FRM1", 4);
+  for (int a = 0; a < 3; ++a) put(s, piece.regionLo[a]);
+  const MeshStats& st = piece.stats;
+  for (uint64_t v : {st.cellsVisited, st.cellsCrossed, st.rootEvals, st.gradientEvals, st.samplePointEvals,
+                     st.fallbackEdges, st.featureCells})
+    put(s, v);
+  put(s, uint32_t(piece.vertices.size()));
+  put(s, uint32_t(piece.triangles.size()));
+  EdgeKey prev = 0;
+  for (size_t i = 0; i < piece.vertices.size(); ++i) {
+    const MeshVertex& v = piece.vertices[i];
+    putVarint(s, i == 0 ? v.key : v.key - prev);
+    prev = v.key;
+    for (double c : v.position) put(s, c);
+    for (double c : v.normal) put(s, c);
+  }
+  int64_t first = 0;
+  for (const auto& t : piece.triangles) {
+    putVarint(s, zigzag(int64_t(t[0]) - first));
+    putVarint(s, zigzag(int64_t(t[1]) - int64_t(t[0])));
+    putVarint(s, zigzag(int64_t(t[2]) - int64_t(t[0])));
+    first = t[0];
+  }
+  return s;
+}
+
+bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string* error) {
+  auto fail = [&](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (size < kMeshHeader || std::memcmp(data, "FRM1", 4) != 0) return fail("mesh payload: bad magic or header");
+  Reader r{static_cast<const char*>(data) + 4, static_cast<const char*>(data) + size};
+  for (int a = 0; a < 3; ++a) r.get(out.regionLo[a]);
+  if ((out.regionLo[0] | out.regionLo[1] | out.regionLo[2]) & 7 || out.regionLo[0] < 0 || out.regionLo[1] < 0 ||
+      out.regionLo[2] < 0)
+    return fail("mesh payload: region origin not a non-negative multiple of 8");
+  MeshStats& st = out.stats;
+  for (uint64_t* v : {&st.cellsVisited, &st.cellsCrossed, &st.rootEvals, &st.gradientEvals, &st.samplePointEvals,
+                      &st.fallbackEdges, &st.featureCells})
+    r.get(*v);
+  uint32_t nv = 0, nt = 0;
+  r.get(nv);
+  r.get(nt);
+  // Reject absurd counts before allocating anything.
+  if (uint64_t(nv) * kMinVertexBytes + uint64_t(nt) * kMinTriangleBytes > size - kMeshHeader)
+    return fail("mesh payload: counts exceed its size");
+  out.vertices.resize(nv);
+  for (uint32_t i = 0; i < nv; ++i) {
+    MeshVertex& v = out.vertices[i];
+    uint64_t k = 0;
+    if (!getVarint(r, k)) return fail("mesh payload: truncated or overlong vertex key");
+    if (i == 0) {
+      v.key = k;
+    } else {
+      if (k == 0 || k > ~uint64_t(0) - out.vertices[i - 1].key) return fail("mesh payload: vertex keys not increasing");
+      v.key = out.vertices[i - 1].key + k;
+    }
+    for (double& c : v.position)
+      if (!r.get(c)) return fail("mesh payload: truncated vertex");
+    for (double& c : v.normal)
+      if (!r.get(c)) return fail("mesh payload: truncated vertex");
+    for (int a = 0; a < 3; ++a)
+      if (!std::isfinite(v.position[size_t(a)]) || !std::isfinite(v.normal[size_t(a)]))
+        return fail("mesh payload: non-finite vertex coordinate");
+  }
+  out.triangles.resize(nt);
+  int64_t first = 0;
+  for (auto& t : out.triangles) {
+    uint64_t z[3];
+    for (uint64_t& x : z)
+      if (!getVarint(r, x)) return fail("mesh payload: truncated or overlong triangle");
+    const int64_t a = first + unzigzag(z[0]);
+    if (a < 0 || a >= int64_t(nv)) return fail("mesh payload: triangle index out of range");
+    const int64_t b = a + unzigzag(z[1]), c = a + unzigzag(z[2]);
+    // unzigzag of a 64-bit value can be huge: compare before adding could overflow, so bound the deltas.
+    if (unzigzag(z[1]) <= -int64_t(nv) || unzigzag(z[1]) >= int64_t(nv) || unzigzag(z[2]) <= -int64_t(nv) ||
+        unzigzag(z[2]) >= int64_t(nv) || b < 0 || b >= int64_t(nv) || c < 0 || c >= int64_t(nv))
+      return fail("mesh payload: triangle index out of range");
+    if (a == b || b == c || a == c) return fail("mesh payload: degenerate triangle");
+    t = {uint32_t(a), uint32_t(b), uint32_t(c)};
+    first = a;
+  }
+  if (r.p != r.end) return fail("mesh payload: trailing bytes");
+  return true;
+}
+
+std::string encodePayload(Operation op, const BrickOutput& out) {
+  return op == Operation::Mesh ? encodeMeshPiece(out.piece) : encodeBrick(out);
+}
+
+bool decodePayload(Operation op, const void* data, size_t size, BrickOutput& out, std::string* error) {
+  if (op == Operation::Sample) return decodeBrick(data, size, out, error);
+  if (!decodeMeshPiece(data, size, out.piece, error)) return false;
+  out.stats.pointEvals = meshPointEvals(out.piece.stats);
   return true;
 }
 

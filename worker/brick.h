@@ -11,14 +11,24 @@
 #include <vector>
 
 #include "farm.pb.h"
+#include "frep/mesh.h"
 #include "frep/sample.h"
 
 namespace frep::farm {
 
+// What a job computes (JobSpec.operation).
+enum class Operation { Sample, Mesh };
+// "sample" (or empty, proto3's default) and "mesh"; throws std::invalid_argument otherwise.
+Operation operationOf(const JobSpec& job);
+
+// One brick's result. "sample": leaves and tiles; "mesh": piece (the core mesher's MeshPiece of
+// the brick's cells). stats holds the counters reported to the master (for "mesh":
+// pointEvals = grid-point + root-finding + gradient evaluations).
 struct BrickOutput {
   std::vector<LeafBlock> leaves;
   std::vector<Tile> tiles;
   SampleStats stats;
+  MeshPiece piece;
 };
 
 // The grid a job samples.
@@ -41,7 +51,9 @@ class ModelCache {
   std::unordered_map<uint64_t, TapePtr> tapes_;
 };
 
-// Samples the region [lo, hi) of the job's grid.
+// Computes the region [lo, hi) of the job's grid: samples it ("sample") or meshes its cells
+// ("mesh", core meshRegion with the job's MeshSpec). threads: 0 = all cores; never changes the
+// result.
 BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::array<int32_t, 3>& lo,
                          const std::array<int32_t, 3>& hi, int threads);
 
@@ -52,6 +64,24 @@ BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::arr
 std::string encodeBrick(const BrickOutput& out);
 // Returns false (with a reason) on a malformed payload; never reads out of bounds.
 bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* error);
+
+// Mesh piece codec (little-endian, version in the magic): "FRM1", regionLo (3 x i32), the
+// piece's MeshStats (7 x u64: cells visited, crossed, root evals, gradient evals, sample point
+// evals, fallback edges, feature cells), u32 vertices, u32 triangles; per vertex: its key as a
+// varint (the first absolute, then the increase over the previous key: keys strictly increase),
+// position and normal (6 x f64, bit-exact); per triangle: the first index as a zigzag varint
+// delta from the previous triangle's first index, the other two as zigzag varint deltas from
+// the first. Varints are LEB128 (7 bits a byte, at most 10 bytes).
+std::string encodeMeshPiece(const MeshPiece& piece);
+// Returns false (with a reason) on a malformed payload: bad magic, truncation, counts beyond
+// the size, keys not strictly increasing, a varint that overflows, a non-finite coordinate, a
+// triangle index out of range or repeated, trailing bytes. Never reads out of bounds.
+bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string* error);
+
+// The job's payload codec: encodeBrick/decodeBrick for "sample", encodeMeshPiece/decodeMeshPiece
+// (into out.piece, with out.stats.pointEvals from the piece's stats) for "mesh".
+std::string encodePayload(Operation op, const BrickOutput& out);
+bool decodePayload(Operation op, const void* data, size_t size, BrickOutput& out, std::string* error);
 
 uint32_t crc32Of(const void* data, size_t size);
 

@@ -21,6 +21,54 @@ Value& ObjectLowering::arrayArgument(const AstExpr& arg, const std::string& call
   return arr;
 }
 
+int ObjectLowering::findObject(const std::string& name) const {
+  for (size_t i = 0; i < sh_.program.objects.size(); ++i)
+    if (sh_.program.objects[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+void ObjectLowering::objectArgument(const AstExpr& arg, const std::string& callee, size_t index,
+                                    Arg& out) {
+  const std::string which = "argument " + std::to_string(index + 1) + " of " + callee;
+  if (arg.kind != AstExpr::Kind::Name)
+    throw CompileError{arg.loc, which + " must be the name of an object defined earlier in the file"};
+  int i = findObject(arg.name);
+  if (i < 0) {
+    auto it = env_.find(arg.name);
+    if (it != env_.end() && (it->second.isArray || it->second.state != Def::Undefined))
+      throw CompileError{arg.loc, which + " must be an object name, but '" + arg.spelling +
+                                      "' is a variable"};
+    throw CompileError{arg.loc, which + " must be an object name: no object '" + arg.spelling +
+                                    "' is defined in this file"};
+  }
+  const ObjectDecl& o = sh_.program.objects[static_cast<size_t>(i)];
+  if (&o == &obj_)
+    throw CompileError{arg.loc, "object '" + obj_.spelling + "' cannot use itself in " + callee};
+  if (static_cast<size_t>(i) >= sh_.done.size())
+    throw CompileError{arg.loc, "object '" + o.spelling + "' is defined later (line " +
+                                    std::to_string(o.loc.line) +
+                                    "); " + callee + " can only use objects defined before it"};
+  const LoweredObject& lowered = sh_.done[static_cast<size_t>(i)];
+  out.isObject = true;
+  out.name = o.spelling;
+  out.objectDims = o.xSize;
+  if (!o.headerOk || !lowered.ok) {  // its errors are already reported: the call gives 0
+    out.objectDims = -1;
+    return;
+  }
+  // Its a[] reads the caller's a values (zeros where the caller has fewer).
+  std::vector<Expr> params;
+  auto ait = env_.find("a");
+  for (int j = 0; j < o.aSize; ++j) {
+    if (ait != env_.end() && ait->second.isArray && static_cast<size_t>(j) < ait->second.elems.size() &&
+        ait->second.elemState[static_cast<size_t>(j)] != Def::Undefined)
+      params.push_back(ait->second.elems[static_cast<size_t>(j)]);
+    else
+      params.push_back(Expr(0.0));
+  }
+  out.value = bindParams(lowered.field, params);
+}
+
 Expr ObjectLowering::call(const AstExpr& e) {
   if (const Builtin* b = findBuiltin(e.name)) return callBuiltin(e, *b);
   // Attribute functions first: even when the library registers them, they only warn.
@@ -61,7 +109,7 @@ std::string ObjectLowering::describeSignature(const std::string& sig) {
   std::string out;
   for (size_t i = 0; i < sig.size(); ++i) {
     if (i) out += ", ";
-    out += sig[i] == 'A' ? "array" : "scalar";
+    out += sig[i] == 'A' ? "array" : sig[i] == 'O' ? "object" : "scalar";
   }
   return out;
 }
@@ -72,7 +120,10 @@ Expr ObjectLowering::callLibrary(const AstExpr& e, const LibraryFunction& f) {
     sig.clear();
     for (const auto& a : e.args) {
       auto it = a->kind == AstExpr::Kind::Name ? env_.find(a->name) : env_.end();
-      sig += it != env_.end() && it->second.isArray ? 'A' : 'S';
+      bool isVar = it != env_.end() && (it->second.isArray || it->second.state != Def::Undefined);
+      if (it != env_.end() && it->second.isArray) sig += 'A';
+      else if (a->kind == AstExpr::Kind::Name && !isVar && findObject(a->name) >= 0) sig += 'O';
+      else sig += 'S';
     }
   }
   if (e.args.size() != sig.size())
@@ -84,6 +135,10 @@ Expr ObjectLowering::callLibrary(const AstExpr& e, const LibraryFunction& f) {
   for (size_t i = sig.size(); i-- > 0;) {
     if (sig[i] == 'A') continue;
     const AstExpr& a = *e.args[i];
+    if (sig[i] == 'O') {
+      objectArgument(a, f.name, i, args[i]);
+      continue;
+    }
     if (a.kind == AstExpr::Kind::Name) {
       auto it = env_.find(a.name);
       if (it != env_.end() && it->second.isArray)
@@ -101,6 +156,8 @@ Expr ObjectLowering::callLibrary(const AstExpr& e, const LibraryFunction& f) {
     args[i].name = arr.spelling;
     arrays.push_back(&arr);
   }
+  for (const Arg& a : args)
+    if (a.isObject && a.objectDims < 0) return Expr(0.0);  // an operand's errors are reported
   Expr result;
   try {
     result = f.lower(args);

@@ -12,14 +12,19 @@
 
 namespace frep::lang {
 
-// One argument of a call: a scalar expression, or an array of per-element expressions.
+// One argument of a call: a scalar expression, an array of per-element expressions, or (signature
+// letter 'O') the name of an object defined earlier in the file.
 // Array arguments are passed by reference: transformations (hfShift3D, ...) mutate them in
 // place and the caller sees the change for the rest of the object (HyperFun semantics).
 struct Arg {
   bool isArray = false;
   Expr value;                          // when !isArray
   std::vector<Expr>* array = nullptr;  // when isArray
-  std::string name;                    // array name as written, for messages
+  std::string name;                    // array (or object) name as written, for messages
+  // Object arguments: `value` holds the callee's field over its own coordinates x[0..objectDims)
+  // (its a[] bound to the caller's a values, or zeros beyond the caller's a).
+  bool isObject = false;
+  int objectDims = 0;
 };
 
 // Thrown by a library function on bad arguments (wrong array size, ...). The lowering turns it
@@ -31,7 +36,10 @@ struct LibraryError : std::runtime_error {
 
 struct LibraryFunction {
   std::string name;       // canonical spelling, e.g. "hfSphere" (lookup is case-insensitive)
-  std::string signature;  // one letter per argument: 'A' array, 'S' scalar, e.g. "AAS"
+  // One letter per argument: 'A' array, 'S' scalar, 'O' object name, e.g. "AAS"; "*": any
+  // arguments (bare array names pass as arrays, earlier objects' names as objects, the rest as
+  // scalars; the function checks them).
+  std::string signature;
   std::string summary;    // one line: formula or effect (docs/language.md, `frep check` help)
   // Returns the call's value: a primitive's field, or 1 for transformations.
   std::function<Expr(std::vector<Arg>& args)> lower;

@@ -113,6 +113,10 @@ class ObjectLowering {
   Expr readElement(const AstExpr& e);
   // An array argument: a bare name of x, a, s or a declared array whose elements all have values.
   Value& arrayArgument(const AstExpr& arg, const std::string& callee, size_t index);
+  // An object argument of a library call (signature 'O'): an earlier object's name; fills
+  // out.value with its field over its own x (a[] bound to the caller's a, zeros beyond).
+  void objectArgument(const AstExpr& arg, const std::string& callee, size_t index, Arg& out);
+  int findObject(const std::string& name) const;  // index in the program, -1 when none
   Expr call(const AstExpr& e);
   std::vector<Expr> lowerArgsRightToLeft(const AstExpr& e);
   Expr callBuiltin(const AstExpr& e, const Builtin& b);
