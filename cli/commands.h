@@ -58,14 +58,15 @@ struct SampleRequest {
 };
 int runSample(const SampleRequest& request);
 
-// frep mesh: in-process for now (the farm comes later); --brick and --threads never change
-// the output file.
+// frep mesh: on the farm like frep sample (bricks meshed by workers, pieces stitched by the
+// master); --workers, --brick and --threads never change the output file.
 struct MeshRequest {
   ModelRequest model;
   RegionRequest region;
-  int brick = 64;   // region edge in voxels (a multiple of 8)
-  int threads = 0;  // 0: all cores
+  FarmRequest farm;
+  int threads = 0;     // threads of the in-process run (--workers 0); 0: all cores
   bool sharp = false;  // --sharp: MeshOptions::sharpFeatures
+  std::string logLevel = "info";
 };
 int runMesh(const MeshRequest& request);
 

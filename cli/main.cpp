@@ -76,6 +76,21 @@ void addRegionOptions(CLI::App* sub, RegionRequest& r, const std::string& outHel
   sub->add_option("-O,--out", r.out, outHelp + " (required)");  // required: checked by the command, after -o
 }
 
+void addFarmOptions(CLI::App* sub, FarmRequest& f) {
+  sub->add_option("--workers", f.workers, "Local worker processes (default: one per core; 0 computes in-process)");
+  sub->add_option("--listen", f.listen,
+                  "Cluster mode: bind here (e.g. tcp://*:5555), start no workers; they connect with "
+                  "frep-worker --connect");
+  sub->add_option("--expect-workers", f.expectWorkers,
+                  "Cluster mode: workers expected; dispatch waits up to 5 s after the first one joins for the rest");
+  sub->add_option("--brick", f.brick, "Brick edge in voxels, a multiple of 8 (default 64; same output)");
+  sub->add_option("--heartbeat-ms", f.heartbeatMs, "Heartbeat interval both ways (default 500)");
+  sub->add_flag("--resume", f.resume, "Continue a stopped job from OUT.journal");
+  sub->add_flag("--json", f.json, "JSON progress events on stdout (batch systems)");
+  sub->add_flag("--no-progress", f.noProgress, "No progress bar");
+  sub->add_option("--curve", f.curveDir, "Require CURVE keys from DIR (see frep keygen)");
+}
+
 void checkObjectIsNotAFile(const ModelRequest& m) {
   if (m.object.find_first_of("./") != std::string::npos)
     throw badArgs("-o/--object: '" + m.object +
@@ -124,25 +139,15 @@ int main(int argc, char** argv) {
   addRegionOptions(sampleCmd, sample.region, "Output .vdb file", 128);
   sampleCmd->add_option("--band", sample.band, "Band half-width in voxels (default 3)");
   sampleCmd->add_option("--threads", sample.threads, "Threads of the in-process run, --workers 0 (default 0: all cores)");
-  sampleCmd->add_option("--workers", sample.farm.workers,
-                        "Local worker processes (default: one per core; 0 computes in-process)");
-  sampleCmd->add_option("--listen", sample.farm.listen,
-                        "Cluster mode: bind here (e.g. tcp://*:5555), start no workers; they connect with "
-                        "frep-worker --connect");
-  sampleCmd->add_option("--expect-workers", sample.farm.expectWorkers, "Cluster mode: workers expected; dispatch waits up to 5 s after the first one joins for the rest");
-  sampleCmd->add_option("--brick", sample.farm.brick, "Brick edge in voxels, a multiple of 8 (default 64)");
-  sampleCmd->add_option("--heartbeat-ms", sample.farm.heartbeatMs, "Heartbeat interval both ways (default 500)");
-  sampleCmd->add_flag("--resume", sample.farm.resume, "Continue a stopped job from OUT.journal");
-  sampleCmd->add_flag("--json", sample.farm.json, "JSON progress events on stdout (batch systems)");
-  sampleCmd->add_flag("--no-progress", sample.farm.noProgress, "No progress bar");
-  sampleCmd->add_option("--curve", sample.farm.curveDir, "Require CURVE keys from DIR (see frep keygen)");
+  addFarmOptions(sampleCmd, sample.farm);
 
   MeshRequest mesh;
-  CLI::App* meshCmd = app.add_subcommand("mesh", "Watertight triangle mesh of a model's surface (in-process)");
+  CLI::App* meshCmd = app.add_subcommand("mesh", "Watertight triangle mesh of a model's surface (on the farm)");
   addModelOptions(meshCmd, mesh.model, true);
   addRegionOptions(meshCmd, mesh.region, "Output mesh: .ply (binary), .obj or .stl (binary)", 128);
-  meshCmd->add_option("--brick", mesh.brick, "Region edge in voxels, a multiple of 8 (default 64; same output)");
-  meshCmd->add_option("--threads", mesh.threads, "Threads (default 0: all cores; same output)");
+  meshCmd->add_option("--threads", mesh.threads,
+                      "Threads of the in-process run, --workers 0 (default 0: all cores; same output)");
+  addFarmOptions(meshCmd, mesh.farm);
   meshCmd->add_flag("--sharp", mesh.sharp, "Experimental: QEF vertices on edges and corners (docs/mesh.md)");
 
   std::string keygenDir;
@@ -179,6 +184,7 @@ int main(int argc, char** argv) {
     if (keygenCmd->parsed()) return runKeygen(keygenDir);
     if (meshCmd->parsed()) {
       checkObjectIsNotAFile(mesh.model);
+      mesh.logLevel = logLevel;
       return runMesh(mesh);
     }
     checkObjectIsNotAFile(sample.model);

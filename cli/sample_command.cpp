@@ -12,66 +12,12 @@
 #include "commands.h"
 #include "curve.h"
 #include "exit_codes.h"
+#include "farm_job.h"
 #include "farm_master.h"
 #include "sampling_grid.h"
 #include "vdb_writer.h"
 
 namespace frep::cli {
-
-namespace {
-
-farm::JobSpec makeJob(const LoadedModel& m, const std::string& path, const GridSpec& grid, int band) {
-  farm::JobSpec job;
-  job.set_operation("sample");
-  job.set_model_source(m.source);
-  job.set_model_name(path);
-  job.set_object(m.model.objectName);
-  for (double p : m.spec.params) job.add_params(p);
-  for (int a : m.spec.axis) job.add_map_axis(a);
-  for (double c : m.spec.constant) job.add_map_constant(c);
-  job.set_iso(m.spec.iso);
-  for (int a = 0; a < 3; ++a) {
-    job.add_origin(grid.origin[a]);
-    job.add_dims(grid.dims[a]);
-  }
-  job.set_voxel(grid.voxel);
-  job.set_band(band);
-  return job;
-}
-
-farm::FarmOptions farmOptions(const SampleRequest& r) {
-  const FarmRequest& f = r.farm;
-  if (f.workers < -1) throw badArgs("--workers: expected 0 (in-process) or more, got " + std::to_string(f.workers));
-  if (f.brick < 8 || f.brick % 8 != 0)
-    throw badArgs("--brick: expected a positive multiple of 8 voxels, got " + std::to_string(f.brick));
-  if (f.heartbeatMs < 10) throw badArgs("--heartbeat-ms: expected at least 10, got " + std::to_string(f.heartbeatMs));
-  if (!f.listen.empty() && f.listen.rfind("tcp://", 0) != 0)
-    throw badArgs("--listen: expected tcp://HOST:PORT (e.g. tcp://*:5555), got '" + f.listen + "'");
-  farm::FarmOptions o;
-  o.workers = f.workers;
-  o.listen = f.listen;
-  o.expectWorkers = f.expectWorkers;
-  o.brickVoxels = f.brick;
-  o.heartbeatMs = f.heartbeatMs;
-  o.curveDir = f.curveDir;
-  o.resume = f.resume;
-  o.progressJson = f.json;
-  o.progressBar = !f.json && !f.noProgress && ::isatty(2);
-  o.journalPath = r.region.out + ".journal";
-  o.logLevel = r.logLevel == "info" ? "warn" : r.logLevel;
-  return o;
-}
-
-std::string poisonedMessage(const farm::FarmReport& report) {
-  std::string s = std::to_string(report.poisoned.size()) + " brick(s) failed " + "3 times and were given up:";
-  for (auto& p : report.poisoned)
-    s += "\n  brick " + std::to_string(p.brick) + " voxels [" + std::to_string(p.lo[0]) + "," +
-         std::to_string(p.lo[1]) + "," + std::to_string(p.lo[2]) + ")-(" + std::to_string(p.hi[0]) + "," +
-         std::to_string(p.hi[1]) + "," + std::to_string(p.hi[2]) + "): " + p.error;
-  return s + "\nthe other bricks are in the journal; fix the cause and run again with --resume";
-}
-
-}  // namespace
 
 int runSample(const SampleRequest& request) {
   if (request.region.out.empty()) throw badArgs("-O/--out: the output .vdb path is required");
@@ -80,38 +26,19 @@ int runSample(const SampleRequest& request) {
   if (request.threads < 0) throw badArgs("--threads: expected 0 (all cores) or more, got " + std::to_string(request.threads));
   Box box = request.region.bounds.empty() ? Box{} : parseBounds("-b/--bounds", request.region.bounds);
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);
-  farm::FarmOptions options = farmOptions(request);
+  farm::FarmOptions options = farmOptions(request.farm, request.region.out, request.logLevel, request.threads);
   LoadedModel m = loadModel(request.model, true);
   GridSpec grid = makeGrid(box, 3, res);
 
   AtomicOutput out("-O/--out", request.region.out);
   AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
-  farm::JobSpec job = makeJob(m, request.model.path, grid, request.band);
+  farm::JobSpec job = makeJob(m, request.model.path, grid, "sample");
+  job.set_band(request.band);
   spdlog::info("sampling '{}' on {}x{}x{} voxels of {}", m.model.objectName, grid.dims[0], grid.dims[1],
                grid.dims[2], grid.voxel);
-  farm::FarmOutcome outcome;
-  try {
-    outcome = farm::runSampleJob(job, options);
-  } catch (const std::invalid_argument& e) {
-    throw badArgs(e.what());
-  } catch (const std::runtime_error& e) {
-    throw CliError(kExitFarmError, e.what());
-  }
+  farm::FarmOutcome outcome = runFarmJob(job, options);
   const farm::FarmReport& report = outcome.report;
-  auto writeReport = [&] {
-    {
-      std::ofstream r(reportOut.tempPath());
-      r << report.toJson() << "\n";
-      if (!r) throw ioError("cannot write " + reportOut.tempPath());
-    }
-    reportOut.commit();
-  };
-  if (report.interrupted || !report.poisoned.empty()) writeReport();
-  if (report.interrupted)
-    throw CliError(kExitInterrupted, "stopped by a signal; " + std::to_string(report.bricksComputed + report.bricksFromJournal) +
-                                         " of " + std::to_string(report.bricks) +
-                                         " bricks are in the journal: run the same command with --resume");
-  if (!report.poisoned.empty()) throw CliError(kExitPoisoned, poisonedMessage(report));
+  requireComplete(reportOut, report);
 
   VdbMetadata meta;
   meta.gridName = m.model.objectName;
@@ -121,7 +48,7 @@ int runSample(const SampleRequest& request) {
   meta.iso = request.model.iso;
   writeLevelSet(out.tempPath(), outcome.result, meta);
   out.commit();
-  writeReport();
+  writeReport(reportOut, report);
   std::remove(options.journalPath.c_str());  // the output is complete: nothing to resume
 
   const SampleStats& s = outcome.result.stats;
@@ -136,9 +63,7 @@ int runSample(const SampleRequest& request) {
        << "  domain errors " << s.domainErrors.total()
        << (s.domainErrors.total() ? " (" + s.domainErrors.describe() + "; documented values used, see docs/language.md)" : "")
        << "\n"
-       << "  bricks " << report.bricks << " (" << report.bricksComputed << " computed, " << report.bricksFromJournal
-       << " from the journal), workers " << report.workersSeen << ", retries " << report.retries << ", "
-       << formatNumber(std::round(report.wallSeconds * 1000) / 1000) << " s\n"
+       << "  " << bricksSummary(report) << "\n"
        << "  report " << request.region.out << ".report.json\n";
   if (request.farm.json) {
     std::cout << "{\"event\":\"done\",\"output\":\"" << request.region.out << "\",\"report\":\"" << request.region.out

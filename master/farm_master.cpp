@@ -74,7 +74,8 @@ struct Peer {
 
 class Master {
  public:
-  Master(const JobSpec& job, const FarmOptions& opt) : job_(job), opt_(opt), jobId_(jobIdOf(job)), grid_(gridOf(job)) {
+  Master(const JobSpec& job, const FarmOptions& opt)
+      : job_(job), opt_(opt), jobId_(jobIdOf(job)), grid_(gridOf(job)), op_(operationOf(job)) {
     if (opt.brickVoxels < 8 || opt.brickVoxels % 8 != 0)
       throw std::invalid_argument("--brick must be a positive multiple of 8 voxels");
     plan();
@@ -88,7 +89,7 @@ class Master {
         if (id >= bricks_.size() || bricks_[id].phase == BrickPhase::Done) return;
         BrickOutput out;
         std::string err;
-        if (!decodeBrick(payload.data(), payload.size(), out, &err)) return;
+        if (!decodePayload(op_, payload.data(), payload.size(), out, &err) || !insideBrick(out, bricks_[id])) return;
         commit(id, std::move(out), "journal", false);
         ++report_.bricksFromJournal;
       });
@@ -129,6 +130,12 @@ class Master {
     size_t leaves = 0;
     for (auto& br : bricks_) leaves = std::max(leaves, br.maxLeaves);
     payloadLimit_ = 12 + leaves * (16 + 64 + 2048) + leaves * 8 * 20 + 4096;
+    if (op_ == Operation::Mesh) {
+      // At most 8 vertices per grid point (7 edges and a feature vertex; a varint key and 6
+      // doubles each) and 12 triangles per cell (3 varints of at most 5 bytes each).
+      const size_t b = size_t(opt_.brickVoxels);
+      payloadLimit_ = 4096 + 8 * (b + 1) * (b + 1) * (b + 1) * (10 + 48) + 12 * b * b * b * 15;
+    }
   }
 
   // A brick's result is final: keep it, journal it, count it.
@@ -138,8 +145,10 @@ class Master {
     b.holders.clear();
     leased_.erase(id);
     ++done_;
-    report_.leaves += out.leaves.size();
-    report_.tiles += out.tiles.size();
+    if (op_ == Operation::Sample) {
+      report_.leaves += out.leaves.size();
+      report_.tiles += out.tiles.size();
+    }
     if (computed) {
       ++report_.bricksComputed;
       report_.pointEvals += out.stats.pointEvals;
@@ -162,9 +171,9 @@ class Master {
         return;
       }
       auto t0 = Clock::now();
-      BrickOutput out = computeBrick(tape, job_, b.lo, b.hi, 0);
+      BrickOutput out = computeBrick(tape, job_, b.lo, b.hi, opt_.threads);
       report_.perWorker["in-process"].computeSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
-      if (journal_) journal_->append(b.id, encodeBrick(out));
+      if (journal_) journal_->append(b.id, encodePayload(op_, out));
       commit(b.id, std::move(out), "in-process", true);
       progress_->update(done_, report_.pointEvals, 1);
     }
@@ -365,7 +374,7 @@ class Master {
     BrickOutput out;
     std::string err;
     bool ok = crc32Of(payload.data(), payload.size()) == r.payload_crc32() &&
-              decodeBrick(payload.data(), payload.size(), out, &err) && insideBrick(out, b);
+              decodePayload(op_, payload.data(), payload.size(), out, &err) && insideBrick(out, b);
     if (!ok) {
       ++report_.malformed;
       spdlog::warn("dropped a corrupt result for brick {} from {}: {}", id, p.workerId, err.empty() ? "crc or bounds" : err);
@@ -389,7 +398,18 @@ class Master {
     commit(id, std::move(out), p.workerId, true);
   }
 
-  static bool insideBrick(const BrickOutput& out, const Brick& b) {
+  bool insideBrick(const BrickOutput& out, const Brick& b) const {
+    if (op_ == Operation::Mesh) {
+      // The piece of this brick: every vertex on an edge starting at a grid point of the
+      // brick's cells, [lo, hi] (a cell's far corners included).
+      if (out.piece.regionLo != b.lo) return false;
+      for (const MeshVertex& v : out.piece.vertices) {
+        auto k = edgeKeyParts(v.key);
+        for (int a = 0; a < 3; ++a)
+          if (k[size_t(a)] < b.lo[a] || k[size_t(a)] > b.hi[a]) return false;
+      }
+      return true;
+    }
     for (auto& l : out.leaves)
       for (int a = 0; a < 3; ++a)
         if (l.origin[a] < b.lo[a] || l.origin[a] >= b.hi[a]) return false;
@@ -555,6 +575,17 @@ class Master {
 
   FarmOutcome finish() {
     FarmOutcome o;
+    report_.operation = op_ == Operation::Mesh ? "mesh" : "sample";
+    if (op_ == Operation::Mesh && done_ == bricks_.size()) {
+      // The merge step of a mesh job: the pieces stitched by global edge key (split-invariant).
+      std::vector<MeshPiece> pieces;
+      pieces.reserve(outputs_.size());
+      for (auto& out : outputs_) pieces.push_back(std::move(out.piece));
+      outputs_.clear();
+      o.mesh = mergePieces(pieces);
+      report_.vertices = o.mesh.positions.size();
+      report_.triangles = o.mesh.triangles.size();
+    }
     o.result.grid = grid_;
     o.result.bandVoxels = job_.band();
     for (auto& out : outputs_) {
@@ -581,6 +612,7 @@ class Master {
   FarmOptions opt_;
   uint64_t jobId_;
   GridSpec grid_;
+  Operation op_;
   std::vector<Brick> bricks_;
   std::deque<uint64_t> pending_, reissue_;
   std::vector<BrickOutput> outputs_;
@@ -608,7 +640,9 @@ std::string FarmReport::toJson() const {
   nlohmann::json dom = nlohmann::json::object();
   for (size_t k = 0; k < kDomainErrorKinds; ++k) dom[domainErrorName(DomainError(k))] = domainErrors.n[k];
   j["domain_errors"] = dom;
-  j["output"] = {{"leaves", leaves}, {"tiles", tiles}};
+  j["operation"] = operation;
+  if (operation == "mesh") j["output"] = {{"vertices", vertices}, {"triangles", triangles}};
+  else j["output"] = {{"leaves", leaves}, {"tiles", tiles}};
   j["faults"] = {{"retries", retries},           {"duplicates", duplicates},
                  {"late_results", lateResults},  {"malformed", malformed},
                  {"oversized", oversized},       {"dead_workers", deadWorkers},
@@ -631,6 +665,6 @@ std::string FarmReport::toJson() const {
   return j.dump(2);
 }
 
-FarmOutcome runSampleJob(const JobSpec& job, const FarmOptions& options) { return Master(job, options).run(); }
+FarmOutcome runJob(const JobSpec& job, const FarmOptions& options) { return Master(job, options).run(); }
 
 }  // namespace frep::farm

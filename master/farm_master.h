@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "farm.pb.h"
+#include "frep/mesh.h"
 #include "frep/sample.h"
 
 namespace frep::farm {
@@ -31,6 +32,7 @@ struct FarmOptions {
   bool progressBar = false;      // progress bar on stderr
   std::string workerExecutable;  // local mode: path of frep-worker ("" = next to this program)
   int workerThreads = 1;         // local mode: threads per worker
+  int threads = 0;               // in-process mode: threads per brick (0: all cores)
   std::string logLevel = "warn"; // local mode: workers' --log-level
 };
 
@@ -46,11 +48,13 @@ struct PoisonedBrick {
 };
 
 struct FarmReport {
+  std::string operation = "sample";
   double wallSeconds = 0;
   uint64_t bricks = 0, bricksComputed = 0, bricksFromJournal = 0;
   uint64_t pointEvals = 0, intervalEvals = 0, denseEvals = 0, nanValues = 0;
   DomainCounts domainErrors;
-  uint64_t leaves = 0, tiles = 0;
+  uint64_t leaves = 0, tiles = 0;        // "sample": merged output
+  uint64_t vertices = 0, triangles = 0;  // "mesh": merged output
   uint64_t retries = 0, duplicates = 0, lateResults = 0, malformed = 0, oversized = 0;
   uint64_t deadWorkers = 0, handedBack = 0, stragglerReissues = 0, leaseReissues = 0, refused = 0;
   uint64_t curveRejected = 0;
@@ -61,12 +65,18 @@ struct FarmReport {
   std::string toJson() const;
 };
 
+// The merged result of a job; which member is filled depends on the job's operation. Both are
+// complete only if nothing was poisoned (and the job was not interrupted).
 struct FarmOutcome {
-  SampleResult result;  // merged, sorted as sample() sorts; complete only if nothing was poisoned
+  SampleResult result;  // "sample": merged, sorted as sample() sorts
+  Mesh mesh;            // "mesh": the bricks' pieces stitched by mergePieces (as meshGrid does)
   FarmReport report;
 };
 
-// Runs a "sample" job. Throws std::runtime_error for setup failures (bind, journal, keys).
-FarmOutcome runSampleJob(const JobSpec& job, const FarmOptions& options);
+// Runs a job ("sample" or "mesh"): one scheduling loop; only the final merge depends on the
+// operation. Throws std::invalid_argument for a bad job or options (unknown operation, brick
+// size) and std::runtime_error for setup failures (bind, journal, keys).
+FarmOutcome runJob(const JobSpec& job, const FarmOptions& options);
+inline FarmOutcome runSampleJob(const JobSpec& job, const FarmOptions& options) { return runJob(job, options); }
 
 }  // namespace frep::farm

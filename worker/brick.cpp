@@ -94,7 +94,11 @@ BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::arr
   opt.regionHi = hi;
   opt.threads = threads;
   SampleResult r = sample(tape, gridOf(job), opt);
-  return BrickOutput{std::move(r.leaves), std::move(r.tiles), r.stats};
+  BrickOutput out;
+  out.leaves = std::move(r.leaves);
+  out.tiles = std::move(r.tiles);
+  out.stats = r.stats;
+  return out;
 }
 
 namespace {
@@ -281,7 +285,7 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
   if (size < kMeshHeader || std::memcmp(data, "FRM1", 4) != 0) return fail("mesh payload: bad magic or header");
   Reader r{static_cast<const char*>(data) + 4, static_cast<const char*>(data) + size};
   for (int a = 0; a < 3; ++a) r.get(out.regionLo[a]);
-  if ((out.regionLo[0] | out.regionLo[1] | out.regionLo[2]) & 7 || out.regionLo[0] < 0 || out.regionLo[1] < 0 ||
+  if (((out.regionLo[0] | out.regionLo[1] | out.regionLo[2]) & 7) != 0 || out.regionLo[0] < 0 || out.regionLo[1] < 0 ||
       out.regionLo[2] < 0)
     return fail("mesh payload: region origin not a non-negative multiple of 8");
   MeshStats& st = out.stats;
@@ -319,13 +323,12 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
     uint64_t z[3];
     for (uint64_t& x : z)
       if (!getVarint(r, x)) return fail("mesh payload: truncated or overlong triangle");
-    const int64_t a = first + unzigzag(z[0]);
-    if (a < 0 || a >= int64_t(nv)) return fail("mesh payload: triangle index out of range");
-    const int64_t b = a + unzigzag(z[1]), c = a + unzigzag(z[2]);
-    // unzigzag of a 64-bit value can be huge: compare before adding could overflow, so bound the deltas.
-    if (unzigzag(z[1]) <= -int64_t(nv) || unzigzag(z[1]) >= int64_t(nv) || unzigzag(z[2]) <= -int64_t(nv) ||
-        unzigzag(z[2]) >= int64_t(nv) || b < 0 || b >= int64_t(nv) || c < 0 || c >= int64_t(nv))
+    // Deltas are bounded before any addition, so nothing overflows.
+    const int64_t d0 = unzigzag(z[0]), d1 = unzigzag(z[1]), d2 = unzigzag(z[2]), n = int64_t(nv);
+    if (d0 <= -n || d0 >= n || d1 <= -n || d1 >= n || d2 <= -n || d2 >= n)
       return fail("mesh payload: triangle index out of range");
+    const int64_t a = first + d0, b = a + d1, c = a + d2;
+    if (a < 0 || a >= n || b < 0 || b >= n || c < 0 || c >= n) return fail("mesh payload: triangle index out of range");
     if (a == b || b == c || a == c) return fail("mesh payload: degenerate triangle");
     t = {uint32_t(a), uint32_t(b), uint32_t(c)};
     first = a;

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <thread>
 
-#include "frep_runner.h"
+#include "farm_runner.h"
 
 using namespace frep_cli_test;
 
@@ -23,48 +23,14 @@ const char* kPart =
     "  my_model = b \\ ball;\n"
     "}\n";
 
-class FarmCli : public FrepTest {
+class FarmCli : public FarmTest {
  protected:
   void SetUp() override {
-    FrepTest::SetUp();
+    FarmTest::SetUp();
     write("part.hf", kPart);
   }
   std::string sampleArgs(const std::string& out) const {
     return "sample part.hf -b 1 --res 96 --no-progress --heartbeat-ms 100 -O " + out;
-  }
-  // Starts frep in the background; returns its pid.
-  pid_t start(const std::string& args, const std::string& env = "") const {
-    std::string cmd = "cd '" + dir_ + "' && " + env + " exec '" FREP_BINARY "' " + args + " >" + path(".bg.out") +
-                      " 2>" + path(".bg.err");
-    pid_t pid = fork();
-    if (pid == 0) {
-      execl("/bin/sh", "sh", "-c", cmd.c_str(), (char*)nullptr);
-      _exit(127);
-    }
-    return pid;
-  }
-  static int waitFor(pid_t pid) {
-    int status = 0;
-    waitpid(pid, &status, 0);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  }
-  // Number of bricks recorded in a journal (12-byte header, records of 20 bytes + payload).
-  size_t journalRecords(const std::string& name) const {
-    std::string j = readText(path(name));
-    size_t pos = 12, n = 0;
-    while (pos + 20 <= j.size()) {
-      uint64_t size;
-      std::memcpy(&size, j.data() + pos + 12, 8);
-      if (pos + 20 + size > j.size()) break;
-      pos += 20 + size;
-      ++n;
-    }
-    return n;
-  }
-  static long jsonNumber(const std::string& json, const std::string& key) {
-    size_t at = json.find("\"" + key + "\"");
-    if (at == std::string::npos) return -1;
-    return std::strtol(json.c_str() + json.find(':', at) + 1, nullptr, 10);
   }
 };
 

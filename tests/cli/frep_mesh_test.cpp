@@ -1,6 +1,7 @@
 // frep mesh end to end: the files it writes are read back here (binary PLY, OBJ, binary STL)
 // and checked: watertight and oriented, Euler characteristic, volume, outward normals, the three
-// formats agreeing, and the same bytes whatever --brick and --threads.
+// formats agreeing, and the same bytes whatever --brick and --threads (farm options: see
+// frep_mesh_farm_test.cpp).
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -166,7 +167,8 @@ TEST_F(FrepTest, MeshWritesPlyObjStlThatReadBackWatertight) {
     ASSERT_NEAR(mc::norm(stl.facetNormals[t]), 1.0, 1e-6);
     ASSERT_GT(mc::dot(stl.facetNormals[t], stl.positions[3 * t]), 0.0) << "facet " << t;
   }
-  EXPECT_EQ(listing(), "S.STL s.hf s.obj s.ply");  // no temporary files left
+  // No temporary files or journals left; each output has its farm report beside it.
+  EXPECT_EQ(listing(), "S.STL S.STL.report.json s.hf s.obj s.obj.report.json s.ply s.ply.report.json");
 }
 
 TEST_F(FrepTest, MeshBytesDoNotDependOnBrickOrThreads) {

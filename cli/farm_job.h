@@ -1,0 +1,38 @@
+// What `frep sample` and `frep mesh` share to run a job on the farm: the JobSpec built from a
+// loaded model and grid, the farm options from the command line (validated, exit 2 on bad
+// values), running the job with failures mapped to exit codes, and the report beside the output.
+#pragma once
+
+#include <string>
+
+#include "atomic_output.h"
+#include "commands.h"
+#include "farm_master.h"
+#include "frep/sample.h"
+#include "model_loader.h"
+
+namespace frep::cli {
+
+// The job for `operation` ("sample" or "mesh") over `grid`; the caller adds the operation's own
+// options (band, mesh spec).
+farm::JobSpec makeJob(const LoadedModel& m, const std::string& modelPath, const GridSpec& grid,
+                      const std::string& operation);
+
+// Validates the farm options (throws CliError(kExitBadArgs) naming the option). The journal is
+// OUT.journal; `threads` is the in-process run's thread count (--workers 0).
+farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, const std::string& logLevel, int threads);
+
+// Runs the job: std::invalid_argument -> exit 2, std::runtime_error -> exit 7 (farm error).
+farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& options);
+
+// Writes report.toJson() to the report's temporary file and commits it.
+void writeReport(AtomicOutput& reportOut, const farm::FarmReport& report);
+
+// An interrupted or poisoned job: writes the report and throws CliError with exit 6 (resume) or
+// 5 (the poisoned bricks named). Returns when the job is complete.
+void requireComplete(AtomicOutput& reportOut, const farm::FarmReport& report);
+
+// "bricks N (C computed, J from the journal), workers W, retries R, T s" for the summary.
+std::string bricksSummary(const farm::FarmReport& report);
+
+}  // namespace frep::cli

@@ -1,0 +1,383 @@
+// frepfarm's fr* extremum extensions (issue 6, docs/extremum.md "The language side"): Minkowski
+// sum and difference, projection, sweep, constant-radius offset and Minkowski metamorphosis of
+// OBJECTS defined earlier in the file. Each lowers to one extremum node (frep/extremum.h) over
+// the callee's compiled field, read through the caller's coordinate array.
+//
+// Options: an optional trailing array [method, tol, lo1, hi1, ..., lok, hik]: method 0 =
+// branch-and-bound (default), 1 = the paper's grid; tol = the B&B certified gap or the grid step
+// (0 = default); then the searched operand's box (pairs per coordinate) when the automatic one
+// is not wanted. Every option must be a constant known at compile time.
+//
+// Automatic boxes: interval subdivision of [-1000, 1000]^n on the operand's field, keeping the
+// boxes not certified outside (hull of the rest is a sound enclosure of the solid).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include "frep/eval.h"
+#include "frep/extremum.h"
+#include "frep/interval.h"
+#include "frep/tape.h"
+#include "lib_hf_util.h"
+
+namespace frep::lang {
+namespace {
+
+using hf::constArg;
+
+constexpr double kSearchLimit = 1000.0;
+
+template <typename F>
+auto guarded(const char* fn, int arg, F&& build) -> decltype(build()) {
+  try {
+    return build();
+  } catch (const std::invalid_argument& e) {
+    throw LibraryError(std::string(fn) + ": " + e.what(), arg);
+  }
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+const Arg& objectArg(const char* fn, std::vector<Arg>& a, int i, const char* role) {
+  if (i >= static_cast<int>(a.size()) || !a[i].isObject)
+    throw LibraryError(std::string(fn) + ": argument " + std::to_string(i + 1) + " (" + role +
+                           ") must be the name of an object defined earlier in the file",
+                       i);
+  if (numParams(a[i].value) > 0)
+    throw LibraryError(std::string(fn) + ": object '" + a[i].name +
+                           "' reads a[] values that are not known at compile time here; " +
+                           "call it from an object without a[] or bind them in an object of its own",
+                       i);
+  return a[i];
+}
+
+std::vector<Expr>& coordArg(const char* fn, std::vector<Arg>& a, size_t n) {
+  if (a.empty() || !a[0].isArray || !a[0].array)
+    throw LibraryError(std::string(fn) + ": argument 1 must be the coordinate array (x)", 0);
+  if (a[0].array->size() < n)
+    throw LibraryError(std::string(fn) + ": the result has " + std::to_string(n) +
+                           " coordinates but array '" + a[0].name + "' has only " +
+                           std::to_string(a[0].array->size()),
+                       0);
+  return *a[0].array;
+}
+
+// Reads the result (over x[0..n)) through the caller's coordinates.
+Expr through(const Expr& result, const std::vector<Expr>& xs, size_t n) {
+  return remap(result, std::vector<Expr>(xs.begin(), xs.begin() + static_cast<long>(n)));
+}
+
+struct Options {
+  SearchOptions search;
+  bool hasBox = false;
+  Bounds box;
+};
+
+// The trailing options array (argument i, when present); boxDims: coordinates of the box.
+Options parseOptions(const char* fn, std::vector<Arg>& a, int i, size_t boxDims) {
+  Options o;
+  if (i >= static_cast<int>(a.size())) return o;
+  if (!a[i].isArray || !a[i].array)
+    throw LibraryError(std::string(fn) + ": the options must be an array [method, tol, lo1, hi1, ...]",
+                       i);
+  const std::vector<Expr>& v = *a[i].array;
+  for (size_t k = 0; k < v.size(); ++k)
+    if (!v[k].isConst())
+      throw LibraryError(std::string(fn) + ": option " + a[i].name + "[" + std::to_string(k + 1) +
+                             "] must be a constant known at compile time",
+                         i);
+  if (v.size() != 2 && v.size() != 2 + 2 * boxDims)
+    throw LibraryError(std::string(fn) + ": the options array must have 2 elements [method, tol] " +
+                           "or " + std::to_string(2 + 2 * boxDims) +
+                           " [method, tol, lo1, hi1, ...] (got " + std::to_string(v.size()) + ")",
+                       i);
+  double method = v[0].constValue(), tol = v[1].constValue();
+  if (method != 0.0 && method != 1.0)
+    throw LibraryError(std::string(fn) + ": method (options[1]) must be 0 (branch-and-bound) or 1 (grid)",
+                       i);
+  if (!(tol >= 0.0))
+    throw LibraryError(std::string(fn) + ": tol (options[2]) must be >= 0 (0: default)", i);
+  o.search.method = method == 1.0 ? ExtremumMethod::Grid : ExtremumMethod::BranchAndBound;
+  if (tol > 0.0) (method == 1.0 ? o.search.eps : o.search.tolerance) = tol;
+  if (v.size() > 2) {
+    o.hasBox = true;
+    for (size_t d = 0; d < boxDims; ++d) {
+      double lo = v[2 + 2 * d].constValue(), hi = v[3 + 2 * d].constValue();
+      if (!(lo <= hi) || !std::isfinite(lo) || !std::isfinite(hi))
+        throw LibraryError(std::string(fn) + ": box coordinate " + std::to_string(d + 1) +
+                               " needs finite lo <= hi (got " + num(lo) + ", " + num(hi) + ")",
+                           i);
+      o.box.lo.push_back(lo);
+      o.box.hi.push_back(hi);
+    }
+  }
+  return o;
+}
+
+// Sound bounding box of {f >= 0} within [-kSearchLimit, kSearchLimit]^n by interval subdivision.
+Bounds autoBox(const char* fn, const Arg& obj, int argIndex) {
+  const uint32_t n = static_cast<uint32_t>(obj.objectDims);
+  const std::string give = "; give its box in the options array [method, tol, lo1, hi1, ...]";
+  if (n == 0 || n > 6)
+    throw LibraryError(std::string(fn) + ": cannot bound object '" + obj.name + "' of " +
+                           std::to_string(n) + " coordinates automatically" + give,
+                       argIndex);
+  TapePtr tape = Tape::compile(obj.value, n);
+  IntervalEvaluator ev;
+  using Box = std::vector<Interval>;
+  std::vector<Box> amb{Box(n, Interval(-kSearchLimit, kSearchLimit))};
+  std::vector<double> inLo(n, INFINITY), inHi(n, -INFINITY);  // hull of certified-inside boxes
+  const size_t children = size_t{1} << n;
+  const size_t kMaxEvals = 400000;
+  size_t evals = 0;
+  auto hullOf = [&](std::vector<double>& lo, std::vector<double>& hi) {
+    lo = inLo;
+    hi = inHi;
+    for (const Box& b : amb)
+      for (uint32_t d = 0; d < n; ++d) {
+        lo[d] = std::min(lo[d], b[d].lo);
+        hi[d] = std::max(hi[d], b[d].hi);
+      }
+  };
+  std::vector<double> lo, hi;
+  for (int level = 0; level < 64 && !amb.empty(); ++level) {
+    hullOf(lo, hi);
+    // Refined to 1/32 of the extent on every axis, or out of budget: stop.
+    bool fine = true;
+    for (uint32_t d = 0; d < n; ++d)
+      if (amb[0][d].width() > (hi[d] - lo[d]) / 32.0) fine = false;
+    if (fine || evals + amb.size() * children > kMaxEvals) break;
+    std::vector<Box> next;
+    for (const Box& b : amb) {
+      for (size_t c = 0; c < children; ++c) {
+        Box k(n);
+        for (uint32_t d = 0; d < n; ++d) {
+          double m = b[d].mid();
+          k[d] = (c >> d) & 1 ? Interval(m, b[d].hi) : Interval(b[d].lo, m);
+        }
+        Interval v = ev.eval(*tape, k.data());
+        ++evals;
+        if (v.hi < 0.0) continue;  // certified outside
+        if (v.lo >= 0.0) {         // certified inside: final
+          for (uint32_t d = 0; d < n; ++d) {
+            inLo[d] = std::min(inLo[d], k[d].lo);
+            inHi[d] = std::max(inHi[d], k[d].hi);
+          }
+          continue;
+        }
+        // Inside the inside-hull it cannot widen the result: drop it.
+        bool within = true;
+        for (uint32_t d = 0; d < n && within; ++d)
+          within = k[d].lo >= inLo[d] && k[d].hi <= inHi[d];
+        if (!within) next.push_back(std::move(k));
+      }
+    }
+    amb = std::move(next);
+  }
+  hullOf(lo, hi);
+  if (!(lo[0] <= hi[0]))
+    throw LibraryError(std::string(fn) + ": object '" + obj.name + "' is empty within ±" +
+                           num(kSearchLimit) + " (no point with f >= 0 found)" + give,
+                       argIndex);
+  for (uint32_t d = 0; d < n; ++d)
+    if (lo[d] <= -kSearchLimit || hi[d] >= kSearchLimit)
+      throw LibraryError(std::string(fn) + ": object '" + obj.name + "' is not bounded within ±" +
+                             num(kSearchLimit) + " (along x[" + std::to_string(d + 1) + "])" + give,
+                         argIndex);
+  return Bounds{lo, hi};
+}
+
+bool hasOptions(std::vector<Arg>& a, size_t fixed) {
+  return a.size() == fixed + 1 && a.back().isArray;
+}
+
+void checkArgCount(const char* fn, std::vector<Arg>& a, size_t fixed, const char* usage) {
+  if (a.size() != fixed && !hasOptions(a, fixed))
+    throw LibraryError(std::string(fn) + " takes " + usage + " (got " + std::to_string(a.size()) +
+                       " arguments)");
+}
+
+// A, B: same dimension n; returns n.
+size_t pairDims(const char* fn, const Arg& A, const Arg& B) {
+  if (A.objectDims != B.objectDims)
+    throw LibraryError(std::string(fn) + ": objects '" + A.name + "' (x[" +
+                           std::to_string(A.objectDims) + "]) and '" + B.name + "' (x[" +
+                           std::to_string(B.objectDims) + "]) have different dimensions",
+                       2);
+  return static_cast<size_t>(A.objectDims);
+}
+
+Bounds boxOf(const char* fn, const Options& o, const Arg& B, int argIndex) {
+  return o.hasBox ? o.box : autoBox(fn, B, argIndex);
+}
+
+MinkowskiOptions minkowskiOptions(const Options& o) {
+  MinkowskiOptions m;
+  static_cast<SearchOptions&>(m) = o.search;
+  return m;
+}
+
+Expr frMinkowski(std::vector<Arg>& a) {
+  const char* fn = "frMinkowski";
+  checkArgCount(fn, a, 3, "(x, A, B [, options])");
+  const Arg& A = objectArg(fn, a, 1, "A");
+  const Arg& B = objectArg(fn, a, 2, "B");
+  size_t n = pairDims(fn, A, B);
+  std::vector<Expr>& xs = coordArg(fn, a, n);
+  Options o = parseOptions(fn, a, 3, n);
+  Bounds bb = boxOf(fn, o, B, 2);
+  Expr r = guarded(fn, -1, [&] {
+    return minkowskiSum(A.value, B.value, static_cast<uint32_t>(n), bb, minkowskiOptions(o));
+  });
+  return through(r, xs, n);
+}
+
+Expr frMinkowskiDiff(std::vector<Arg>& a) {
+  const char* fn = "frMinkowskiDiff";
+  checkArgCount(fn, a, 3, "(x, A, B [, options])");
+  const Arg& A = objectArg(fn, a, 1, "A");
+  const Arg& B = objectArg(fn, a, 2, "B");
+  size_t n = pairDims(fn, A, B);
+  std::vector<Expr>& xs = coordArg(fn, a, n);
+  Options o = parseOptions(fn, a, 3, n);
+  Bounds bb = boxOf(fn, o, B, 2);
+  Expr r = guarded(fn, -1, [&] {
+    return minkowskiDifference(A.value, B.value, static_cast<uint32_t>(n), bb, o.search);
+  });
+  return through(r, xs, n);
+}
+
+Expr frOffsetR(std::vector<Arg>& a) {
+  const char* fn = "frOffsetR";
+  checkArgCount(fn, a, 3, "(x, A, r [, options])");
+  const Arg& A = objectArg(fn, a, 1, "A");
+  size_t n = static_cast<size_t>(A.objectDims);
+  std::vector<Expr>& xs = coordArg(fn, a, n);
+  double r = constArg(fn, a, 2, "the radius r");
+  Options o = parseOptions(fn, a, 3, 0);
+  if (o.hasBox) throw LibraryError("frOffsetR: the options take no box", 3);
+  Expr res = guarded(fn, 2, [&] { return offsetRadius(A.value, static_cast<uint32_t>(n), r, o.search); });
+  return through(res, xs, n);
+}
+
+Expr frMorphMinkowski(std::vector<Arg>& a) {
+  const char* fn = "frMorphMinkowski";
+  checkArgCount(fn, a, 4, "(x, A, B, t [, options])");
+  const Arg& A = objectArg(fn, a, 1, "A");
+  const Arg& B = objectArg(fn, a, 2, "B");
+  size_t n = pairDims(fn, A, B);
+  std::vector<Expr>& xs = coordArg(fn, a, n);
+  double t = constArg(fn, a, 3, "the time t");
+  if (!(t >= 0.0 && t <= 1.0)) throw LibraryError("frMorphMinkowski: t must be in [0, 1]", 3);
+  Options o = parseOptions(fn, a, 4, n);
+  Bounds bb = (t == 0.0 || t == 1.0) ? Bounds{} : boxOf(fn, o, B, 2);
+  Expr r = guarded(fn, -1, [&] {
+    return morphMinkowski(A.value, B.value, static_cast<uint32_t>(n), t, bb, minkowskiOptions(o));
+  });
+  return through(r, xs, n);
+}
+
+// frProject(x, A, d1, ..., dk [, options]): max over the coordinates d1..dk (1-based) of A.
+Expr frProject(std::vector<Arg>& a) {
+  const char* fn = "frProject";
+  bool opts = a.size() >= 4 && a.back().isArray;
+  size_t k = a.size() - 2 - (opts ? 1 : 0);
+  if (a.size() < 3 || k == 0)
+    throw LibraryError("frProject takes (x, A, d1 [, d2 ...] [, options])");
+  const Arg& A = objectArg(fn, a, 1, "A");
+  const size_t N = static_cast<size_t>(A.objectDims);
+  std::vector<uint32_t> dims;
+  for (size_t j = 0; j < k; ++j) {
+    int i = static_cast<int>(2 + j);
+    double d = constArg(fn, a, i, "a projected coordinate");
+    if (d != std::floor(d) || d < 1 || d > static_cast<double>(N))
+      throw LibraryError("frProject: coordinate " + num(d) + " is not one of object '" + A.name +
+                             "''s x[1.." + std::to_string(N) + "]",
+                         i);
+    uint32_t di = static_cast<uint32_t>(d) - 1;
+    if (std::find(dims.begin(), dims.end(), di) != dims.end())
+      throw LibraryError("frProject: coordinate " + num(d) + " is given twice", i);
+    dims.push_back(di);
+  }
+  if (k >= N)
+    throw LibraryError("frProject: projecting all " + std::to_string(N) + " coordinates of object '" +
+                           A.name + "' leaves none",
+                       2);
+  std::vector<Expr>& xs = coordArg(fn, a, N - k);
+  Options o = parseOptions(fn, a, opts ? static_cast<int>(a.size() - 1) : static_cast<int>(a.size()), k);
+  Bounds box;
+  if (o.hasBox) {
+    box = o.box;
+  } else {
+    Bounds full = autoBox(fn, A, 1);
+    for (uint32_t d : dims) {
+      box.lo.push_back(full.lo[d]);
+      box.hi.push_back(full.hi[d]);
+    }
+  }
+  Expr r = guarded(fn, -1, [&] { return project(A.value, static_cast<uint32_t>(N), dims, box, o.search); });
+  return through(r, xs, N - k);
+}
+
+// frSweep(x, A, T1, ..., Tn [, R...], t0, t1 [, options]): T, R are objects of one coordinate
+// (the time); A is time-varying when it has one more coordinate than x (its last one is t).
+Expr frSweep(std::vector<Arg>& a) {
+  const char* fn = "frSweep";
+  bool opts = !a.empty() && a.back().isArray && a.size() >= 6;
+  size_t end = a.size() - (opts ? 1 : 0);  // one past t1
+  if (end < 5)
+    throw LibraryError("frSweep takes (x, A, T1, ..., Tn [, R1 (2D) | R1, R2, R3 (3D)], t0, t1 [, options])");
+  const Arg& A = objectArg(fn, a, 1, "A");
+  if (!a[0].isArray || !a[0].array)
+    throw LibraryError("frSweep: argument 1 must be the coordinate array (x)", 0);
+  const size_t xsize = a[0].array->size();
+  const size_t N = static_cast<size_t>(A.objectDims);
+  const bool timeVarying = N == xsize + 1;
+  const size_t n = timeVarying ? N - 1 : N;
+  if (n < 1 || n > 3)
+    throw LibraryError("frSweep: object '" + A.name + "' must have 1, 2 or 3 coordinates (plus time)", 1);
+  std::vector<Expr>& xs = coordArg(fn, a, n);
+  const size_t motions = end - 4;
+  const size_t rot = n == 2 ? 1 : n == 3 ? 3 : 0;
+  if (motions != n && motions != n + rot)
+    throw LibraryError("frSweep: " + std::to_string(n) + "D motion needs " + std::to_string(n) +
+                           " translation objects" +
+                           (rot ? " (then optionally " + std::to_string(rot) + " rotation objects)" : "") +
+                           ", got " + std::to_string(motions),
+                       2);
+  Motion m;
+  for (size_t j = 0; j < motions; ++j) {
+    int i = static_cast<int>(2 + j);
+    const Arg& M = objectArg(fn, a, i, "a motion component");
+    if (M.objectDims != 1)
+      throw LibraryError("frSweep: motion object '" + M.name + "' must have x[1] (the time), not x[" +
+                             std::to_string(M.objectDims) + "]",
+                         i);
+    (j < n ? m.translation : m.rotation).push_back(M.value);
+  }
+  double t0 = constArg(fn, a, static_cast<int>(end - 2), "t0");
+  double t1 = constArg(fn, a, static_cast<int>(end - 1), "t1");
+  if (!(t0 <= t1)) throw LibraryError("frSweep: need t0 <= t1", static_cast<int>(end - 1));
+  Options o = parseOptions(fn, a, static_cast<int>(end), 0);
+  if (o.hasBox) throw LibraryError("frSweep: the options take no box", static_cast<int>(end));
+  Expr r = guarded(fn, -1, [&] { return sweep(A.value, static_cast<uint32_t>(n), m, t0, t1, o.search); });
+  return through(r, xs, n);
+}
+
+const bool registered = registerAll({
+    {"frMinkowski", "*", "A + B: max over u in box(B) of A(X - u) & B(u)", frMinkowski},
+    {"frMinkowskiDiff", "*", "A - B: min over u in box(B) of max(A(X + u), -B(u))", frMinkowskiDiff},
+    {"frOffsetR", "*", "r > 0: max over |u| <= r of A(X + u); r < 0: min", frOffsetR},
+    {"frMorphMinkowski", "*", "((1 - t) A) + (t B), t in [0, 1] constant", frMorphMinkowski},
+    {"frProject", "*", "max over the given coordinates (1-based) of A", frProject},
+    {"frSweep", "*", "max over t in [t0, t1] of A(M(t)^-1 X), M from motion objects of t", frSweep},
+});
+
+}  // namespace
+}  // namespace frep::lang

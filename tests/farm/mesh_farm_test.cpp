@@ -1,0 +1,293 @@
+// "mesh" jobs on the farm: the master in this process, real frep-worker processes. The merged
+// mesh is the in-process meshGrid's, vertex for vertex and triangle for triangle, for any worker
+// count and brick size, through a worker killed mid-job and a resume from a torn journal; the
+// mesh payload codec rejects malformed input without reading out of bounds.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include "brick.h"
+#include "farm_master.h"
+
+using namespace frep;
+using namespace frep::farm;
+
+extern char** environ;
+
+namespace {
+
+const char* kModel = R"(
+-- a block with a spherical bite: flat faces, edges, corners and a curved pocket
+my_model(x[3], a[1]) {
+  array c[3], v[3];
+  c = [0.3, 0.2, 0.4];
+  v = [-0.7, -0.6, -0.5];
+  b = hfBlock(x, v, 1.4, 1.2, 1.0);
+  ball = hfSphere(x, c, 0.45);
+  my_model = b \ ball;
+}
+)";
+
+JobSpec meshJob(int res, bool sharp = false) {
+  JobSpec j;
+  j.set_operation("mesh");
+  j.set_model_source(kModel);
+  j.set_model_name("test.hf");
+  GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, res);
+  for (int a = 0; a < 3; ++a) {
+    j.add_origin(g.origin[a]);
+    j.add_dims(g.dims[a]);
+  }
+  j.set_voxel(g.voxel);
+  if (sharp) j.mutable_mesh()->set_sharp_features(true);
+  return j;
+}
+
+void expectSameMesh(const Mesh& a, const Mesh& b) {
+  ASSERT_GT(a.triangles.size(), 1000u);
+  ASSERT_EQ(a.keys, b.keys);
+  ASSERT_EQ(a.positions, b.positions);
+  ASSERT_EQ(a.normals, b.normals);
+  ASSERT_EQ(a.triangles, b.triangles);
+}
+
+FarmOptions fast(int workers, int brick = 32) {
+  FarmOptions o;
+  o.workers = workers;
+  o.brickVoxels = brick;
+  o.heartbeatMs = 100;
+  o.liveness = 5;
+  o.workerExecutable = FREP_WORKER_PATH;
+  o.noWorkerTimeoutSec = 30;
+  return o;
+}
+
+struct WorkerProcess {
+  pid_t pid = 0;
+  WorkerProcess(const std::string& endpoint, std::vector<std::string> env = {}) {
+    std::vector<std::string> args{FREP_WORKER_PATH, "--connect", endpoint, "--threads", "1", "--log-level", "off",
+                                  "--master-timeout", "5"};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::vector<std::string> envs;
+    for (char** e = environ; *e; ++e) envs.push_back(*e);
+    for (auto& e : env) envs.push_back(e);
+    std::vector<char*> envp;
+    for (auto& e : envs) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    EXPECT_EQ(posix_spawn(&pid, FREP_WORKER_PATH, nullptr, nullptr, argv.data(), envp.data()), 0);
+  }
+  int wait() {
+    int status = 0;
+    waitpid(pid, &status, 0);
+    pid = 0;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  }
+  ~WorkerProcess() {
+    if (pid) {
+      kill(pid, SIGKILL);
+      waitpid(pid, nullptr, 0);
+    }
+  }
+};
+
+int freePort() {
+  static int next = 40000 + (getpid() % 10000) * 2;
+  return next++;
+}
+
+Mesh direct(const JobSpec& j, int brick = 0) {
+  MeshOptions mo;
+  mo.sharpFeatures = j.mesh().sharp_features();
+  return meshGrid(compileJobModel(j), gridOf(j), mo, brick);
+}
+
+}  // namespace
+
+TEST(MeshFarm, ZeroOneAndTwoWorkersGiveMeshGrid) {
+  JobSpec j = meshJob(72);
+  const Mesh ref = direct(j);
+  const MeshStats split = direct(j, 32).stats;  // shared edges are solved once per brick
+  for (int w : {0, 1, 2}) {
+    SCOPED_TRACE(w);
+    FarmOutcome o = runJob(j, fast(w));
+    expectSameMesh(ref, o.mesh);
+    EXPECT_EQ(o.report.operation, "mesh");
+    EXPECT_EQ(o.report.bricks, 27u);
+    EXPECT_EQ(o.report.bricksComputed, 27u);
+    EXPECT_EQ(o.report.vertices, ref.positions.size());
+    EXPECT_EQ(o.report.triangles, ref.triangles.size());
+    EXPECT_EQ(o.mesh.stats.rootEvals, split.rootEvals);
+    EXPECT_EQ(o.mesh.stats.cellsVisited, split.cellsVisited);
+    EXPECT_TRUE(o.report.poisoned.empty());
+    EXPECT_NE(o.report.toJson().find("\"vertices\": " + std::to_string(ref.positions.size())), std::string::npos);
+  }
+  // Another brick size, and sharp features, through two workers.
+  expectSameMesh(ref, runJob(j, fast(2, 16)).mesh);
+  JobSpec s = meshJob(48, true);
+  expectSameMesh(direct(s, 8), runJob(s, fast(2, 24)).mesh);
+}
+
+TEST(MeshFarm, WorkerKilledMidJobChangesNothing) {
+  JobSpec j = meshJob(72);
+  const Mesh ref = direct(j);
+  FarmOptions o = fast(0);
+  o.listen = "tcp://127.0.0.1:" + std::to_string(freePort());
+  FarmOutcome out;
+  std::string error;
+  std::thread master([&] {
+    try {
+      out = runJob(j, o);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  });
+  // The steady worker keeps the queue busy past the victim's liveness window (27 x 100 ms), so
+  // the victim's brick is requeued as a death, not merely copied as a straggler.
+  WorkerProcess steady(o.listen, {"FREP_TEST_SLOW_MS=100"});
+  WorkerProcess victim(o.listen, {"FREP_TEST_SLOW_MS=400"});
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));  // the victim holds a brick now
+  kill(victim.pid, SIGKILL);
+  victim.wait();
+  master.join();
+  ASSERT_EQ(error, "");
+  expectSameMesh(ref, out.mesh);
+  EXPECT_GE(out.report.deadWorkers, 1u);
+  EXPECT_GE(out.report.retries, 1u);
+}
+
+TEST(MeshFarm, ResumeFromATruncatedJournalRecomputesOnlyTheMissingBricks) {
+  JobSpec j = meshJob(72);
+  const Mesh ref = direct(j);
+  std::string journal =
+      std::filesystem::temp_directory_path() / ("frep-mesh-test-" + std::to_string(getpid()) + ".journal");
+  FarmOptions o = fast(0);
+  o.journalPath = journal;
+  FarmOutcome first = runJob(j, o);
+  expectSameMesh(ref, first.mesh);
+  // Keep the header and the first 10 records, plus a torn one, as if the master had died there.
+  {
+    std::ifstream in(journal, std::ios::binary);
+    std::string all((std::istreambuf_iterator<char>(in)), {});
+    size_t pos = 12;
+    for (int r = 0; r < 10; ++r) {
+      uint64_t size;
+      std::memcpy(&size, all.data() + pos + 12, 8);
+      pos += 20 + size;
+    }
+    std::ofstream out(journal, std::ios::binary | std::ios::trunc);
+    out.write(all.data(), std::streamsize(pos + 7));
+  }
+  o.resume = true;
+  o.workers = 2;
+  FarmOutcome resumed = runJob(j, o);
+  expectSameMesh(ref, resumed.mesh);
+  EXPECT_EQ(resumed.report.bricksFromJournal, 10u);
+  EXPECT_EQ(resumed.report.bricksComputed, 27u - 10u);
+  EXPECT_LT(resumed.report.pointEvals, first.report.pointEvals);
+  // A sample job cannot resume a mesh job's journal.
+  JobSpec sample = j;
+  sample.set_operation("sample");
+  sample.set_band(3);
+  sample.clear_mesh();
+  o.workers = 0;
+  EXPECT_THROW(runJob(sample, o), std::runtime_error);
+  std::filesystem::remove(journal);
+}
+
+TEST(MeshFarm, UnknownOperationIsRefused) {
+  JobSpec j = meshJob(24);
+  j.set_operation("render");
+  EXPECT_THROW(runJob(j, fast(0)), std::invalid_argument);
+}
+
+TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
+  JobSpec j = meshJob(40);
+  MeshPiece piece = meshRegion(compileJobModel(j), gridOf(j), {0, 0, 0}, {32, 32, 32});
+  ASSERT_GT(piece.triangles.size(), 100u);
+  piece.stats.featureCells = 7;
+  std::string s = encodeMeshPiece(piece);
+  EXPECT_LT(s.size(), piece.vertices.size() * 56 + piece.triangles.size() * 12);  // compact
+  MeshPiece back;
+  std::string err;
+  ASSERT_TRUE(decodeMeshPiece(s.data(), s.size(), back, &err)) << err;
+  EXPECT_EQ(back.regionLo, piece.regionLo);
+  ASSERT_EQ(back.vertices.size(), piece.vertices.size());
+  for (size_t i = 0; i < piece.vertices.size(); ++i) {
+    ASSERT_EQ(back.vertices[i].key, piece.vertices[i].key);
+    ASSERT_EQ(back.vertices[i].position, piece.vertices[i].position);
+    ASSERT_EQ(back.vertices[i].normal, piece.vertices[i].normal);
+  }
+  EXPECT_EQ(back.triangles, piece.triangles);
+  EXPECT_EQ(back.stats.rootEvals, piece.stats.rootEvals);
+  EXPECT_EQ(back.stats.featureCells, 7u);
+  // An empty piece round-trips too.
+  MeshPiece empty;
+  empty.regionLo = {64, 0, 8};
+  std::string e = encodeMeshPiece(empty);
+  ASSERT_TRUE(decodeMeshPiece(e.data(), e.size(), back, &err)) << err;
+  EXPECT_EQ(back.regionLo, empty.regionLo);
+  EXPECT_TRUE(back.vertices.empty() && back.triangles.empty());
+
+  EXPECT_FALSE(decodeMeshPiece(s.data(), s.size() - 1, back, &err));  // truncated
+  EXPECT_FALSE(decodeMeshPiece("FRM1", 4, back, &err));
+  EXPECT_FALSE(decodeMeshPiece((s + "x").data(), s.size() + 1, back, &err));  // trailing
+  std::string bad = s;
+  bad[0] = 'X';
+  EXPECT_FALSE(decodeMeshPiece(bad.data(), bad.size(), back, &err));  // magic (and version)
+  bad = s;
+  bad[4] = 3;  // region origin x = 3
+  EXPECT_FALSE(decodeMeshPiece(bad.data(), bad.size(), back, &err));
+  bad = s;
+  const uint32_t huge = 0x7fffffff;
+  std::memcpy(&bad[4 + 12 + 56], &huge, 4);  // vertex count beyond the size
+  EXPECT_FALSE(decodeMeshPiece(bad.data(), bad.size(), back, &err));
+  EXPECT_NE(err.find("counts"), std::string::npos) << err;
+  // Hand-made pieces: repeated key, out-of-range and degenerate triangles, non-finite values.
+  auto twoVertices = [&](EdgeKey k0, EdgeKey k1, std::array<uint32_t, 3> t, double x) {
+    MeshPiece p;
+    p.vertices.push_back(MeshVertex{k0, {x, 0, 0}, {1, 0, 0}});
+    p.vertices.push_back(MeshVertex{k1, {0, 1, 0}, {0, 1, 0}});
+    p.vertices.push_back(MeshVertex{k1 + 1, {0, 0, 1}, {0, 0, 1}});
+    p.triangles.push_back(t);
+    return encodeMeshPiece(p);
+  };
+  std::string ok = twoVertices(5, 9, {0, 1, 2}, 1);
+  EXPECT_TRUE(decodeMeshPiece(ok.data(), ok.size(), back, &err)) << err;
+  for (const std::string& m : {twoVertices(9, 9, {0, 1, 2}, 1), twoVertices(5, 9, {0, 1, 3}, 1),
+                               twoVertices(5, 9, {0, 1, 1}, 1), twoVertices(5, 9, {0, 1, 2}, NAN)})
+    EXPECT_FALSE(decodeMeshPiece(m.data(), m.size(), back, &err));
+  std::string overlong = e + std::string(11, char(0xff)) + std::string(48, '\0');  // one vertex, key > 64 bits
+  const uint32_t one = 1;
+  std::memcpy(&overlong[4 + 12 + 56], &one, 4);
+  EXPECT_FALSE(decodeMeshPiece(overlong.data(), overlong.size(), back, &err));
+  EXPECT_NE(err.find("overlong"), std::string::npos) << err;
+  // Random corruption and truncation never crash the decoder (ASan/UBSan builds check the reads)
+  // and what it accepts always satisfies mergePieces' preconditions.
+  std::mt19937 rng(11);
+  std::string small = encodeMeshPiece(meshRegion(compileJobModel(j), gridOf(j), {32, 32, 32}, {40, 40, 40}));
+  for (int k = 0; k < 3000; ++k) {
+    std::string m = (k % 2) ? small : s;
+    for (int c = 0; c < 4; ++c) m[rng() % m.size()] = char(rng());
+    if (rng() % 2) m.resize(rng() % (m.size() + 1));
+    if (decodeMeshPiece(m.data(), m.size(), back, &err)) {
+      EXPECT_NO_THROW(mergePieces({back}));
+    }
+  }
+  // Through the operation's dispatch too.
+  BrickOutput b;
+  ASSERT_TRUE(decodePayload(Operation::Mesh, s.data(), s.size(), b, &err)) << err;
+  EXPECT_EQ(b.stats.pointEvals, piece.stats.samplePointEvals + piece.stats.rootEvals + piece.stats.gradientEvals);
+  EXPECT_FALSE(decodePayload(Operation::Sample, s.data(), s.size(), b, &err));
+}
