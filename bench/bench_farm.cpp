@@ -41,12 +41,7 @@ JobSpec job(const char* source, int res) {
   j.set_operation("sample");
   j.set_model_source(source);
   j.set_model_name("bench.hf");
-  GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, res);
-  for (int a = 0; a < 3; ++a) {
-    j.add_origin(g.origin[a]);
-    j.add_dims(g.dims[a]);
-  }
-  j.set_voxel(g.voxel);
+  setGrid(j, GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, res));
   j.set_band(3);
   return j;
 }
@@ -127,7 +122,7 @@ int main() {
     o.brickVoxels = 32;
     o.workerExecutable = FREP_WORKER_PATH;
     auto t0 = std::chrono::steady_clock::now();
-    FarmOutcome out = runSampleJob(heavy, o);
+    FarmOutcome out = runJob(heavy, o);
     t[w] = seconds(t0);
     bricks = out.report.bricksComputed;
     std::printf("heavy model 192^3 (32^3 bricks), %d worker(s): %.2f s, %llu bricks, %llu point evals\n", w, t[w],
@@ -140,7 +135,7 @@ int main() {
     o.workers = 1;
     o.brickVoxels = 64;
     o.workerExecutable = FREP_WORKER_PATH;
-    FarmOutcome out = runSampleJob(job(kHeavyModel, 256), o);
+    FarmOutcome out = runJob(job(kHeavyModel, 256), o);
     brickSeconds = out.report.perWorker.begin()->second.computeSeconds / double(out.report.bricks);
     std::printf("mean compute time of a 64^3 brick (heavy model, 256^3): %.4f s\n\n", brickSeconds);
   }
@@ -158,7 +153,7 @@ int main() {
     std::vector<std::thread> ws;
     auto t0 = std::chrono::steady_clock::now();
     std::thread master([&] {
-      FarmOutcome out = runSampleJob(big, o);
+      FarmOutcome out = runJob(big, o);
       double s = seconds(t0);
       double rate = double(out.report.bricks) / s;
       std::printf("master with %2d instant fake workers: %llu bricks, %llu leaves in %.2f s = %.0f bricks/s, %.0f leaves/s\n",

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "arg_parse.h"
+#include "brick.h"
 #include "exit_codes.h"
 
 namespace frep::cli {
@@ -21,11 +22,7 @@ farm::JobSpec makeJob(const LoadedModel& m, const std::string& modelPath, const 
   for (int a : m.spec.axis) job.add_map_axis(a);
   for (double c : m.spec.constant) job.add_map_constant(c);
   job.set_iso(m.spec.iso);
-  for (int a = 0; a < 3; ++a) {
-    job.add_origin(grid.origin[a]);
-    job.add_dims(grid.dims[a]);
-  }
-  job.set_voxel(grid.voxel);
+  farm::setGrid(job, grid);
   return job;
 }
 

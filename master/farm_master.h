@@ -77,6 +77,5 @@ struct FarmOutcome {
 // operation. Throws std::invalid_argument for a bad job or options (unknown operation, brick
 // size) and std::runtime_error for setup failures (bind, journal, keys).
 FarmOutcome runJob(const JobSpec& job, const FarmOptions& options);
-inline FarmOutcome runSampleJob(const JobSpec& job, const FarmOptions& options) { return runJob(job, options); }
 
 }  // namespace frep::farm

@@ -24,6 +24,16 @@ GridSpec gridOf(const JobSpec& job) {
   return g;
 }
 
+void setGrid(JobSpec& job, const GridSpec& grid) {
+  job.clear_origin();
+  job.clear_dims();
+  for (int a = 0; a < 3; ++a) {
+    job.add_origin(grid.origin[a]);
+    job.add_dims(grid.dims[a]);
+  }
+  job.set_voxel(grid.voxel);
+}
+
 uint64_t jobIdOf(const JobSpec& job) {
   std::string bytes;
   job.SerializeToString(&bytes);  // deterministic for a given message (no maps in JobSpec)

@@ -31,8 +31,9 @@ struct BrickOutput {
   MeshPiece piece;
 };
 
-// The grid a job samples.
+// The grid a job samples, and setting it (origin, dims, voxel) on a job.
 GridSpec gridOf(const JobSpec& job);
+void setGrid(JobSpec& job, const GridSpec& grid);
 
 // Stable 64-bit id of a job (FNV-1a over its serialized spec): results are keyed by it.
 uint64_t jobIdOf(const JobSpec& job);

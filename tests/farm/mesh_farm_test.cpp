@@ -2,53 +2,21 @@
 // mesh is the in-process meshGrid's, vertex for vertex and triangle for triangle, for any worker
 // count and brick size, through a worker killed mid-job and a resume from a torn journal; the
 // mesh payload codec rejects malformed input without reading out of bounds.
-#include <gtest/gtest.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <thread>
 
-#include "brick.h"
-#include "farm_master.h"
+#include "farm_test_util.h"
 
-using namespace frep;
-using namespace frep::farm;
-
-extern char** environ;
+using namespace farmtest;
 
 namespace {
 
-const char* kModel = R"(
--- a block with a spherical bite: flat faces, edges, corners and a curved pocket
-my_model(x[3], a[1]) {
-  array c[3], v[3];
-  c = [0.3, 0.2, 0.4];
-  v = [-0.7, -0.6, -0.5];
-  b = hfBlock(x, v, 1.4, 1.2, 1.0);
-  ball = hfSphere(x, c, 0.45);
-  my_model = b \ ball;
-}
-)";
-
 JobSpec meshJob(int res, bool sharp = false) {
-  JobSpec j;
-  j.set_operation("mesh");
-  j.set_model_source(kModel);
-  j.set_model_name("test.hf");
-  GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, res);
-  for (int a = 0; a < 3; ++a) {
-    j.add_origin(g.origin[a]);
-    j.add_dims(g.dims[a]);
-  }
-  j.set_voxel(g.voxel);
+  JobSpec j = partJob("mesh", res);
   if (sharp) j.mutable_mesh()->set_sharp_features(true);
   return j;
 }
@@ -59,52 +27,6 @@ void expectSameMesh(const Mesh& a, const Mesh& b) {
   ASSERT_EQ(a.positions, b.positions);
   ASSERT_EQ(a.normals, b.normals);
   ASSERT_EQ(a.triangles, b.triangles);
-}
-
-FarmOptions fast(int workers, int brick = 32) {
-  FarmOptions o;
-  o.workers = workers;
-  o.brickVoxels = brick;
-  o.heartbeatMs = 100;
-  o.liveness = 5;
-  o.workerExecutable = FREP_WORKER_PATH;
-  o.noWorkerTimeoutSec = 30;
-  return o;
-}
-
-struct WorkerProcess {
-  pid_t pid = 0;
-  WorkerProcess(const std::string& endpoint, std::vector<std::string> env = {}) {
-    std::vector<std::string> args{FREP_WORKER_PATH, "--connect", endpoint, "--threads", "1", "--log-level", "off",
-                                  "--master-timeout", "5"};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    std::vector<std::string> envs;
-    for (char** e = environ; *e; ++e) envs.push_back(*e);
-    for (auto& e : env) envs.push_back(e);
-    std::vector<char*> envp;
-    for (auto& e : envs) envp.push_back(e.data());
-    envp.push_back(nullptr);
-    EXPECT_EQ(posix_spawn(&pid, FREP_WORKER_PATH, nullptr, nullptr, argv.data(), envp.data()), 0);
-  }
-  int wait() {
-    int status = 0;
-    waitpid(pid, &status, 0);
-    pid = 0;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  }
-  ~WorkerProcess() {
-    if (pid) {
-      kill(pid, SIGKILL);
-      waitpid(pid, nullptr, 0);
-    }
-  }
-};
-
-int freePort() {
-  static int next = 40000 + (getpid() % 10000) * 2;
-  return next++;
 }
 
 Mesh direct(const JobSpec& j, int brick = 0) {
@@ -143,7 +65,7 @@ TEST(MeshFarm, WorkerKilledMidJobChangesNothing) {
   JobSpec j = meshJob(72);
   const Mesh ref = direct(j);
   FarmOptions o = fast(0);
-  o.listen = "tcp://127.0.0.1:" + std::to_string(freePort());
+  o.listen = "tcp://127.0.0.1:" + std::to_string(freePort(40000));
   FarmOutcome out;
   std::string error;
   std::thread master([&] {

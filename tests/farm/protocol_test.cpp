@@ -27,12 +27,7 @@ JobSpec sphereJob() {
   j.set_operation("sample");
   j.set_model_source("my_model(x[3], a[1]) { my_model = 0.64 - x[1]^2 - x[2]^2 - x[3]^2; }");
   j.set_model_name("sphere.hf");
-  GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 64);
-  for (int a = 0; a < 3; ++a) {
-    j.add_origin(g.origin[a]);
-    j.add_dims(g.dims[a]);
-  }
-  j.set_voxel(g.voxel);
+  setGrid(j, GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 64));
   j.set_band(3);
   return j;
 }
@@ -75,10 +70,10 @@ TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
   JobSpec j = sphereJob();
   FarmOptions inProcess;
   inProcess.workers = 0;
-  FarmOutcome ref = runSampleJob(j, inProcess);
+  FarmOutcome ref = runJob(j, inProcess);
   std::string ep = endpoint();
   FarmOutcome out;
-  std::thread master([&] { out = runSampleJob(j, clusterOptions(ep)); });
+  std::thread master([&] { out = runJob(j, clusterOptions(ep)); });
 
   zmq::context_t ctx(1);
   zmq::socket_t rogue(ctx, zmq::socket_type::dealer);
@@ -119,7 +114,7 @@ TEST(Protocol, WorkerOfAnotherProtocolMajorIsRefusedWithAReason) {
   JobSpec j = sphereJob();
   std::string ep = endpoint();
   FarmOutcome out;
-  std::thread master([&] { out = runSampleJob(j, clusterOptions(ep)); });
+  std::thread master([&] { out = runJob(j, clusterOptions(ep)); });
   zmq::context_t ctx(1);
   zmq::socket_t peer(ctx, zmq::socket_type::dealer);
   peer.set(zmq::sockopt::linger, 0);
@@ -161,7 +156,7 @@ TEST(Protocol, CurveMasterRefusesWorkersWithoutTheKeys) {
   FarmOptions o = clusterOptions(ep);
   o.curveDir = dir.string();
   FarmOutcome out;
-  std::thread master([&] { out = runSampleJob(j, o); });
+  std::thread master([&] { out = runJob(j, o); });
   // Plain TCP: the handshake never completes, the worker gives up (75) without joining.
   EXPECT_EQ(runWorker({"--connect", ep, "--master-timeout", "1"}), 75);
   // Keys of another farm: the handshake fails, gives up too.
