@@ -588,15 +588,18 @@ class Master {
     }
     o.result.grid = grid_;
     o.result.bandVoxels = job_.band();
+    // One pass: order pointers to the bricks' leaves, then copy each leaf once (they are 2 KiB).
+    std::vector<const LeafBlock*> order;
     for (auto& out : outputs_) {
-      o.result.leaves.insert(o.result.leaves.end(), out.leaves.begin(), out.leaves.end());
+      for (const LeafBlock& l : out.leaves) order.push_back(&l);
       o.result.tiles.insert(o.result.tiles.end(), out.tiles.begin(), out.tiles.end());
-      out = BrickOutput{};
     }
-    std::sort(o.result.leaves.begin(), o.result.leaves.end(),
-              [](const LeafBlock& a, const LeafBlock& b) { return a.origin < b.origin; });
-    std::sort(o.result.tiles.begin(), o.result.tiles.end(),
-              [](const Tile& a, const Tile& b) { return a.origin < b.origin; });
+    std::sort(order.begin(), order.end(), [](const LeafBlock* a, const LeafBlock* b) { return a->origin < b->origin; });
+    o.result.leaves.reserve(order.size());
+    for (const LeafBlock* l : order) o.result.leaves.push_back(*l);
+    std::vector<LeafBlock> noLeaves;
+    sortByOrigin(noLeaves, o.result.tiles);
+    outputs_.clear();
     o.result.stats.pointEvals = report_.pointEvals;
     o.result.stats.intervalEvals = report_.intervalEvals;
     o.result.stats.nanValues = report_.nanValues;

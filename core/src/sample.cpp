@@ -115,10 +115,7 @@ class Sampler {
       res.tiles.insert(res.tiles.end(), w.tiles.begin(), w.tiles.end());
     }
     res.stats.denseEvals = uint64_t(hi_[0] - lo_[0]) * uint64_t(hi_[1] - lo_[1]) * uint64_t(hi_[2] - lo_[2]);
-    std::sort(res.leaves.begin(), res.leaves.end(),
-              [](const LeafBlock& a, const LeafBlock& b) { return a.origin < b.origin; });
-    std::sort(res.tiles.begin(), res.tiles.end(),
-              [](const Tile& a, const Tile& b) { return a.origin < b.origin; });
+    sortByOrigin(res.leaves, res.tiles);
     return res;
   }
 
@@ -295,6 +292,17 @@ class Sampler {
 };
 
 }  // namespace
+
+void sortByOrigin(std::vector<LeafBlock>& leaves, std::vector<Tile>& tiles) {
+  std::vector<uint32_t> order(leaves.size());
+  for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return leaves[a].origin < leaves[b].origin; });
+  std::vector<LeafBlock> sorted;
+  sorted.reserve(leaves.size());
+  for (uint32_t i : order) sorted.push_back(leaves[i]);
+  leaves.swap(sorted);
+  std::sort(tiles.begin(), tiles.end(), [](const Tile& a, const Tile& b) { return a.origin < b.origin; });
+}
 
 SampleResult sample(const TapePtr& tape, const GridSpec& grid, const SampleOptions& options) {
   return Sampler(tape, grid, options).run();

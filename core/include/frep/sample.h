@@ -74,4 +74,8 @@ struct SampleResult {
 
 SampleResult sample(const TapePtr& tape, const GridSpec& grid, const SampleOptions& options = {});
 
+// Puts leaves and tiles in the canonical order (by origin: x, then y, then z). Leaves are 2 KiB
+// each, so they are ordered through an index and moved once.
+void sortByOrigin(std::vector<LeafBlock>& leaves, std::vector<Tile>& tiles);
+
 }  // namespace frep
