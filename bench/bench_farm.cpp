@@ -5,6 +5,7 @@
 //     measured in 1.
 #include <chrono>
 #include <cstring>
+#include <future>
 #include <cstdio>
 #include <thread>
 #include <vector>
@@ -146,7 +147,9 @@ int main() {
   const int leavesPerBrick = 128;
   for (int fakes : {2, 8}) {
     FarmOptions o;
-    o.listen = "tcp://127.0.0.1:" + std::to_string(40000 + fakes);
+    o.listen = "tcp://127.0.0.1:*";
+    std::promise<std::string> bound;
+    o.onListening = [&](const std::string& ep) { bound.set_value(ep); };
     o.brickVoxels = 64;
     o.heartbeatMs = 500;
     std::atomic<bool> stop{false};
@@ -162,7 +165,8 @@ int main() {
       std::printf("  -> at %.4f s per brick one master keeps %.0f workers busy (goal >= 256)\n", brickSeconds,
                   rate * brickSeconds);
     });
-    for (int i = 0; i < fakes; ++i) ws.emplace_back(fakeWorker, o.listen, leavesPerBrick, std::ref(stop));
+    const std::string endpoint = bound.get_future().get();
+    for (int i = 0; i < fakes; ++i) ws.emplace_back(fakeWorker, endpoint, leavesPerBrick, std::ref(stop));
     master.join();
     stop = true;
     for (auto& w : ws) w.join();

@@ -200,6 +200,7 @@ class Master {
     router.bind(endpoint);
     endpoint = router.get(zmq::sockopt::last_endpoint);
     spdlog::info("master listening on {}", endpoint);
+    if (opt_.onListening) opt_.onListening(endpoint);
     if (opt_.progressJson)
       std::printf("{\"event\":\"listening\",\"endpoint\":\"%s\",\"bricks\":%zu}\n", endpoint.c_str(), bricks_.size()),
           std::fflush(stdout);

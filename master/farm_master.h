@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -34,6 +35,9 @@ struct FarmOptions {
   int workerThreads = 1;         // local mode: threads per worker
   int threads = 0;               // in-process mode: threads per brick (0: all cores)
   std::string logLevel = "warn"; // local mode: workers' --log-level
+  // Called once the master is bound, with the actual endpoint (tcp://127.0.0.1:* picks a free
+  // port): tests and embedders start their workers from it.
+  std::function<void(const std::string& endpoint)> onListening;
 };
 
 struct WorkerShare {

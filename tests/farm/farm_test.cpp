@@ -62,10 +62,9 @@ TEST(Farm, WorkerKilledMidBrickIsReplaced) {
   JobSpec j = job(96);
   FarmOutcome ref = runJob(j, fast(0));
   FarmOptions o = fast(0);
-  o.listen = "tcp://127.0.0.1:" + std::to_string(freePort(20000));
   MasterThread m(j, o);
-  WorkerProcess steady(o.listen, {"FREP_TEST_SLOW_MS=30"});
-  WorkerProcess victim(o.listen, {"FREP_TEST_SLOW_MS=400"});
+  WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=30"});
+  WorkerProcess victim(m.endpoint(), {"FREP_TEST_SLOW_MS=400"});
   std::this_thread::sleep_for(std::chrono::milliseconds(700));  // victim holds a brick now
   kill(victim.pid, SIGKILL);
   victim.wait();
@@ -80,10 +79,9 @@ TEST(Farm, StoppedWorkerPastLivenessThenContinuedChangesNothing) {
   JobSpec j = job(96);
   FarmOutcome ref = runJob(j, fast(0));
   FarmOptions o = fast(0);
-  o.listen = "tcp://127.0.0.1:" + std::to_string(freePort(20000));
   MasterThread m(j, o);
-  WorkerProcess steady(o.listen, {"FREP_TEST_SLOW_MS=40"});
-  WorkerProcess sleeper(o.listen, {"FREP_TEST_SLOW_MS=40"});
+  WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=40"});
+  WorkerProcess sleeper(m.endpoint(), {"FREP_TEST_SLOW_MS=40"});
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   kill(sleeper.pid, SIGSTOP);
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // > 5 x 100 ms liveness
@@ -98,10 +96,9 @@ TEST(Farm, SigtermedWorkerHandsItsBrickBack) {
   JobSpec j = job(96);
   FarmOutcome ref = runJob(j, fast(0));
   FarmOptions o = fast(0);
-  o.listen = "tcp://127.0.0.1:" + std::to_string(freePort(20000));
   MasterThread m(j, o);
-  WorkerProcess steady(o.listen, {"FREP_TEST_SLOW_MS=30"});
-  WorkerProcess leaver(o.listen, {"FREP_TEST_SLOW_MS=500"});
+  WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=30"});
+  WorkerProcess leaver(m.endpoint(), {"FREP_TEST_SLOW_MS=500"});
   std::this_thread::sleep_for(std::chrono::milliseconds(600));
   kill(leaver.pid, SIGTERM);
   EXPECT_EQ(leaver.wait(), 0);
@@ -166,13 +163,12 @@ TEST(Farm, StragglerBrickIsIssuedOnceMoreToAnIdleWorker) {
   JobSpec j = job(64);
   FarmOutcome ref = runJob(j, fast(0));
   FarmOptions o = fast(0);
-  o.listen = "tcp://127.0.0.1:" + std::to_string(freePort(20000));
   MasterThread m(j, o);
   // The slow worker joins first and takes the first bricks; the fast one finishes the rest,
   // then gets a copy of the oldest brick still running (after max(1 s, 2 x median)).
-  WorkerProcess slow(o.listen, {"FREP_TEST_SLOW_MS=4000"});
+  WorkerProcess slow(m.endpoint(), {"FREP_TEST_SLOW_MS=4000"});
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  WorkerProcess quick(o.listen);
+  WorkerProcess quick(m.endpoint());
   m.join();
   ASSERT_EQ(m.error, "");
   expectSame(ref.result, m.outcome.result);

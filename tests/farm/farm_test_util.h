@@ -8,6 +8,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
+#include <future>
 #include <string>
 #include <thread>
 #include <vector>
@@ -57,18 +60,15 @@ inline FarmOptions fast(int workers, int brick = 32) {
   return o;
 }
 
-// Loopback ports for cluster-mode tests, distinct per test process.
-inline int freePort(int base) {
-  static int next = base + (getpid() % 5000) * 2;
-  return next++;
-}
-
 // A frep-worker started by the test (as a cluster's launcher would), so the test can signal it.
 struct WorkerProcess {
   pid_t pid = 0;
-  explicit WorkerProcess(const std::string& endpoint, std::vector<std::string> env = {}) {
-    std::vector<std::string> args{FREP_WORKER_PATH, "--connect", endpoint, "--threads", "1", "--log-level", "off",
-                                  "--master-timeout", "5"};
+  explicit WorkerProcess(const std::string& endpoint, std::vector<std::string> env = {},
+                         std::vector<std::string> extra = {}) {
+    std::vector<std::string> args{FREP_WORKER_PATH, "--connect", endpoint, "--threads", "1", "--log-level", "off"};
+    if (std::find(extra.begin(), extra.end(), "--master-timeout") == extra.end())
+      args.insert(args.end(), {"--master-timeout", "5"});
+    args.insert(args.end(), extra.begin(), extra.end());
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -80,9 +80,19 @@ struct WorkerProcess {
     envp.push_back(nullptr);
     EXPECT_EQ(posix_spawn(&pid, FREP_WORKER_PATH, nullptr, nullptr, argv.data(), envp.data()), 0);
   }
-  int wait() {
+  // The exit code (128 + signal if killed); -2 if it had to be killed after timeoutSec.
+  int wait(int timeoutSec = 60) {
     int status = 0;
-    waitpid(pid, &status, 0);
+    auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(timeoutSec);
+    while (waitpid(pid, &status, WNOHANG) == 0) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        kill(pid, SIGKILL);
+        waitpid(pid, &status, 0);
+        pid = 0;
+        return -2;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
     pid = 0;
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
@@ -94,20 +104,27 @@ struct WorkerProcess {
   }
 };
 
-// The master of a job on its own thread; join() returns when the job ends.
+// The master of a job on its own thread, bound to a free loopback port (cluster mode);
+// endpoint() waits until it listens, join() until the job ends.
 struct MasterThread {
   FarmOutcome outcome;
   std::string error;
   std::thread thread;
+  std::promise<std::string> bound;
+  std::shared_future<std::string> boundFuture = bound.get_future().share();
   MasterThread(const JobSpec& j, FarmOptions o) {
+    o.listen = "tcp://127.0.0.1:*";
+    o.onListening = [this](const std::string& ep) { bound.set_value(ep); };
     thread = std::thread([this, j, o] {
       try {
         outcome = runJob(j, o);
       } catch (const std::exception& e) {
         error = e.what();
+        if (boundFuture.wait_for(std::chrono::seconds(0)) != std::future_status::ready) bound.set_value("");
       }
     });
   }
+  std::string endpoint() { return boundFuture.get(); }
   void join() { thread.join(); }
 };
 

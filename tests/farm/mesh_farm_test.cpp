@@ -64,26 +64,17 @@ TEST(MeshFarm, ZeroOneAndTwoWorkersGiveMeshGrid) {
 TEST(MeshFarm, WorkerKilledMidJobChangesNothing) {
   JobSpec j = meshJob(72);
   const Mesh ref = direct(j);
-  FarmOptions o = fast(0);
-  o.listen = "tcp://127.0.0.1:" + std::to_string(freePort(40000));
-  FarmOutcome out;
-  std::string error;
-  std::thread master([&] {
-    try {
-      out = runJob(j, o);
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-  });
+  MasterThread m(j, fast(0));
   // The steady worker keeps the queue busy past the victim's liveness window (27 x 100 ms), so
   // the victim's brick is requeued as a death, not merely copied as a straggler.
-  WorkerProcess steady(o.listen, {"FREP_TEST_SLOW_MS=100"});
-  WorkerProcess victim(o.listen, {"FREP_TEST_SLOW_MS=400"});
+  WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=100"});
+  WorkerProcess victim(m.endpoint(), {"FREP_TEST_SLOW_MS=400"});
   std::this_thread::sleep_for(std::chrono::milliseconds(700));  // the victim holds a brick now
   kill(victim.pid, SIGKILL);
   victim.wait();
-  master.join();
-  ASSERT_EQ(error, "");
+  m.join();
+  ASSERT_EQ(m.error, "");
+  const FarmOutcome& out = m.outcome;
   expectSameMesh(ref, out.mesh);
   EXPECT_GE(out.report.deadWorkers, 1u);
   EXPECT_GE(out.report.retries, 1u);

@@ -12,13 +12,11 @@
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
-#include "brick.h"
 #include "curve.h"
-#include "farm_master.h"
+#include "farm_test_util.h"
 #include "wire.h"
 
-using namespace frep;
-using namespace frep::farm;
+using namespace farmtest;
 
 namespace {
 
@@ -32,36 +30,17 @@ JobSpec sphereJob() {
   return j;
 }
 
-std::string endpoint() { return "tcp://127.0.0.1:" + std::to_string(30000 + (getpid() % 10000) * 2); }
-
-int runWorker(const std::vector<std::string>& extra, int timeoutSec = 20) {
-  std::vector<std::string> args{FREP_WORKER_PATH, "--threads", "1", "--log-level", "off"};
-  args.insert(args.end(), extra.begin(), extra.end());
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid;
-  if (posix_spawn(&pid, FREP_WORKER_PATH, nullptr, nullptr, argv.data(), environ) != 0) return -1;
-  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(timeoutSec);
-  int status = 0;
-  while (waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() > deadline) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-      return -2;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-FarmOptions clusterOptions(const std::string& ep) {
+FarmOptions clusterOptions() {
   FarmOptions o;
-  o.listen = ep;
   o.brickVoxels = 32;
   o.heartbeatMs = 100;
   o.noWorkerTimeoutSec = 20;
   return o;
+}
+
+// Runs a worker to its end; returns its exit code.
+int runWorker(const std::string& endpoint, std::vector<std::string> extra = {}) {
+  return WorkerProcess(endpoint, {}, std::move(extra)).wait(20);
 }
 
 }  // namespace
@@ -71,9 +50,8 @@ TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
   FarmOptions inProcess;
   inProcess.workers = 0;
   FarmOutcome ref = runJob(j, inProcess);
-  std::string ep = endpoint();
-  FarmOutcome out;
-  std::thread master([&] { out = runJob(j, clusterOptions(ep)); });
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
 
   zmq::context_t ctx(1);
   zmq::socket_t rogue(ctx, zmq::socket_type::dealer);
@@ -103,8 +81,10 @@ TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
   zmq::send_multipart(rogue, withPayload);
 
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  EXPECT_EQ(runWorker({"--connect", ep}), 0);  // a real worker finishes the job
+  EXPECT_EQ(runWorker(ep), 0);  // a real worker finishes the job
   master.join();
+  const FarmOutcome& out = master.outcome;
+  ASSERT_EQ(master.error, "");
   EXPECT_GE(out.report.malformed + out.report.oversized, 3u);
   EXPECT_EQ(out.result.leaves.size(), ref.result.leaves.size());
   for (size_t i = 0; i < ref.result.leaves.size(); ++i) ASSERT_EQ(out.result.leaves[i].values, ref.result.leaves[i].values);
@@ -112,9 +92,8 @@ TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
 
 TEST(Protocol, WorkerOfAnotherProtocolMajorIsRefusedWithAReason) {
   JobSpec j = sphereJob();
-  std::string ep = endpoint();
-  FarmOutcome out;
-  std::thread master([&] { out = runJob(j, clusterOptions(ep)); });
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
   zmq::context_t ctx(1);
   zmq::socket_t peer(ctx, zmq::socket_type::dealer);
   peer.set(zmq::sockopt::linger, 0);
@@ -134,8 +113,10 @@ TEST(Protocol, WorkerOfAnotherProtocolMajorIsRefusedWithAReason) {
   ASSERT_TRUE(r.ParseFromArray(reply.data(), int(reply.size())));
   ASSERT_EQ(r.body_case(), Envelope::kReject);
   EXPECT_NE(r.reject().reason().find("protocol major 2"), std::string::npos) << r.reject().reason();
-  EXPECT_EQ(runWorker({"--connect", ep}), 0);
+  EXPECT_EQ(runWorker(ep), 0);
   master.join();
+  const FarmOutcome& out = master.outcome;
+  ASSERT_EQ(master.error, "");
   EXPECT_EQ(out.report.refused, 1u);
 }
 
@@ -152,20 +133,21 @@ TEST(Protocol, CurveMasterRefusesWorkersWithoutTheKeys) {
   fs::copy_file(other / "worker.pub", intruder / "worker.pub");
   fs::copy_file(other / "worker.key", intruder / "worker.key");
   JobSpec j = sphereJob();
-  std::string ep = endpoint();
-  FarmOptions o = clusterOptions(ep);
+  FarmOptions o = clusterOptions();
   o.curveDir = dir.string();
-  FarmOutcome out;
-  std::thread master([&] { out = runJob(j, o); });
+  MasterThread master(j, o);
+  const std::string ep = master.endpoint();
   // Plain TCP: the handshake never completes, the worker gives up (75) without joining.
-  EXPECT_EQ(runWorker({"--connect", ep, "--master-timeout", "1"}), 75);
+  EXPECT_EQ(runWorker(ep, {"--master-timeout", "1"}), 75);
   // Keys of another farm: the handshake fails, gives up too.
-  EXPECT_EQ(runWorker({"--connect", ep, "--master-timeout", "1", "--curve", other.string()}), 75);
+  EXPECT_EQ(runWorker(ep, {"--master-timeout", "1", "--curve", other.string()}), 75);
   // The master's public key but an unauthorized worker key: refused by the ZAP handler.
-  EXPECT_EQ(runWorker({"--connect", ep, "--master-timeout", "1", "--curve", intruder.string()}), 75);
+  EXPECT_EQ(runWorker(ep, {"--master-timeout", "1", "--curve", intruder.string()}), 75);
   // The right keys: joins and finishes the job.
-  EXPECT_EQ(runWorker({"--connect", ep, "--curve", dir.string()}), 0);
+  EXPECT_EQ(runWorker(ep, {"--curve", dir.string()}), 0);
   master.join();
+  const FarmOutcome& out = master.outcome;
+  ASSERT_EQ(master.error, "");
   EXPECT_EQ(out.report.workersSeen, 1);
   EXPECT_GE(out.report.curveRejected, 1u);
   EXPECT_TRUE(out.report.poisoned.empty());
