@@ -118,6 +118,26 @@ Key keyOf(const Node& n) {
   return Key{n.op, n.index, vb, {n.args[0].get(), n.args[1].get(), n.args[2].get()}, n.spec.get()};
 }
 
+// Deleting a node releases its children, which may delete them in turn: on a chain of 10^5
+// nodes (an unrolled loop) plain recursion overflows the stack. Children are parked on a
+// per-thread list instead and released one at a time by the outermost deletion.
+void releaseIteratively(const Node* n) {
+  thread_local std::vector<NodePtr> parked;
+  thread_local bool draining = false;
+  Node* mut = const_cast<Node*>(n);
+  for (auto& a : mut->args)
+    if (a) parked.push_back(std::move(a));
+  delete n;  // an extremum's spec may still release its inputs here, one level deep
+  if (draining) return;
+  draining = true;
+  while (!parked.empty()) {
+    NodePtr last = std::move(parked.back());
+    parked.pop_back();
+    last.reset();  // may park more children
+  }
+  draining = false;
+}
+
 NodePtr intern(Node&& proto) {
   Key key = keyOf(proto);
   auto& t = table();
@@ -152,7 +172,7 @@ NodePtr intern(Node&& proto) {
       auto found = tt.map.find(keyOf(*n));
       if (found != tt.map.end() && found->second.expired()) tt.map.erase(found);
     }
-    delete n;
+    releaseIteratively(n);
   });
   t.map[key] = p;
   return p;

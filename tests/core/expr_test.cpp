@@ -39,3 +39,12 @@ TEST(Tape, PointEvaluatesSphere) {
   const double* out = be.eval(*tape, 10);
   for (int k = 0; k < 10; ++k) EXPECT_DOUBLE_EQ(out[k], 1.0 - (0.1 * k) * (0.1 * k));
 }
+
+TEST(Expr, VeryDeepChainsAreBuiltEvaluatedAndFreedWithoutRecursion) {
+  // 200000 nested operations: destruction must not recurse once per level.
+  Expr e = Expr::x(0);
+  for (int i = 0; i < 200000; ++i) e = sin(e) + 1.0;
+  EXPECT_EQ(e.node().depth, 400000u);
+  e = Expr();  // frees the whole chain
+  EXPECT_TRUE(e.isConst(0.0));
+}
