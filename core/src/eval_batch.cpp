@@ -7,24 +7,13 @@
 #include <cmath>
 
 #include "frep/eval.h"
+#include "frep/pow_int.h"
 #include "frep/extremum.h"
 
 namespace frep {
 
 namespace {
 
-template <typename T>
-inline T powInt(T a, int n) {
-  bool neg = n < 0;
-  unsigned m = neg ? -static_cast<unsigned>(n) : static_cast<unsigned>(n);
-  T r = 1, b = a;
-  while (m) {
-    if (m & 1u) r *= b;
-    b *= b;
-    m >>= 1;
-  }
-  return neg ? T(1) / r : r;
-}
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define FREP_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))

@@ -1,5 +1,6 @@
 // Hash-consed expression DAG: intern table, constant folding, structural rewrites.
 #include "frep/expr.h"
+#include "frep/pow_int.h"
 
 #include "frep/extremum.h"
 
@@ -188,18 +189,6 @@ NodePtr leaf(Op op, uint32_t index, double value) {
 
 bool isInt(double v) { return std::isfinite(v) && v == std::trunc(v) && std::fabs(v) < 1 << 30; }
 
-double powInt(double a, int n) {
-  // exact repeated squaring; the same in every evaluator
-  bool neg = n < 0;
-  unsigned m = neg ? -static_cast<unsigned>(n) : static_cast<unsigned>(n);
-  double r = 1.0, b = a;
-  while (m) {
-    if (m & 1u) r *= b;
-    b *= b;
-    m >>= 1;
-  }
-  return neg ? 1.0 / r : r;
-}
 
 }  // namespace
 

@@ -7,6 +7,7 @@
 //  * Bounds are computed from the same libm/IEEE operations the point evaluator uses, then
 //    pushed outward: 1 ulp for correctly rounded ops, kTransUlps for libm transcendentals.
 #include "frep/interval.h"
+#include "frep/pow_int.h"
 
 #include <algorithm>
 #include <cmath>
@@ -85,18 +86,6 @@ Interval tanInterval(const Interval& a) {
 double clamp1(double v) { return std::min(1.0, std::max(-1.0, v)); }
 double floorLog(double v) { return v > kLogFloor ? v : kLogFloor; }
 
-// powInt as the point evaluators compute it (repeated squaring).
-double powInt(double a, int n) {
-  bool neg = n < 0;
-  unsigned m = neg ? -static_cast<unsigned>(n) : static_cast<unsigned>(n);
-  double r = 1.0, b = a;
-  while (m) {
-    if (m & 1u) r *= b;
-    b *= b;
-    m >>= 1;
-  }
-  return neg ? 1.0 / r : r;
-}
 
 // Computed powInt is monotone in |x| (products of rounded monotone factors), so endpoints
 // bound every computed value; the ulp margin also covers the exact x^n (<= 2 roundings per bit).

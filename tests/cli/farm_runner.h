@@ -12,6 +12,18 @@
 
 namespace frep_cli_test {
 
+// A block with a spherical bite: faces, edges, corners and a curved pocket in most bricks.
+inline const char* kPartModel =
+    "-- a block with a spherical bite\n"
+    "my_model(x[3], a[1]) {\n"
+    "  array c[3], v[3];\n"
+    "  c = [0.3, 0.2, 0.4];\n"
+    "  v = [-0.7, -0.6, -0.5];\n"
+    "  b = hfBlock(x, v, 1.4, 1.2, 1.0);\n"
+    "  ball = hfSphere(x, c, 0.45);\n"
+    "  my_model = b \\ ball;\n"
+    "}\n";
+
 class FarmTest : public FrepTest {
  protected:
   // Starts frep in the background; returns its pid.

@@ -10,22 +10,11 @@ using namespace frep_cli_test;
 
 namespace {
 
-const char* kPart =
-    "-- a block with a spherical bite\n"
-    "my_model(x[3], a[1]) {\n"
-    "  array c[3], v[3];\n"
-    "  c = [0.3, 0.2, 0.4];\n"
-    "  v = [-0.7, -0.6, -0.5];\n"
-    "  b = hfBlock(x, v, 1.4, 1.2, 1.0);\n"
-    "  ball = hfSphere(x, c, 0.45);\n"
-    "  my_model = b \\ ball;\n"
-    "}\n";
-
 class MeshFarmCli : public FarmTest {
  protected:
   void SetUp() override {
     FarmTest::SetUp();
-    write("part.hf", kPart);
+    write("part.hf", kPartModel);
   }
   static std::string meshArgs(const std::string& out, int res = 64) {
     return "mesh part.hf -b 1 --res " + std::to_string(res) + " --no-progress --heartbeat-ms 100 -O " + out;
