@@ -155,6 +155,8 @@ class Master {
       report_.intervalEvals += out.stats.intervalEvals;
       report_.nanValues += out.stats.nanValues;
       report_.domainErrors.add(out.stats.domainErrors);
+      report_.extremumSearches += out.extremumSearches;
+      report_.extremumUncertified += out.extremumUncertified;
       auto& share = report_.perWorker[who];
       ++share.bricks;
       share.pointEvals += out.stats.pointEvals;
@@ -164,6 +166,7 @@ class Master {
 
   void runInProcess() {
     TapePtr tape = compileJobModel(job_);
+    describeErrorBounds(*tape, &report_.errorBounds);
     for (Brick& b : bricks_) {
       if (b.phase == BrickPhase::Done) continue;
       if (gStop) {
@@ -183,7 +186,7 @@ class Master {
 
   void runFarm() {
     // Compile once here too: a model that does not compile fails before any worker starts.
-    compileJobModel(job_);
+    describeErrorBounds(*compileJobModel(job_), &report_.errorBounds);
     zmq::context_t ctx(1);
     std::unique_ptr<ZapAuthenticator> zap;
     CurveKeys keys;
@@ -385,6 +388,8 @@ class Master {
     out.stats.pointEvals = r.point_evals();
     out.stats.intervalEvals = r.interval_evals();
     out.stats.nanValues = r.nan_values();
+    out.extremumSearches = r.extremum_searches();
+    out.extremumUncertified = r.extremum_uncertified();
     for (int k = 0; k < r.domain_errors_size() && k < int(kDomainErrorKinds); ++k)
       out.stats.domainErrors.n[k] = r.domain_errors(k);
     report_.perWorker[p.workerId].computeSeconds += r.compute_seconds();
@@ -644,6 +649,7 @@ std::string FarmReport::toJson() const {
   nlohmann::json dom = nlohmann::json::object();
   for (size_t k = 0; k < kDomainErrorKinds; ++k) dom[domainErrorName(DomainError(k))] = domainErrors.n[k];
   j["domain_errors"] = dom;
+  j["extremum"] = {{"searches", extremumSearches}, {"uncertified", extremumUncertified}, {"error_bounds", errorBounds}};
   j["operation"] = operation;
   if (operation == "mesh") j["output"] = {{"vertices", vertices}, {"triangles", triangles}};
   else j["output"] = {{"leaves", leaves}, {"tiles", tiles}};

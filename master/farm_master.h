@@ -62,6 +62,8 @@ struct FarmReport {
   uint64_t retries = 0, duplicates = 0, lateResults = 0, malformed = 0, oversized = 0;
   uint64_t deadWorkers = 0, handedBack = 0, stragglerReissues = 0, leaseReissues = 0, refused = 0;
   uint64_t curveRejected = 0;
+  uint64_t extremumSearches = 0, extremumUncertified = 0;
+  std::vector<std::string> errorBounds;  // one line per extremum node of the model
   int workersSeen = 0;
   std::map<std::string, WorkerShare> perWorker;  // by worker id ("in-process" for --workers 0)
   std::vector<PoisonedBrick> poisoned;

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "frep/extremum.h"
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 
@@ -87,8 +88,26 @@ namespace {
 uint64_t meshPointEvals(const MeshStats& s) { return s.samplePointEvals + s.rootEvals + s.gradientEvals; }
 }  // namespace
 
+namespace {
+BrickOutput computeBrickOnce(const TapePtr& tape, const JobSpec& job, const std::array<int32_t, 3>& lo,
+                             const std::array<int32_t, 3>& hi, int threads);
+}  // namespace
+
 BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::array<int32_t, 3>& lo,
                          const std::array<int32_t, 3>& hi, int threads) {
+  // A process computes one brick at a time, so the change of the process-wide extremum
+  // counters over the call is this brick's.
+  ExtremumCounters& c = extremumCounters();
+  const uint64_t searches = c.searches, uncertified = c.uncertified;
+  BrickOutput out = computeBrickOnce(tape, job, lo, hi, threads);
+  out.extremumSearches = c.searches - searches;
+  out.extremumUncertified = c.uncertified - uncertified;
+  return out;
+}
+
+namespace {
+BrickOutput computeBrickOnce(const TapePtr& tape, const JobSpec& job, const std::array<int32_t, 3>& lo,
+                             const std::array<int32_t, 3>& hi, int threads) {
   if (operationOf(job) == Operation::Mesh) {
     MeshOptions mo;
     mo.threads = threads;
@@ -109,6 +128,27 @@ BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::arr
   out.tiles = std::move(r.tiles);
   out.stats = r.stats;
   return out;
+}
+}  // namespace
+
+std::string describeErrorBounds(const Tape& tape, std::vector<std::string>* lines) {
+  std::string all;
+  for (const ExtremumEntry& e : tape.extrema()) {
+    const ExtremumSpec& s = *e.spec;
+    std::string line;
+    if (s.method == ExtremumMethod::Grid) {
+      // Pasko-Minkowski §4: the grid's solid M satisfies A_d + B_d ⊂ M ⊂ A + B, d = sqrt(p)/2 eps.
+      const double d = std::sqrt(double(s.numParams())) / 2.0 * s.eps;
+      line = "grid search (eps " + std::to_string(s.eps) + " over " + std::to_string(s.numParams()) +
+             " parameters): set inclusion A_d + B_d in M in A + B with d = " + std::to_string(d);
+    } else {
+      line = "branch-and-bound: value certified within " + std::to_string(s.tolerance) +
+             " (searches that ran out of boxes are counted as uncertified)";
+    }
+    if (lines) lines->push_back(line);
+    all += (all.empty() ? "" : "; ") + line;
+  }
+  return all;
 }
 
 namespace {

@@ -28,6 +28,7 @@ struct BrickOutput {
   std::vector<LeafBlock> leaves;
   std::vector<Tile> tiles;
   SampleStats stats;
+  uint64_t extremumSearches = 0, extremumUncertified = 0;  // this brick's extremum searches
   MeshPiece piece;
 };
 
@@ -51,6 +52,9 @@ class ModelCache {
   std::mutex mutex_;
   std::unordered_map<uint64_t, TapePtr> tapes_;
 };
+
+// The error bound of each extremum node of a model (one line each, for the job report).
+std::string describeErrorBounds(const Tape& tape, std::vector<std::string>* lines);
 
 // Computes the region [lo, hi) of the job's grid: samples it ("sample") or meshes its cells
 // ("mesh", core meshRegion with the job's MeshSpec). threads: 0 = all cores; never changes the

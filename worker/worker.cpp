@@ -147,6 +147,8 @@ class ComputeThread {
       r->set_payload_crc32(crc32Of(out.payload.data(), out.payload.size()));
       r->set_compute_seconds(secs);
       for (uint64_t n : b.stats.domainErrors.n) r->add_domain_errors(n);
+      r->set_extremum_searches(b.extremumSearches);
+      r->set_extremum_uncertified(b.extremumUncertified);
     } catch (const std::exception& e) {
       Failed* f = out.env.mutable_failed();
       f->set_brick_id(task.brick_id());

@@ -175,3 +175,26 @@ TEST(Farm, StragglerBrickIsIssuedOnceMoreToAnIdleWorker) {
   EXPECT_GE(m.outcome.report.stragglerReissues, 1u);
   EXPECT_EQ(m.outcome.report.retries, 0u);  // nothing failed: the copies were backups
 }
+
+TEST(Farm, ExtremumModelsReportTheirSearchesAndErrorBounds) {
+  // A ball of radius 0.5 offset by 0.25 (a max over a ball of radius 0.25: Pasko-Survey offset
+  // 3), branch-and-bound to within 0.05.
+  JobSpec j;
+  j.set_operation("sample");
+  j.set_model_source(R"(
+ball(x[3], a[1]) { ball = 0.25 - x[1]^2 - x[2]^2 - x[3]^2; }
+my_model(x[3], a[1]) { array o[2]; o = [0, 0.05]; my_model = frOffsetR(x, ball, 0.25, o); }
+)");
+  j.set_model_name("offset.hf");
+  setGrid(j, GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 16));
+  j.set_band(1);
+  FarmOutcome in = runJob(j, fast(0, 8)), farm = runJob(j, fast(2, 8));
+  expectSame(in.result, farm.result);
+  EXPECT_GT(in.report.extremumSearches, 0u);
+  EXPECT_EQ(farm.report.extremumSearches, in.report.extremumSearches);
+  EXPECT_EQ(farm.report.extremumUncertified, 0u);
+  ASSERT_EQ(farm.report.errorBounds.size(), 1u);
+  EXPECT_NE(farm.report.errorBounds[0].find("branch-and-bound: value certified within 0.05"), std::string::npos)
+      << farm.report.errorBounds[0];
+  EXPECT_NE(farm.report.toJson().find("\"error_bounds\""), std::string::npos);
+}
