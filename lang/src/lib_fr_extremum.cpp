@@ -223,8 +223,9 @@ MinkowskiOptions minkowskiOptions(const Options& o) {
   return m;
 }
 
-Expr frMinkowski(std::vector<Arg>& a) {
-  const char* fn = "frMinkowski";
+// fn(x, A, B [, options]) for an operation on two objects of one dimension, searching over B.
+template <typename Build>
+Expr objectPair(const char* fn, std::vector<Arg>& a, Build build) {
   checkArgCount(fn, a, 3, "(x, A, B [, options])");
   const Arg& A = objectArg(fn, a, 1, "A");
   const Arg& B = objectArg(fn, a, 2, "B");
@@ -232,25 +233,21 @@ Expr frMinkowski(std::vector<Arg>& a) {
   std::vector<Expr>& xs = coordArg(fn, a, n);
   Options o = parseOptions(fn, a, 3, n);
   Bounds bb = boxOf(fn, o, B, 2);
-  Expr r = guarded(fn, -1, [&] {
-    return minkowskiSum(A.value, B.value, static_cast<uint32_t>(n), bb, minkowskiOptions(o));
-  });
+  Expr r = guarded(fn, -1, [&] { return build(A.value, B.value, static_cast<uint32_t>(n), bb, o); });
   return through(r, xs, n);
 }
 
-Expr frMinkowskiDiff(std::vector<Arg>& a) {
-  const char* fn = "frMinkowskiDiff";
-  checkArgCount(fn, a, 3, "(x, A, B [, options])");
-  const Arg& A = objectArg(fn, a, 1, "A");
-  const Arg& B = objectArg(fn, a, 2, "B");
-  size_t n = pairDims(fn, A, B);
-  std::vector<Expr>& xs = coordArg(fn, a, n);
-  Options o = parseOptions(fn, a, 3, n);
-  Bounds bb = boxOf(fn, o, B, 2);
-  Expr r = guarded(fn, -1, [&] {
-    return minkowskiDifference(A.value, B.value, static_cast<uint32_t>(n), bb, o.search);
+Expr frMinkowski(std::vector<Arg>& a) {
+  return objectPair("frMinkowski", a, [](const Expr& A, const Expr& B, uint32_t n, const Bounds& bb, const Options& o) {
+    return minkowskiSum(A, B, n, bb, minkowskiOptions(o));
   });
-  return through(r, xs, n);
+}
+
+Expr frMinkowskiDiff(std::vector<Arg>& a) {
+  return objectPair("frMinkowskiDiff", a,
+                    [](const Expr& A, const Expr& B, uint32_t n, const Bounds& bb, const Options& o) {
+                      return minkowskiDifference(A, B, n, bb, o.search);
+                    });
 }
 
 Expr frOffsetR(std::vector<Arg>& a) {

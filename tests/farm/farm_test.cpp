@@ -127,19 +127,7 @@ TEST(Farm, ResumeRecomputesOnlyUnjournaledBricks) {
   FarmOptions o = fast(0);
   o.journalPath = journal;
   FarmOutcome first = runJob(j, o);
-  // Keep the header and the first 10 records, as if the master had died there.
-  {
-    std::ifstream in(journal, std::ios::binary);
-    std::string all((std::istreambuf_iterator<char>(in)), {});
-    size_t pos = 12;
-    for (int r = 0; r < 10; ++r) {
-      uint64_t size;
-      std::memcpy(&size, all.data() + pos + 12, 8);
-      pos += 20 + size;
-    }
-    std::ofstream out(journal, std::ios::binary | std::ios::trunc);
-    out.write(all.data(), std::streamsize(pos + 7));  // plus a torn record
-  }
+  tearJournal(journal, 10, 7);  // the first 10 records and a torn one
   o.resume = true;
   FarmOutcome resumed = runJob(j, o);
   expectSame(ref.result, resumed.result);

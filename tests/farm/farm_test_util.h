@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
+#include <fstream>
 #include <future>
 #include <string>
 #include <thread>
@@ -58,6 +60,21 @@ inline FarmOptions fast(int workers, int brick = 32) {
   o.workerExecutable = FREP_WORKER_PATH;
   o.noWorkerTimeoutSec = 30;
   return o;
+}
+
+// Cuts a journal after its header and first `records` records, plus `tornBytes` of the next
+// one, as if the master had died while writing it.
+inline void tearJournal(const std::string& path, int records, size_t tornBytes) {
+  std::ifstream in(path, std::ios::binary);
+  std::string all((std::istreambuf_iterator<char>(in)), {});
+  size_t pos = 12;  // magic + job id
+  for (int r = 0; r < records; ++r) {
+    uint64_t size;
+    std::memcpy(&size, all.data() + pos + 12, 8);  // brick id, crc, size
+    pos += 20 + size;
+  }
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(all.data(), std::streamsize(pos + tornBytes));
 }
 
 // A frep-worker started by the test (as a cluster's launcher would), so the test can signal it.

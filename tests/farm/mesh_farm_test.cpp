@@ -89,19 +89,7 @@ TEST(MeshFarm, ResumeFromATruncatedJournalRecomputesOnlyTheMissingBricks) {
   o.journalPath = journal;
   FarmOutcome first = runJob(j, o);
   expectSameMesh(ref, first.mesh);
-  // Keep the header and the first 10 records, plus a torn one, as if the master had died there.
-  {
-    std::ifstream in(journal, std::ios::binary);
-    std::string all((std::istreambuf_iterator<char>(in)), {});
-    size_t pos = 12;
-    for (int r = 0; r < 10; ++r) {
-      uint64_t size;
-      std::memcpy(&size, all.data() + pos + 12, 8);
-      pos += 20 + size;
-    }
-    std::ofstream out(journal, std::ios::binary | std::ios::trunc);
-    out.write(all.data(), std::streamsize(pos + 7));
-  }
+  tearJournal(journal, 10, 7);  // the first 10 records and a torn one
   o.resume = true;
   o.workers = 2;
   FarmOutcome resumed = runJob(j, o);
