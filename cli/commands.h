@@ -64,8 +64,9 @@ struct MeshRequest {
   ModelRequest model;
   RegionRequest region;
   FarmRequest farm;
-  int threads = 0;     // threads of the in-process run (--workers 0); 0: all cores
-  bool sharp = false;  // --sharp: MeshOptions::sharpFeatures
+  int threads = 0;         // threads of the in-process run (--workers 0); 0: all cores
+  double tolerance = -1;   // --tolerance, voxels (SimplifyOptions); < 0: the default (0.1, 0 for a .vdb)
+  bool noSharp = false;    // --no-sharp: SimplifyOptions::sharpFeatures = false
   std::string logLevel = "info";
 };
 int runMesh(const MeshRequest& request);

@@ -63,8 +63,10 @@ farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& 
 
 void writeReport(AtomicOutput& reportOut, const farm::FarmReport& report) {
   {
+    farm::FarmReport final = report;
+    final.peakRssBytes = farm::peakRssBytes();  // after the output was written
     std::ofstream r(reportOut.tempPath());
-    r << report.toJson() << "\n";
+    r << final.toJson() << "\n";
     if (!r) throw ioError("cannot write " + reportOut.tempPath());
   }
   reportOut.commit();

@@ -25,7 +25,8 @@ farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, cons
 // Runs the job: std::invalid_argument -> exit 2, std::runtime_error -> exit 7 (farm error).
 farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& options);
 
-// Writes report.toJson() to the report's temporary file and commits it.
+// Writes report.toJson(), with peak_rss_bytes refreshed (after the output was written), to the
+// report's temporary file and commits it.
 void writeReport(AtomicOutput& reportOut, const farm::FarmReport& report);
 
 // An interrupted or poisoned job: writes the report and throws CliError with exit 6 (resume) or

@@ -142,13 +142,18 @@ int main(int argc, char** argv) {
   addFarmOptions(sampleCmd, sample.farm);
 
   MeshRequest mesh;
-  CLI::App* meshCmd = app.add_subcommand("mesh", "Watertight triangle mesh of a model's surface (on the farm)");
+  CLI::App* meshCmd = app.add_subcommand("mesh", "Watertight triangle mesh of a model's surface (on the farm), or of the "
+                                               "float grid of a .vdb written by frep sample (-o names the grid)");
   addModelOptions(meshCmd, mesh.model, true);
   addRegionOptions(meshCmd, mesh.region, "Output mesh: .ply (binary), .obj or .stl (binary)", 128);
   meshCmd->add_option("--threads", mesh.threads,
                       "Threads of the in-process run, --workers 0 (default 0: all cores; same output)");
   addFarmOptions(meshCmd, mesh.farm);
-  meshCmd->add_flag("--sharp", mesh.sharp, "Experimental: QEF vertices on edges and corners (docs/mesh.md)");
+  meshCmd->add_option("--tolerance", mesh.tolerance,
+                      "Adaptive simplification: the largest distance from the surface it may add, in voxels "
+                      "(default 0.1; 0 keeps every triangle of the marching tetrahedra)");
+  meshCmd->add_flag("--no-sharp", mesh.noSharp,
+                    "Keep merged vertices on the mesher's vertices instead of the model's edges and corners");
 
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");

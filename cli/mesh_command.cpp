@@ -4,6 +4,7 @@
 // pieces by global edge keys), so the file does not depend on --workers, --brick or --threads.
 #include <spdlog/spdlog.h>
 
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -15,15 +16,94 @@
 #include "exit_codes.h"
 #include "farm_job.h"
 #include "frep/mesh.h"
+#include "frep/mesh_simplify.h"
 #include "mesh_writer.h"
+#include "frep/mesh_grid.h"
 #include "sampling_grid.h"
+#include "vdb_reader.h"
 
 namespace frep::cli {
 
-int runMesh(const MeshRequest& request) {
+namespace {
+
+bool hasVdbExtension(const std::string& path) {
+  auto dot = path.find_last_of('.');
+  if (dot == std::string::npos || path.find('/', dot) != std::string::npos) return false;
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == "vdb";
+}
+
+// frep mesh input.vdb: the sampled values of a FloatGrid (frep sample's output) meshed in-process
+// by the core's meshSamples, the same marching tetrahedra as the model mesher (docs/mesh.md).
+int runMeshVdb(const MeshRequest& request) {
   if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj or .stl) is required");
   MeshFormat format = meshFormatFromPath("-O/--out", request.region.out);
   if (request.threads < 0) throw badArgs("--threads: expected 0 (all cores) or more, got " + std::to_string(request.threads));
+  // The grid's extent and transform are the file's; the model options have nothing to act on.
+  const std::string input = "'" + request.model.path + "' is a .vdb: its grid and transform are used as stored";
+  if (!request.region.bounds.empty()) throw badArgs("-b/--bounds: " + input);
+  if (request.region.res != 0 || !request.region.cells.empty()) throw badArgs("--res/-g: " + input);
+  if (!request.model.params.empty()) throw badArgs("-a/--params: " + input + " (parameters were bound by frep sample)");
+  if (!request.model.mapping.empty()) throw badArgs("-x/--map: " + input);
+  if (request.model.iso != 0.0) throw badArgs("-i/--iso: " + input + " (sample the model with -i instead)");
+  if (request.tolerance > 0 || request.noSharp)
+    throw badArgs("--tolerance/--no-sharp: simplification checks every change against the model; a .vdb has none");
+  if (!request.farm.listen.empty() || request.farm.expectWorkers != 0 || request.farm.resume ||
+      !request.farm.curveDir.empty())
+    throw badArgs("--listen/--expect-workers/--resume/--curve: a .vdb is meshed in-process (use --threads)");
+
+  AtomicOutput out("-O/--out", request.region.out);
+  const auto start = std::chrono::steady_clock::now();
+  SampledVdb vdb = readSampledVdb(request.model.path, request.model.object);
+  const double readSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  spdlog::info("meshing grid '{}' of {}: {} leaves, {}", vdb.gridName, request.model.path, vdb.samples.leaves.size(),
+               vdb.transformDescription);
+  SampledMeshOptions options;
+  options.threads = request.threads;
+  SampledMesh sm = meshSamples(vdb.samples, options);
+  const size_t leaves = vdb.samples.leaves.size();
+  vdb.samples = SampleResult{};  // the values are no longer needed
+  Mesh& mesh = sm.mesh;
+  if (vdb.toWorld) vdb.toWorld(mesh);
+  const double meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - readSeconds;
+  if (sm.incompleteCells)
+    spdlog::warn("{} crossed cell(s) have a corner outside the active band (only its sign stored): left out, so the "
+                 "mesh has holes there; sample with a band of at least 1 voxel",
+                 sm.incompleteCells);
+  if (mesh.triangles.empty()) spdlog::warn("grid '{}' has no sign change between active voxels: the mesh is empty", vdb.gridName);
+  std::string comment = "frep mesh of grid '" + vdb.gridName + "' in " + request.model.path +
+                        " (sampled values); normals point outward (decreasing f)";
+  writeMesh(out.tempPath(), mesh, format, comment);
+  out.commit();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  const MeshStats& s = mesh.stats;
+  std::ostream& text = request.farm.json ? std::cerr : std::cout;
+  text << "wrote " << request.region.out << " (" << meshFormatName(format) << "): " << mesh.positions.size()
+       << " vertices, " << mesh.triangles.size() << " triangles\n"
+       << "  from grid '" << vdb.gridName << "' of " << request.model.path << ": " << leaves << " leaves, "
+       << vdb.transformDescription << "\n"
+       << "  cells examined " << s.cellsVisited << ", crossed " << s.cellsCrossed << ", left out " << sm.incompleteCells
+       << "\n"
+       << "  time " << formatNumber(std::round(readSeconds * 1000) / 1000) << " s reading, "
+       << formatNumber(std::round(meshSeconds * 1000) / 1000) << " s meshing, "
+       << formatNumber(std::round(seconds * 1000) / 1000) << " s in all\n";
+  if (request.farm.json)
+    std::cout << "{\"event\":\"done\",\"output\":\"" << request.region.out << "\"}\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+int runMesh(const MeshRequest& request) {
+  if (hasVdbExtension(request.model.path)) return runMeshVdb(request);
+  if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj or .stl) is required");
+  MeshFormat format = meshFormatFromPath("-O/--out", request.region.out);
+  if (request.threads < 0) throw badArgs("--threads: expected 0 (all cores) or more, got " + std::to_string(request.threads));
+  if (request.tolerance < 0 && request.tolerance != -1)
+    throw badArgs("--tolerance: expected 0 (no simplification) or more voxels, got " + formatNumber(request.tolerance));
+  if (!std::isfinite(request.tolerance)) throw badArgs("--tolerance: expected a finite number of voxels");
   farm::FarmOptions options = farmOptions(request.farm, request.region.out, request.logLevel, request.threads);
   Box box = request.region.bounds.empty() ? Box{} : parseBounds("-b/--bounds", request.region.bounds);
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);
@@ -39,15 +119,27 @@ int runMesh(const MeshRequest& request) {
   AtomicOutput out("-O/--out", request.region.out);
   AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
   farm::JobSpec job = makeJob(m, request.model.path, grid, "mesh");
-  job.mutable_mesh()->set_sharp_features(request.sharp);
   spdlog::info("meshing '{}' on {}x{}x{} points of {}", m.model.objectName, grid.dims[0], grid.dims[1], grid.dims[2],
                grid.voxel);
   const auto start = std::chrono::steady_clock::now();
   farm::FarmOutcome outcome = runFarmJob(job, options);
-  const farm::FarmReport& report = outcome.report;
+  farm::FarmReport& report = outcome.report;
   requireComplete(reportOut, report);
-  const Mesh& mesh = outcome.mesh;
+  Mesh& mesh = outcome.mesh;
   const double meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Adaptive simplification of the merged mesh, here in the master: deterministic, so the file
+  // still does not depend on the split (docs/mesh.md).
+  SimplifyOptions so;
+  so.tolerance = request.tolerance < 0 ? 0.1 : request.tolerance;
+  so.sharpFeatures = !request.noSharp;
+  SimplifyStats ss = simplifyMesh(mesh, Tape::compile(m.field, 3), grid, so);
+  report.simplifyTolerance = so.tolerance;
+  report.sharpFeatures = so.sharpFeatures;
+  report.simplify = ss;
+  report.vertices = mesh.positions.size();
+  report.triangles = mesh.triangles.size();
+  const double simplifySeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - meshSeconds;
   std::string comment = "frep mesh of '" + m.model.objectName + "', grid " + std::to_string(grid.dims[0]) + "x" +
                         std::to_string(grid.dims[1]) + "x" + std::to_string(grid.dims[2]) + " voxel " +
                         formatNumber(grid.voxel) + "; normals point outward (decreasing f)";
@@ -66,7 +158,11 @@ int runMesh(const MeshRequest& request) {
        << formatNumber(grid.voxel) << ", cells examined " << s.cellsVisited << " ("
        << formatNumber(std::round(1e4 * double(s.cellsVisited) / dense) / 100) << "% of " << uint64_t(dense)
        << "), crossed " << s.cellsCrossed << "\n"
-       << (request.sharp ? "  feature vertices " + std::to_string(s.featureCells) + "\n" : std::string())
+       << (so.tolerance > 0 ? "  simplified from " + std::to_string(ss.trianglesBefore) + " triangles (tolerance " +
+                                  formatNumber(so.tolerance) + " voxel, sharp features " +
+                                  (so.sharpFeatures ? "on" : "off") + "): error bound " +
+                                  formatNumber(ss.errorBound) + ", " + formatNumber(std::round(simplifySeconds * 1000) / 1000) + " s\n"
+                            : std::string())
        << "  evaluations: grid points " << s.samplePointEvals << ", root finding " << s.rootEvals << ", gradients "
        << s.gradientEvals << "\n"
        << "  time " << formatNumber(std::round(meshSeconds * 1000) / 1000) << " s meshing, "

@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <vector>
 
 #include "exit_codes.h"
@@ -17,33 +16,59 @@ namespace frep::cli {
 
 namespace {
 
+// Little-endian bytes streamed to the file through a 1 MiB buffer: the file is never held in
+// memory whole (a 512^3 mesh's PLY is ~0.4 GB), so writing adds nothing proportional to it.
 class Bytes {
  public:
-  void u8(uint8_t v) { buf_.push_back(char(v)); }
+  explicit Bytes(const std::string& path) : path_(path), file_(std::fopen(path.c_str(), "wb")) {
+    if (!file_) throw ioError("cannot write " + path);
+    buf_.reserve(kChunk + 256);
+  }
+  ~Bytes() {
+    if (file_) std::fclose(file_);
+  }
+  Bytes(const Bytes&) = delete;
+  Bytes& operator=(const Bytes&) = delete;
+
+  void u8(uint8_t v) { put(char(v)); }
   void u16(uint16_t v) {
-    for (int i = 0; i < 2; ++i) buf_.push_back(char((v >> (8 * i)) & 0xff));
+    for (int i = 0; i < 2; ++i) put(char((v >> (8 * i)) & 0xff));
   }
   void u32(uint32_t v) {
-    for (int i = 0; i < 4; ++i) buf_.push_back(char((v >> (8 * i)) & 0xff));
+    for (int i = 0; i < 4; ++i) put(char((v >> (8 * i)) & 0xff));
   }
   void f32(float f) {
     uint32_t v;
     std::memcpy(&v, &f, 4);
     u32(v);
   }
-  void text(const std::string& s) { buf_.insert(buf_.end(), s.begin(), s.end()); }
-  const std::vector<char>& data() const { return buf_; }
+  void text(const std::string& s) { text(s.data(), s.size()); }
+  void text(const char* s, size_t n) {
+    buf_.insert(buf_.end(), s, s + n);
+    if (buf_.size() >= kChunk) drain();
+  }
+  void close() {
+    drain();
+    FILE* f = file_;
+    file_ = nullptr;
+    if (!ok_ || std::fclose(f) != 0) throw ioError("cannot write " + path_);
+  }
 
  private:
+  static constexpr size_t kChunk = size_t(1) << 20;
+  void put(char c) {
+    buf_.push_back(c);
+    if (buf_.size() >= kChunk) drain();
+  }
+  void drain() {
+    if (!buf_.empty() && std::fwrite(buf_.data(), 1, buf_.size(), file_) != buf_.size()) ok_ = false;
+    buf_.clear();
+  }
+  std::string path_;
+  FILE* file_;
   std::vector<char> buf_;
+  bool ok_ = true;
 };
-
-void save(const std::string& path, const std::vector<char>& data) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(data.data(), std::streamsize(data.size()));
-  out.close();
-  if (!out) throw ioError("cannot write " + path);
-}
 
 // One line, no control characters (headers are line-based).
 std::string oneLine(const std::string& s) {
@@ -53,8 +78,7 @@ std::string oneLine(const std::string& s) {
   return r;
 }
 
-std::vector<char> ply(const Mesh& m, const std::string& comment) {
-  Bytes b;
+void ply(Bytes& b, const Mesh& m, const std::string& comment) {
   b.text("ply\nformat binary_little_endian 1.0\n");
   if (!comment.empty()) b.text("comment " + oneLine(comment) + "\n");
   b.text("element vertex " + std::to_string(m.positions.size()) + "\n");
@@ -70,31 +94,27 @@ std::vector<char> ply(const Mesh& m, const std::string& comment) {
     b.u8(3);
     for (uint32_t v : t) b.u32(v);
   }
-  return b.data();
 }
 
-std::vector<char> obj(const Mesh& m, const std::string& comment) {
-  Bytes b;
+void obj(Bytes& b, const Mesh& m, const std::string& comment) {
   if (!comment.empty()) b.text("# " + oneLine(comment) + "\n");
   char line[160];
   for (const auto& p : m.positions) {
     std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", double(float(p[0])), double(float(p[1])), double(float(p[2])));
-    b.text(line);
+    b.text(line, std::strlen(line));
   }
   for (const auto& n : m.normals) {
     std::snprintf(line, sizeof line, "vn %.9g %.9g %.9g\n", double(float(n[0])), double(float(n[1])), double(float(n[2])));
-    b.text(line);
+    b.text(line, std::strlen(line));
   }
   for (const auto& t : m.triangles) {  // OBJ indices are 1-based
     std::snprintf(line, sizeof line, "f %u//%u %u//%u %u//%u\n", t[0] + 1, t[0] + 1, t[1] + 1, t[1] + 1, t[2] + 1,
                   t[2] + 1);
-    b.text(line);
+    b.text(line, std::strlen(line));
   }
-  return b.data();
 }
 
-std::vector<char> stl(const Mesh& m, const std::string& comment) {
-  Bytes b;
+void stl(Bytes& b, const Mesh& m, const std::string& comment) {
   // 80-byte header; it must not start with "solid" (readers would take the file for ASCII).
   std::string header = "binary STL " + oneLine(comment);
   header.resize(80, ' ');
@@ -122,7 +142,6 @@ std::vector<char> stl(const Mesh& m, const std::string& comment) {
       for (int c = 0; c < 3; ++c) b.f32(p[v][c]);
     b.u16(0);
   }
-  return b.data();
 }
 
 }  // namespace
@@ -147,11 +166,13 @@ const char* meshFormatName(MeshFormat format) {
 }
 
 void writeMesh(const std::string& path, const Mesh& mesh, MeshFormat format, const std::string& comment) {
+  Bytes b(path);
   switch (format) {
-    case MeshFormat::Ply: save(path, ply(mesh, comment)); break;
-    case MeshFormat::Obj: save(path, obj(mesh, comment)); break;
-    case MeshFormat::Stl: save(path, stl(mesh, comment)); break;
+    case MeshFormat::Ply: ply(b, mesh, comment); break;
+    case MeshFormat::Obj: obj(b, mesh, comment); break;
+    case MeshFormat::Stl: stl(b, mesh, comment); break;
   }
+  b.close();
 }
 
 }  // namespace frep::cli

@@ -1,5 +1,7 @@
 #include "vdb_writer.h"
 
+#include "vdb_grid.h"
+
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Prune.h>
 
@@ -97,7 +99,7 @@ std::string hex(uint64_t v) {
 
 }  // namespace
 
-void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta) {
+openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result) {
   openvdb::initialize();
   const GridSpec& g = result.grid;
   const float background = float(result.bandVoxels * g.voxel);
@@ -112,6 +114,12 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
   xform->postTranslate(openvdb::Vec3d(g.origin[0], g.origin[1], g.origin[2]));
   grid->setTransform(xform);
   grid->setGridClass(openvdb::GRID_LEVEL_SET);
+  return grid;
+}
+
+void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta) {
+  openvdb::FloatGrid::Ptr grid = levelSetGrid(result);
+  const float background = float(result.bandVoxels * result.grid.voxel);
   grid->setName(meta.gridName);
   grid->insertMeta("frep_sign", openvdb::StringMetadata("value = -f"));
   grid->insertMeta("frep_operation", openvdb::StringMetadata("sample"));

@@ -1,5 +1,5 @@
-// Sampler output -> OpenVDB level set file. The only translation unit that includes OpenVDB
-// (its headers take ~25 s to compile).
+// Sampler output -> OpenVDB level set file. This header does not include OpenVDB (its headers
+// take ~25 s to compile); vdb_writer.cpp does, and vdb_grid.h exposes the grid it builds.
 #pragma once
 
 #include <cstdint>

@@ -2,6 +2,7 @@
 #include "farm_master.h"
 
 #include <spdlog/spdlog.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <atomic>
@@ -17,6 +18,7 @@
 
 #include "brick.h"
 #include "curve.h"
+#include "frep/mesh_merge.h"
 #include "journal.h"
 #include "local_workers.h"
 #include "progress.h"
@@ -584,11 +586,13 @@ class Master {
     report_.operation = op_ == Operation::Mesh ? "mesh" : "sample";
     if (op_ == Operation::Mesh && done_ == bricks_.size()) {
       // The merge step of a mesh job: the pieces stitched by global edge key (split-invariant).
+      // mergePiecesReleasing frees each piece as soon as it is stitched: the master holds about
+      // one copy of the output mesh instead of three (the same mesh as mergePieces).
       std::vector<MeshPiece> pieces;
       pieces.reserve(outputs_.size());
       for (auto& out : outputs_) pieces.push_back(std::move(out.piece));
       outputs_.clear();
-      o.mesh = mergePieces(pieces);
+      o.mesh = mergePiecesReleasing(pieces);
       report_.vertices = o.mesh.positions.size();
       report_.triangles = o.mesh.triangles.size();
     }
@@ -613,6 +617,7 @@ class Master {
     o.result.stats.denseEvals = uint64_t(grid_.dims[0]) * grid_.dims[1] * grid_.dims[2];
     report_.denseEvals = o.result.stats.denseEvals;
     report_.wallSeconds = std::chrono::duration<double>(Clock::now() - start_).count();
+    report_.peakRssBytes = peakRssBytes();
     o.report = report_;
     return o;
   }
@@ -643,6 +648,7 @@ class Master {
 std::string FarmReport::toJson() const {
   nlohmann::json j;
   j["wall_seconds"] = wallSeconds;
+  j["peak_rss_bytes"] = peakRssBytes;
   j["bricks"] = {{"total", bricks}, {"computed", bricksComputed}, {"from_journal", bricksFromJournal}};
   j["evaluations"] = {{"point", pointEvals}, {"interval", intervalEvals}, {"dense_equivalent", denseEvals},
                       {"nan_values", nanValues}};
@@ -651,7 +657,20 @@ std::string FarmReport::toJson() const {
   j["domain_errors"] = dom;
   j["extremum"] = {{"searches", extremumSearches}, {"uncertified", extremumUncertified}, {"error_bounds", errorBounds}};
   j["operation"] = operation;
-  if (operation == "mesh") j["output"] = {{"vertices", vertices}, {"triangles", triangles}};
+  if (operation == "mesh") {
+    j["output"] = {{"vertices", vertices}, {"triangles", triangles}};
+    if (simplifyTolerance > 0)
+      j["output"]["simplification"] = {{"tolerance_voxels", simplifyTolerance},
+                                       {"sharp_features", sharpFeatures},
+                                       {"triangles_before", simplify.trianglesBefore},
+                                       {"collapses", simplify.collapses},
+                                       {"error_bound", simplify.errorBound},
+                                       {"model_evaluations", simplify.modelEvals},
+                                       {"rejected", {{"topology", simplify.rejectedTopology},
+                                                     {"shape", simplify.rejectedShape},
+                                                     {"error", simplify.rejectedError},
+                                                     {"intersection", simplify.rejectedIntersection}}}};
+  }
   else j["output"] = {{"leaves", leaves}, {"tiles", tiles}};
   j["faults"] = {{"retries", retries},           {"duplicates", duplicates},
                  {"late_results", lateResults},  {"malformed", malformed},
@@ -676,5 +695,11 @@ std::string FarmReport::toJson() const {
 }
 
 FarmOutcome runJob(const JobSpec& job, const FarmOptions& options) { return Master(job, options).run(); }
+
+uint64_t peakRssBytes() {
+  struct rusage ru {};
+  if (getrusage(RUSAGE_SELF, &ru) != 0) return 0;
+  return uint64_t(ru.ru_maxrss) * 1024;  // kilobytes on Linux
+}
 
 }  // namespace frep::farm

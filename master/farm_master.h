@@ -12,6 +12,7 @@
 
 #include "farm.pb.h"
 #include "frep/mesh.h"
+#include "frep/mesh_simplify.h"
 #include "frep/sample.h"
 
 namespace frep::farm {
@@ -54,11 +55,18 @@ struct PoisonedBrick {
 struct FarmReport {
   std::string operation = "sample";
   double wallSeconds = 0;
+  // Peak resident memory of this (the master's) process so far, getrusage's ru_maxrss: taken
+  // when the job ends; the cli refreshes it after writing the output ("peak_rss_bytes").
+  uint64_t peakRssBytes = 0;
   uint64_t bricks = 0, bricksComputed = 0, bricksFromJournal = 0;
   uint64_t pointEvals = 0, intervalEvals = 0, denseEvals = 0, nanValues = 0;
   DomainCounts domainErrors;
   uint64_t leaves = 0, tiles = 0;        // "sample": merged output
-  uint64_t vertices = 0, triangles = 0;  // "mesh": merged output
+  uint64_t vertices = 0, triangles = 0;  // "mesh": merged output (after simplification)
+  // "mesh": the simplification of the merged mesh (frep/mesh_simplify.h; run by the caller).
+  double simplifyTolerance = 0;  // voxels; 0: not simplified
+  bool sharpFeatures = false;
+  SimplifyStats simplify;
   uint64_t retries = 0, duplicates = 0, lateResults = 0, malformed = 0, oversized = 0;
   uint64_t deadWorkers = 0, handedBack = 0, stragglerReissues = 0, leaseReissues = 0, refused = 0;
   uint64_t curveRejected = 0;
@@ -83,5 +91,8 @@ struct FarmOutcome {
 // operation. Throws std::invalid_argument for a bad job or options (unknown operation, brick
 // size) and std::runtime_error for setup failures (bind, journal, keys).
 FarmOutcome runJob(const JobSpec& job, const FarmOptions& options);
+
+// Peak resident set of the calling process in bytes (getrusage RUSAGE_SELF; 0 if unavailable).
+uint64_t peakRssBytes();
 
 }  // namespace frep::farm

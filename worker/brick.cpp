@@ -111,7 +111,6 @@ BrickOutput computeBrickOnce(const TapePtr& tape, const JobSpec& job, const std:
   if (operationOf(job) == Operation::Mesh) {
     MeshOptions mo;
     mo.threads = threads;
-    mo.sharpFeatures = job.mesh().sharp_features();
     BrickOutput out;
     out.piece = meshRegion(tape, gridOf(job), lo, hi, mo);
     out.stats.pointEvals = meshPointEvals(out.piece.stats);
@@ -293,7 +292,7 @@ bool getVarint(Reader& r, uint64_t& v) {
   }
   return false;
 }
-constexpr size_t kMeshHeader = 4 + 12 + 7 * 8 + 8;
+constexpr size_t kMeshHeader = 4 + 12 + 6 * 8 + 8;
 constexpr size_t kMinVertexBytes = 1 + 48;
 constexpr size_t kMinTriangleBytes = 3;
 }  // namespace
@@ -301,11 +300,11 @@ constexpr size_t kMinTriangleBytes = 3;
 std::string encodeMeshPiece(const MeshPiece& piece) {
   std::string s;
   s.reserve(kMeshHeader + piece.vertices.size() * 51 + piece.triangles.size() * 5);
-  s.append("FRM1", 4);
+  s.append("FRM2", 4);
   for (int a = 0; a < 3; ++a) put(s, piece.regionLo[a]);
   const MeshStats& st = piece.stats;
   for (uint64_t v : {st.cellsVisited, st.cellsCrossed, st.rootEvals, st.gradientEvals, st.samplePointEvals,
-                     st.fallbackEdges, st.featureCells})
+                     st.fallbackEdges})
     put(s, v);
   put(s, uint32_t(piece.vertices.size()));
   put(s, uint32_t(piece.triangles.size()));
@@ -332,7 +331,7 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
     if (error) *error = why;
     return false;
   };
-  if (size < kMeshHeader || std::memcmp(data, "FRM1", 4) != 0) return fail("mesh payload: bad magic or header");
+  if (size < kMeshHeader || std::memcmp(data, "FRM2", 4) != 0) return fail("mesh payload: bad magic or header");
   Reader r{static_cast<const char*>(data) + 4, static_cast<const char*>(data) + size};
   for (int a = 0; a < 3; ++a) r.get(out.regionLo[a]);
   if (((out.regionLo[0] | out.regionLo[1] | out.regionLo[2]) & 7) != 0 || out.regionLo[0] < 0 || out.regionLo[1] < 0 ||
@@ -340,7 +339,7 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
     return fail("mesh payload: region origin not a non-negative multiple of 8");
   MeshStats& st = out.stats;
   for (uint64_t* v : {&st.cellsVisited, &st.cellsCrossed, &st.rootEvals, &st.gradientEvals, &st.samplePointEvals,
-                      &st.fallbackEdges, &st.featureCells})
+                      &st.fallbackEdges})
     r.get(*v);
   uint32_t nv = 0, nt = 0;
   r.get(nv);

@@ -70,9 +70,9 @@ std::string encodeBrick(const BrickOutput& out);
 // Returns false (with a reason) on a malformed payload; never reads out of bounds.
 bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* error);
 
-// Mesh piece codec (little-endian, version in the magic): "FRM1", regionLo (3 x i32), the
-// piece's MeshStats (7 x u64: cells visited, crossed, root evals, gradient evals, sample point
-// evals, fallback edges, feature cells), u32 vertices, u32 triangles; per vertex: its key as a
+// Mesh piece codec (little-endian, version in the magic): "FRM2", regionLo (3 x i32), the
+// piece's MeshStats (6 x u64: cells visited, crossed, root evals, gradient evals, sample point
+// evals, fallback edges), u32 vertices, u32 triangles; per vertex: its key as a
 // varint (the first absolute, then the increase over the previous key: keys strictly increase),
 // position and normal (6 x f64, bit-exact); per triangle: the first index as a zigzag varint
 // delta from the previous triangle's first index, the other two as zigzag varint deltas from

@@ -21,7 +21,6 @@
 #include <unordered_map>
 
 #include "frep/eval.h"
-#include "mesh_features.h"
 
 namespace frep {
 
@@ -312,10 +311,6 @@ class RegionMesher {
         tris.push_back({v[1], v[2], v[3]});
         tris.push_back({v[1], v[3], v[0]});
       }
-    }
-    if (opt_.sharpFeatures) {
-      FeatureContext fc{grid_, *tape_, opt_.fixedCoords, opt_.featureCos};
-      piece.stats.featureCells += placeFeatureVertices(fc, piece.vertices, tris);
     }
     for (auto& t : tris) canonicalRotate(t);
     std::sort(tris.begin(), tris.end());
@@ -610,7 +605,6 @@ Mesh mergePieces(const std::vector<MeshPiece>& pieces) {
     s.gradientEvals += p.stats.gradientEvals;
     s.samplePointEvals += p.stats.samplePointEvals;
     s.fallbackEdges += p.stats.fallbackEdges;
-    s.featureCells += p.stats.featureCells;
   }
   // Shared vertices are computed identically by each piece; should they ever differ, the
   // smallest record wins, so the result still does not depend on the order of the pieces.

@@ -10,6 +10,7 @@
 
 #include "core/mesh_checks.h"
 #include "frep_runner.h"
+#include "mesh_files.h"
 
 using namespace frep_cli_test;
 namespace mc = mesh_checks;
@@ -20,111 +21,6 @@ constexpr double kPi = 3.14159265358979323846;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-struct ReadMesh {
-  std::vector<mc::Vec3> positions, normals;  // float values, widened
-  std::vector<mc::Tri> triangles;
-  std::vector<mc::Vec3> facetNormals;  // STL only
-};
-
-uint32_t u32(const std::string& b, size_t at) {
-  uint32_t v = 0;
-  for (int i = 0; i < 4; ++i) v |= uint32_t(uint8_t(b[at + i])) << (8 * i);
-  return v;
-}
-float f32(const std::string& b, size_t at) {
-  uint32_t v = u32(b, at);
-  float f;
-  std::memcpy(&f, &v, 4);
-  return f;
-}
-
-ReadMesh readPly(const std::string& bytes) {
-  ReadMesh m;
-  size_t end = bytes.find("end_header\n");
-  EXPECT_NE(end, std::string::npos);
-  if (end == std::string::npos) return m;
-  std::istringstream header(bytes.substr(0, end));
-  std::string line;
-  size_t nv = 0, nf = 0;
-  std::vector<std::string> props;
-  while (std::getline(header, line)) {
-    std::istringstream ls(line);
-    std::string w, what;
-    ls >> w;
-    if (w == "element") {
-      ls >> what;
-      (what == "vertex" ? nv : nf) = std::stoul(line.substr(line.rfind(' ') + 1));
-    } else if (w == "property") {
-      props.push_back(line);
-    } else if (w == "format") {
-      EXPECT_EQ(line, "format binary_little_endian 1.0");
-    }
-  }
-  EXPECT_EQ(props.size(), 7u);
-  EXPECT_EQ(props.back(), "property list uchar uint vertex_indices");
-  size_t at = end + 11;
-  EXPECT_EQ(bytes.size(), at + nv * 24 + nf * 13);
-  if (bytes.size() != at + nv * 24 + nf * 13) return m;
-  for (size_t i = 0; i < nv; ++i, at += 24) {
-    m.positions.push_back({f32(bytes, at), f32(bytes, at + 4), f32(bytes, at + 8)});
-    m.normals.push_back({f32(bytes, at + 12), f32(bytes, at + 16), f32(bytes, at + 20)});
-  }
-  for (size_t i = 0; i < nf; ++i, at += 13) {
-    EXPECT_EQ(uint8_t(bytes[at]), 3u);
-    m.triangles.push_back({u32(bytes, at + 1), u32(bytes, at + 5), u32(bytes, at + 9)});
-  }
-  return m;
-}
-
-ReadMesh readObj(const std::string& text) {
-  ReadMesh m;
-  std::istringstream in(text);
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream ls(line);
-    std::string tag;
-    ls >> tag;
-    if (tag == "v" || tag == "vn") {
-      float x, y, z;  // the writer prints floats with 9 digits: read back exactly
-      ls >> x >> y >> z;
-      (tag == "v" ? m.positions : m.normals).push_back({x, y, z});
-    } else if (tag == "f") {
-      mc::Tri t;
-      for (int c = 0; c < 3; ++c) {
-        std::string item;
-        ls >> item;
-        size_t s = item.find("//");
-        EXPECT_NE(s, std::string::npos);
-        EXPECT_EQ(item.substr(0, s), item.substr(s + 2));  // normal index = vertex index
-        t[c] = uint32_t(std::stoul(item.substr(0, s)) - 1);
-      }
-      m.triangles.push_back(t);
-    }
-  }
-  return m;
-}
-
-ReadMesh readStl(const std::string& bytes) {
-  ReadMesh m;
-  EXPECT_GE(bytes.size(), 84u);
-  if (bytes.size() < 84) return m;
-  EXPECT_NE(bytes.substr(0, 5), "solid");
-  uint32_t n = u32(bytes, 80);
-  EXPECT_EQ(bytes.size(), 84 + size_t(n) * 50);
-  if (bytes.size() != 84 + size_t(n) * 50) return m;
-  for (size_t i = 0, at = 84; i < n; ++i, at += 50) {
-    m.facetNormals.push_back({f32(bytes, at), f32(bytes, at + 4), f32(bytes, at + 8)});
-    mc::Tri t;
-    for (int v = 0; v < 3; ++v) {
-      size_t p = at + 12 + size_t(v) * 12;
-      t[v] = uint32_t(m.positions.size());
-      m.positions.push_back({f32(bytes, p), f32(bytes, p + 4), f32(bytes, p + 8)});
-    }
-    m.triangles.push_back(t);
-  }
-  return m;
-}
-
 }  // namespace
 
 TEST_F(FrepTest, MeshWritesPlyObjStlThatReadBackWatertight) {
@@ -132,7 +28,8 @@ TEST_F(FrepTest, MeshWritesPlyObjStlThatReadBackWatertight) {
   RunResult r = run("mesh s.hf -b 1.5 --res 48 -O s.ply");
   ASSERT_EQ(r.code, 0) << r.err;
   ReadMesh ply = readPly(readText(path("s.ply")));
-  ASSERT_GT(ply.triangles.size(), 1000u);
+  ASSERT_GT(ply.triangles.size(), 300u);
+  EXPECT_TRUE(contains(r.out, "simplified from ")) << r.out;
   EXPECT_TRUE(contains(r.out, "wrote s.ply (binary PLY): " + std::to_string(ply.positions.size()) + " vertices, " +
                                   std::to_string(ply.triangles.size()) + " triangles"))
       << r.out;
@@ -186,20 +83,33 @@ TEST_F(FrepTest, MeshBytesDoNotDependOnBrickOrThreads) {
   }
 }
 
-TEST_F(FrepTest, MeshSharpFeaturesStayWatertightAndSplitInvariant) {
+TEST_F(FrepTest, MeshOfABlockIsAFewTrianglesWithSharpCornersAndOptionsTurnItOff) {
   write("b.hf",
         "my_model(x[3], a[1]) {\n  array c[3];\n  c = [-0.61, -0.52, -0.43];\n"
         "  my_model = hfBlock(x, c, 1.2, 1.0, 0.8);\n}\n");
-  RunResult r = run("mesh b.hf -b 1 --res 40 --sharp -O s.ply");
+  RunResult r = run("mesh b.hf -b 1 --res 40 -O s.ply");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_TRUE(contains(r.out, "feature vertices ")) << r.out;
+  EXPECT_TRUE(contains(r.out, "sharp features on")) << r.out;
   ReadMesh m = readPly(readText(path("s.ply")));
+  EXPECT_LE(m.triangles.size(), 48u);
   EXPECT_EQ(mc::checkEdgePairs(m.triangles, m.positions.size()), "");
   EXPECT_EQ(mc::eulerCharacteristic(m.triangles, m.positions.size()), 2);
   EXPECT_EQ(mc::selfIntersections(m.positions, m.triangles), 0u);
-  EXPECT_NEAR(mc::enclosedVolume(m.positions, m.triangles), 0.96, 0.005 * 0.96);
-  ASSERT_EQ(run("mesh b.hf -b 1 --res 40 --sharp --brick 8 -O t.ply").code, 0);
+  EXPECT_NEAR(mc::enclosedVolume(m.positions, m.triangles), 0.96, 0.002 * 0.96);
+  std::string report = readText(path("s.ply.report.json"));
+  EXPECT_TRUE(contains(report, "\"simplification\"")) << report;
+  EXPECT_TRUE(contains(report, "\"sharp_features\": true")) << report;
+  ASSERT_EQ(run("mesh b.hf -b 1 --res 40 --brick 8 --workers 2 -O t.ply").code, 0);
   EXPECT_TRUE(readText(path("s.ply")) == readText(path("t.ply")));
+  // --no-sharp: corners stay cut off (vertices remain on grid edges), still simplified.
+  ASSERT_EQ(run("mesh b.hf -b 1 --res 40 --no-sharp -O n.ply").code, 0);
+  ReadMesh n = readPly(readText(path("n.ply")));
+  EXPECT_EQ(mc::checkEdgePairs(n.triangles, n.positions.size()), "");
+  EXPECT_LT(n.triangles.size(), 1000u);
+  EXPECT_GT(std::abs(mc::enclosedVolume(n.positions, n.triangles) - 0.96), 0.002 * 0.96);
+  // --tolerance 0: the marching tetrahedra's mesh as it is.
+  ASSERT_EQ(run("mesh b.hf -b 1 --res 40 --tolerance 0 -O z.ply").code, 0);
+  EXPECT_GT(readPly(readText(path("z.ply"))).triangles.size(), 5000u);
 }
 
 TEST_F(FrepTest, MeshRejectsBadArguments) {
@@ -212,6 +122,7 @@ TEST_F(FrepTest, MeshRejectsBadArguments) {
       {"mesh s.hf --res 16", "-O/--out: the output mesh path"},
       {"mesh s.hf --res 16 -O s.vdb", "-O/--out: 's.vdb' has no mesh extension; use .ply"},
       {"mesh s.hf --res 16 -O s.ply --brick 12", "--brick: expected a positive multiple of 8"},
+      {"mesh s.hf --res 16 -O s.ply --tolerance -0.5", "--tolerance: expected 0 (no simplification) or more voxels"},
       {"mesh flat.hf --res 16 -O f.ply", "frep mesh needs a three-dimensional object"},
       {"mesh s.hf --res 16 -O nodir/s.ply", "-O/--out"},
   };

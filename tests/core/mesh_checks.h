@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "frep/mesh_predicates.h"
+
 namespace mesh_checks {
 
 using Vec3 = std::array<double, 3>;
@@ -100,102 +102,11 @@ inline double minTriangleArea(const std::vector<Vec3>& p, const std::vector<Tri>
 // quantised mesh (a displacement of at most 2^-25 of the box, far below the mesher's smallest
 // features). A pair of triangles is improper when it meets anywhere but in a shared vertex or
 // a shared edge: no shared vertex and any contact; one shared vertex and contact beyond it; a
-// shared edge and the two triangles folded onto each other in one plane.
-namespace exact {
-
-using P = std::array<int64_t, 3>;
-
-inline int sgn(__int128 v) { return v > 0 ? 1 : (v < 0 ? -1 : 0); }
-
-inline int orient3d(const P& a, const P& b, const P& c, const P& d) {
-  __int128 u[3], v[3], w[3];
-  for (int i = 0; i < 3; ++i) {
-    u[i] = b[i] - a[i];
-    v[i] = c[i] - a[i];
-    w[i] = d[i] - a[i];
-  }
-  return sgn(u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]));
-}
-
-// Drop the axis along which the plane of (a, b, c) has the largest normal component.
-inline int dropAxis(const P& a, const P& b, const P& c) {
-  __int128 n[3];
-  __int128 u[3], v[3];
-  for (int i = 0; i < 3; ++i) {
-    u[i] = b[i] - a[i];
-    v[i] = c[i] - a[i];
-  }
-  n[0] = u[1] * v[2] - u[2] * v[1];
-  n[1] = u[2] * v[0] - u[0] * v[2];
-  n[2] = u[0] * v[1] - u[1] * v[0];
-  for (auto& x : n) x = x < 0 ? -x : x;
-  return n[0] >= n[1] && n[0] >= n[2] ? 0 : (n[1] >= n[2] ? 1 : 2);
-}
-
-inline int orient2d(int drop, const P& a, const P& b, const P& c) {
-  int i = drop == 0 ? 1 : 0, j = drop == 2 ? 1 : 2;
-  __int128 r = __int128(b[i] - a[i]) * (c[j] - a[j]) - __int128(b[j] - a[j]) * (c[i] - a[i]);
-  return sgn(r);
-}
-
-inline bool onSegment2d(int drop, const P& p, const P& q, const P& x) {  // x collinear with pq
-  for (int k = 0; k < 3; ++k) {
-    if (k == drop) continue;
-    if (x[k] < std::min(p[k], q[k]) || x[k] > std::max(p[k], q[k])) return false;
-  }
-  return true;
-}
-
-inline bool segSeg2d(int drop, const P& p, const P& q, const P& a, const P& b) {
-  int o1 = orient2d(drop, p, q, a), o2 = orient2d(drop, p, q, b), o3 = orient2d(drop, a, b, p), o4 = orient2d(drop, a, b, q);
-  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
-  if (o1 == 0 && onSegment2d(drop, p, q, a)) return true;
-  if (o2 == 0 && onSegment2d(drop, p, q, b)) return true;
-  if (o3 == 0 && onSegment2d(drop, a, b, p)) return true;
-  if (o4 == 0 && onSegment2d(drop, a, b, q)) return true;
-  return false;
-}
-
-inline bool inTri2d(int drop, const P& x, const P& a, const P& b, const P& c) {
-  int o1 = orient2d(drop, a, b, x), o2 = orient2d(drop, b, c, x), o3 = orient2d(drop, c, a, x);
-  return !((o1 < 0 || o2 < 0 || o3 < 0) && (o1 > 0 || o2 > 0 || o3 > 0));
-}
-
-// Closed segment pq against closed triangle abc.
-inline bool segTri(const P& p, const P& q, const P& a, const P& b, const P& c) {
-  int op = orient3d(a, b, c, p), oq = orient3d(a, b, c, q);
-  if (op * oq > 0) return false;
-  if (op == 0 && oq == 0) {
-    int d = dropAxis(a, b, c);
-    return inTri2d(d, p, a, b, c) || inTri2d(d, q, a, b, c) || segSeg2d(d, p, q, a, b) || segSeg2d(d, p, q, b, c) ||
-           segSeg2d(d, p, q, c, a);
-  }
-  int s1 = orient3d(p, q, a, b), s2 = orient3d(p, q, b, c), s3 = orient3d(p, q, c, a);
-  return !((s1 < 0 || s2 < 0 || s3 < 0) && (s1 > 0 || s2 > 0 || s3 > 0));
-}
-
-inline bool triTri(const std::array<P, 3>& t, const std::array<P, 3>& u) {
-  for (int i = 0; i < 3; ++i) {
-    if (segTri(t[i], t[(i + 1) % 3], u[0], u[1], u[2])) return true;
-    if (segTri(u[i], u[(i + 1) % 3], t[0], t[1], t[2])) return true;
-  }
-  return false;
-}
-
-// Segment from v towards a (v excluded) meets triangle (v, c, d)?
-inline bool rayIntoCorner(const P& v, const P& a, const P& c, const P& d) {
-  if (orient3d(v, c, d, a) != 0) return false;  // leaves the plane at once
-  int drop = dropAxis(v, c, d);
-  int s = orient2d(drop, v, c, d);
-  if (s == 0) return true;  // degenerate corner: report
-  return orient2d(drop, v, c, a) * s >= 0 && orient2d(drop, v, a, d) * s >= 0;
-}
-
-}  // namespace exact
+// shared edge and the two triangles folded onto each other in one plane (frep/mesh_predicates.h).
 
 // Number of improper triangle pairs (0 for an embedded surface).
 inline size_t selfIntersections(const std::vector<Vec3>& pos, const std::vector<Tri>& tris) {
-  using exact::P;
+  using P = frep::exact::P;
   if (tris.empty()) return 0;
   Vec3 lo = pos[0], hi = pos[0];
   for (const Vec3& p : pos)
@@ -235,35 +146,7 @@ inline size_t selfIntersections(const std::vector<Vec3>& pos, const std::vector<
         }
         if (!overlap || low != key) continue;
         const Tri &t = tris[list[i]], &u = tris[list[j]];
-        int shared = 0, ti = -1, ui = -1;
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b)
-            if (t[a] == u[b]) ++shared, ti = a, ui = b;
-        std::array<P, 3> T{q[t[0]], q[t[1]], q[t[2]]}, U{q[u[0]], q[u[1]], q[u[2]]};
-        bool improper = false;
-        if (shared == 0) {
-          improper = exact::triTri(T, U);
-        } else if (shared == 1) {
-          const P& v = T[ti];
-          const P &a = T[(ti + 1) % 3], &b = T[(ti + 2) % 3], &c = U[(ui + 1) % 3], &d = U[(ui + 2) % 3];
-          improper = exact::segTri(a, b, U[0], U[1], U[2]) || exact::segTri(c, d, T[0], T[1], T[2]) ||
-                     exact::rayIntoCorner(v, a, c, d) || exact::rayIntoCorner(v, b, c, d) ||
-                     exact::rayIntoCorner(v, c, a, b) || exact::rayIntoCorner(v, d, a, b);
-        } else if (shared == 2) {
-          // The vertices not shared; folded when coplanar and on the same side of the edge.
-          int ta = 0, ub = 0;
-          for (int a = 0; a < 3; ++a) {
-            if (t[a] != u[0] && t[a] != u[1] && t[a] != u[2]) ta = a;
-            if (u[a] != t[0] && u[a] != t[1] && u[a] != t[2]) ub = a;
-          }
-          const P &e0 = T[(ta + 1) % 3], &e1 = T[(ta + 2) % 3];
-          if (exact::orient3d(e0, e1, T[ta], U[ub]) == 0) {
-            int drop = exact::dropAxis(e0, e1, T[ta]);
-            improper = exact::orient2d(drop, e0, e1, T[ta]) * exact::orient2d(drop, e0, e1, U[ub]) > 0;
-          }
-        } else {
-          improper = true;  // the same triangle twice
-        }
+        bool improper = frep::improperPair(t, {q[t[0]], q[t[1]], q[t[2]]}, u, {q[u[0]], q[u[1]], q[u[2]]});
         bad += improper;
       }
   }

@@ -15,11 +15,7 @@ using namespace farmtest;
 
 namespace {
 
-JobSpec meshJob(int res, bool sharp = false) {
-  JobSpec j = partJob("mesh", res);
-  if (sharp) j.mutable_mesh()->set_sharp_features(true);
-  return j;
-}
+JobSpec meshJob(int res) { return partJob("mesh", res); }
 
 void expectSameMesh(const Mesh& a, const Mesh& b) {
   ASSERT_GT(a.triangles.size(), 1000u);
@@ -30,9 +26,7 @@ void expectSameMesh(const Mesh& a, const Mesh& b) {
 }
 
 Mesh direct(const JobSpec& j, int brick = 0) {
-  MeshOptions mo;
-  mo.sharpFeatures = j.mesh().sharp_features();
-  return meshGrid(compileJobModel(j), gridOf(j), mo, brick);
+  return meshGrid(compileJobModel(j), gridOf(j), {}, brick);
 }
 
 }  // namespace
@@ -55,9 +49,9 @@ TEST(MeshFarm, ZeroOneAndTwoWorkersGiveMeshGrid) {
     EXPECT_TRUE(o.report.poisoned.empty());
     EXPECT_NE(o.report.toJson().find("\"vertices\": " + std::to_string(ref.positions.size())), std::string::npos);
   }
-  // Another brick size, and sharp features, through two workers.
+  // Other brick sizes through two workers.
   expectSameMesh(ref, runJob(j, fast(2, 16)).mesh);
-  JobSpec s = meshJob(48, true);
+  JobSpec s = meshJob(48);
   expectSameMesh(direct(s, 8), runJob(s, fast(2, 24)).mesh);
 }
 
@@ -117,7 +111,7 @@ TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
   JobSpec j = meshJob(40);
   MeshPiece piece = meshRegion(compileJobModel(j), gridOf(j), {0, 0, 0}, {32, 32, 32});
   ASSERT_GT(piece.triangles.size(), 100u);
-  piece.stats.featureCells = 7;
+  piece.stats.fallbackEdges = 7;
   std::string s = encodeMeshPiece(piece);
   EXPECT_LT(s.size(), piece.vertices.size() * 56 + piece.triangles.size() * 12);  // compact
   MeshPiece back;
@@ -132,7 +126,7 @@ TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
   }
   EXPECT_EQ(back.triangles, piece.triangles);
   EXPECT_EQ(back.stats.rootEvals, piece.stats.rootEvals);
-  EXPECT_EQ(back.stats.featureCells, 7u);
+  EXPECT_EQ(back.stats.fallbackEdges, 7u);
   // An empty piece round-trips too.
   MeshPiece empty;
   empty.regionLo = {64, 0, 8};
@@ -142,7 +136,7 @@ TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
   EXPECT_TRUE(back.vertices.empty() && back.triangles.empty());
 
   EXPECT_FALSE(decodeMeshPiece(s.data(), s.size() - 1, back, &err));  // truncated
-  EXPECT_FALSE(decodeMeshPiece("FRM1", 4, back, &err));
+  EXPECT_FALSE(decodeMeshPiece("FRM2", 4, back, &err));
   EXPECT_FALSE(decodeMeshPiece((s + "x").data(), s.size() + 1, back, &err));  // trailing
   std::string bad = s;
   bad[0] = 'X';
@@ -152,7 +146,7 @@ TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
   EXPECT_FALSE(decodeMeshPiece(bad.data(), bad.size(), back, &err));
   bad = s;
   const uint32_t huge = 0x7fffffff;
-  std::memcpy(&bad[4 + 12 + 56], &huge, 4);  // vertex count beyond the size
+  std::memcpy(&bad[4 + 12 + 48], &huge, 4);  // vertex count beyond the size
   EXPECT_FALSE(decodeMeshPiece(bad.data(), bad.size(), back, &err));
   EXPECT_NE(err.find("counts"), std::string::npos) << err;
   // Hand-made pieces: repeated key, out-of-range and degenerate triangles, non-finite values.
@@ -171,7 +165,7 @@ TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
     EXPECT_FALSE(decodeMeshPiece(m.data(), m.size(), back, &err));
   std::string overlong = e + std::string(11, char(0xff)) + std::string(48, '\0');  // one vertex, key > 64 bits
   const uint32_t one = 1;
-  std::memcpy(&overlong[4 + 12 + 56], &one, 4);
+  std::memcpy(&overlong[4 + 12 + 48], &one, 4);
   EXPECT_FALSE(decodeMeshPiece(overlong.data(), overlong.size(), back, &err));
   EXPECT_NE(err.find("overlong"), std::string::npos) << err;
   // Random corruption and truncation never crash the decoder (ASan/UBSan builds check the reads)

@@ -20,7 +20,10 @@
 //   BranchAndBound: interval branch-and-bound over the parameters: boxes whose interval upper
 //     bound cannot beat the best value found (plus tolerance) are dropped; it stops when the
 //     certified gap <= tolerance and reports [lo, hi] with lo <= f <= hi (or says it could not
-//     certify within maxBoxes).
+//     certify within maxBoxes). On the body written as a min of terms, the incumbent is
+//     polished by local ascent, boxes are contracted against the cut (best + tolerance) by
+//     interval constraint propagation, and small boxes also get a centred (mean-value) bound
+//     with interval gradients (docs/extremum.md, "Methods and their error").
 // For Min the same searches run on -g.
 #pragma once
 

@@ -49,7 +49,6 @@ struct MeshStats {
   uint64_t gradientEvals = 0;   // normals
   uint64_t samplePointEvals = 0;  // evaluations of the band sampling (grid points)
   uint64_t fallbackEdges = 0;   // edges whose end values disagreed with their signs (bisection)
-  uint64_t featureCells = 0;    // cells whose patch became a fan around a feature vertex
 };
 
 // The triangles of one region: vertices keyed by global edges (sorted by key, unique), triangles
@@ -80,13 +79,6 @@ struct MeshOptions {
   // Roots are kept at least this fraction of the edge away from its ends, so no two vertices
   // coincide and no triangle is degenerate (the surface moves by at most this much).
   double endGuard = 1e-3;
-  // Sharp features (experimental, off by default): in a cell whose vertex normals spread by
-  // more than acos(featureCos), the cell's patch (a disc) is replaced by a fan around one vertex
-  // placed by a QEF over the cell's edge crossings (clamped inside the cell; key: the cell, with
-  // direction 0), when the fan is a valid star-shaped replacement. The result stays closed,
-  // embedded and split-invariant; edges between cells are not flipped onto the feature yet.
-  bool sharpFeatures = false;
-  double featureCos = 0.9;
 };
 
 // Triangles of the cells whose minimum corner is in [lo, hi) (index space; lo a multiple of 8,

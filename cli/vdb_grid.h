@@ -1,0 +1,18 @@
+// The sampler's output as an in-memory OpenVDB grid: the one conversion that frep sample writes
+// (vdb_writer.cpp) and that bench_mesh hands to openvdb::tools::volumeToMesh. This header
+// includes OpenVDB: include it only where OpenVDB is needed (its headers compile slowly).
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+#include "frep/sample.h"
+
+namespace frep::cli {
+
+// One FloatGrid of class level set holding -f (negative inside): the sampler's leaf voxels
+// (active in the band), tiles and the background at +-band * voxel, pruned to the canonical
+// tree, with the grid's transform (voxel size, index (0,0,0) at the grid's origin). No name and
+// no metadata (writeLevelSet adds them). Calls openvdb::initialize().
+openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result);
+
+}  // namespace frep::cli

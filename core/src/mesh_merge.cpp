@@ -1,0 +1,94 @@
+// mergePiecesReleasing (see mesh_merge.h): mergePieces' result with a smaller footprint.
+//
+// mergePieces copies every piece's vertices into one array, sorts it, builds the mesh's arrays
+// from it and merges the triangle runs with a buffer, all while the pieces are alive: about
+// three copies of the output at its peak. Here (1) only the keys are gathered and sorted; (2)
+// the mesh's positions and normals are filled piece by piece, each piece's triangles remapped,
+// and the piece freed at once (memory handed back to the system every few pieces); (3) the
+// triangles are sorted in place. Where two pieces disagree on a shared vertex (they never do:
+// a vertex depends on its edge only) the smaller record (position, then normal) wins, as in
+// mergePieces, so the result is the same whatever the order of the pieces.
+#include "frep/mesh_merge.h"
+
+#include <malloc.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace frep {
+
+namespace {
+inline void canonicalRotate(std::array<uint32_t, 3>& t) {
+  if (t[1] < t[0] && t[1] < t[2]) t = {t[1], t[2], t[0]};
+  else if (t[2] < t[0] && t[2] < t[1]) t = {t[2], t[0], t[1]};
+}
+}  // namespace
+
+Mesh mergePiecesReleasing(std::vector<MeshPiece>& pieces) {
+  Mesh mesh;
+  size_t nv = 0, nt = 0;
+  for (const MeshPiece& p : pieces) {
+    nv += p.vertices.size();
+    nt += p.triangles.size();
+    MeshStats& s = mesh.stats;
+    s.cellsVisited += p.stats.cellsVisited;
+    s.cellsCrossed += p.stats.cellsCrossed;
+    s.rootEvals += p.stats.rootEvals;
+    s.gradientEvals += p.stats.gradientEvals;
+    s.samplePointEvals += p.stats.samplePointEvals;
+    s.fallbackEdges += p.stats.fallbackEdges;
+    for (size_t i = 1; i < p.vertices.size(); ++i)
+      if (p.vertices[i].key <= p.vertices[i - 1].key)
+        throw std::invalid_argument("mergePieces: piece vertices not sorted by key");
+  }
+  {
+    std::vector<EdgeKey> keys;
+    keys.reserve(nv);
+    for (const MeshPiece& p : pieces)
+      for (const MeshVertex& v : p.vertices) keys.push_back(v.key);
+    tbb::parallel_sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    mesh.keys.assign(keys.begin(), keys.end());  // exact size
+  }
+  const size_t n = mesh.keys.size();
+  mesh.positions.resize(n);
+  mesh.normals.resize(n);
+  std::vector<uint8_t> filled(n, 0);
+  mesh.triangles.reserve(nt);
+  std::vector<uint32_t> remap;
+  size_t released = 0;
+  for (MeshPiece& p : pieces) {
+    remap.resize(p.vertices.size());
+    size_t g = 0;
+    if (!p.vertices.empty())
+      g = size_t(std::lower_bound(mesh.keys.begin(), mesh.keys.end(), p.vertices[0].key) - mesh.keys.begin());
+    for (size_t i = 0; i < p.vertices.size(); ++i) {
+      const MeshVertex& v = p.vertices[i];
+      while (mesh.keys[g] < v.key) ++g;
+      remap[i] = uint32_t(g);
+      if (!filled[g] || v.position < mesh.positions[g] || (v.position == mesh.positions[g] && v.normal < mesh.normals[g])) {
+        mesh.positions[g] = v.position;
+        mesh.normals[g] = v.normal;
+        filled[g] = 1;
+      }
+    }
+    for (const auto& t : p.triangles) {
+      if (t[0] >= remap.size() || t[1] >= remap.size() || t[2] >= remap.size())
+        throw std::invalid_argument("mergePieces: a triangle indexes past its piece's vertices");
+      std::array<uint32_t, 3> r{remap[t[0]], remap[t[1]], remap[t[2]]};
+      canonicalRotate(r);
+      mesh.triangles.push_back(r);
+    }
+    std::vector<MeshVertex>().swap(p.vertices);
+    std::vector<std::array<uint32_t, 3>>().swap(p.triangles);
+    released += 1;
+    if (released % 16 == 0) malloc_trim(0);  // hand the freed pieces back (they are small heap blocks)
+  }
+  malloc_trim(0);
+  tbb::parallel_sort(mesh.triangles.begin(), mesh.triangles.end());
+  mesh.triangles.erase(std::unique(mesh.triangles.begin(), mesh.triangles.end()), mesh.triangles.end());
+  return mesh;
+}
+
+}  // namespace frep

@@ -1,0 +1,588 @@
+// Adaptive, feature-preserving edge collapses checked against the model (mesh_simplify.h).
+#include "frep/mesh_simplify.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <unordered_map>
+
+#include "frep/eval.h"
+#include "frep/mesh_predicates.h"
+
+namespace frep {
+
+namespace {
+
+using V3 = std::array<double, 3>;
+using Tri = std::array<uint32_t, 3>;
+
+V3 add(const V3& a, const V3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+V3 scale(const V3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+V3 cross(const V3& a, const V3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double norm(const V3& a) { return std::sqrt(dot(a, a)); }
+
+// Sum of squared distances to planes n.x = n.p (Garland & Heckbert's quadric), here the model's
+// tangent planes at surface points.
+struct Quadric {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  double c = 0, weight = 0;
+  void addPlane(const V3& n, const V3& p) {
+    Eigen::Vector3d nn(n[0], n[1], n[2]);
+    double d = -dot(n, p);
+    A += nn * nn.transpose();
+    b += d * nn;
+    c += d * d;
+    weight += 1;
+  }
+  Quadric& operator+=(const Quadric& o) {
+    A += o.A, b += o.b, c += o.c, weight += o.weight;
+    return *this;
+  }
+  double operator()(const V3& x) const {
+    Eigen::Vector3d v(x[0], x[1], x[2]);
+    return std::max(0.0, v.dot(A * v) + 2 * b.dot(v) + c);
+  }
+  // The least-squares point nearest to `ref`. Directions with less support than half a plane
+  // (eigenvalue < 0.5; each unit-normal plane adds 1 to the trace) stay at ref: nearly parallel
+  // planes do not define a crease. An absolute threshold, not one relative to the largest
+  // eigenvalue: a vertex that has absorbed a whole face holds thousands of that face's planes
+  // and still only a few dozen of the face across the crease.
+  V3 minimiser(const V3& ref) const {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(A);
+    Eigen::Vector3d r(ref[0], ref[1], ref[2]), g = -(A * r + b), x = r;
+    double top = es.eigenvalues().maxCoeff();
+    for (int i = 0; i < 3; ++i) {
+      double l = es.eigenvalues()[i];
+      if (l > 0.5 && l > 1e-9 * top) {
+        x += es.eigenvectors().col(i) * (es.eigenvectors().col(i).dot(g) / l);
+      }
+    }
+    return {x[0], x[1], x[2]};
+  }
+};
+
+// Closest distance from p to triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
+double pointTriangleDistance(const V3& p, const V3& a, const V3& b, const V3& c) {
+  V3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return norm(ap);
+  V3 bp = sub(p, b);
+  double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return norm(bp);
+  double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return norm(sub(p, add(a, scale(ab, d1 / (d1 - d3)))));
+  V3 cp = sub(p, c);
+  double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return norm(cp);
+  double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return norm(sub(p, add(a, scale(ac, d2 / (d2 - d6)))));
+  double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return norm(sub(p, add(b, scale(sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))))));
+  double denom = 1 / (va + vb + vc);
+  return norm(sub(p, add(a, add(scale(ab, vb * denom), scale(ac, vc * denom)))));
+}
+
+double quality(const V3& a, const V3& b, const V3& c) {
+  double s = dot(sub(b, a), sub(b, a)) + dot(sub(c, b), sub(c, b)) + dot(sub(a, c), sub(a, c));
+  return s > 0 ? 2 * std::sqrt(3.0) * norm(cross(sub(b, a), sub(c, a))) / s : 0;
+}
+
+constexpr int kMaxSamplesPerSide = 64;  // error samples per triangle <= 64^2
+constexpr double kQuantum = 65536;      // exact predicates: 2^16 steps per voxel
+constexpr double kBucketVoxels = 4;     // spatial hash cell
+
+class Simplifier {
+ public:
+  Simplifier(Mesh& mesh, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt)
+      : mesh_(mesh), tape_(tape), grid_(grid), opt_(opt), tol_(opt.tolerance * grid.voxel) {
+    // Error levels e_k = tol * 2^k up to two voxels (or the tolerance if larger): a replaced
+    // triangle allows its new ones at most that much error, however far its own chord was (the
+    // mesher's chords across a crease can be most of a voxel deep).
+    while (std::ldexp(tol_, maxLevel_ + 1) <= std::max(tol_, grid_.voxel) * (1 + 1e-12)) ++maxLevel_;
+    if (tape_->numVars() > 3 && opt_.fixedCoords.size() < tape_->numVars() - 3)
+      throw std::invalid_argument("simplifyMesh: the model has " + std::to_string(tape_->numVars()) +
+                                  " coordinates; give values for x[4..] (fixedCoords)");
+  }
+
+  SimplifyStats run() {
+    stats_.trianglesBefore = mesh_.triangles.size();
+    setUp();
+    while (!queue_.empty()) {
+      Candidate c = queue_.top();
+      queue_.pop();
+      if (!alive_[c.a] || !alive_[c.b] || version_[c.a] != c.va || version_[c.b] != c.vb) continue;
+      tryCollapse(c.a, c.b);
+    }
+    finish();
+    stats_.trianglesAfter = mesh_.triangles.size();
+    int worst = -1;  // over the triangles that collapses made
+    for (uint32_t t = 0; t < tris_.size(); ++t)
+      if (tAlive_[t] && made_[t]) worst = std::max<int>(worst, level_[t]);
+    stats_.errorBound = worst < 0 ? 0 : std::ldexp(tol_, worst);
+    return stats_;
+  }
+
+ private:
+  struct Candidate {
+    double cost, length2;
+    uint32_t a, b, va, vb;
+    bool operator>(const Candidate& o) const {
+      if (cost != o.cost) return cost > o.cost;
+      if (length2 != o.length2) return length2 > o.length2;
+      return a != o.a ? a > o.a : b > o.b;
+    }
+  };
+
+  void setUp() {
+    const size_t nv = mesh_.positions.size();
+    pos_ = mesh_.positions;
+    key_ = mesh_.keys;
+    normal_ = mesh_.normals;
+    quad_.resize(nv);
+    for (size_t v = 0; v < nv; ++v) quad_[v].addPlane(mesh_.normals[v], pos_[v]);
+    alive_.assign(nv, 1);
+    moved_.assign(nv, 0);
+    version_.assign(nv, 0);
+    vtris_.assign(nv, {});
+    qpos_.resize(nv);
+    for (size_t v = 0; v < nv; ++v) qpos_[v] = quantise(pos_[v]);
+    tris_ = mesh_.triangles;
+    tAlive_.assign(tris_.size(), 1);
+    made_.assign(tris_.size(), 0);
+    level_.assign(tris_.size(), -1);
+    stamp_.assign(tris_.size(), 0);
+    probe_.assign(tris_.size(), 0);
+    cells_.resize(tris_.size());
+    for (uint32_t t = 0; t < tris_.size(); ++t) {
+      for (uint32_t v : tris_[t]) vtris_[v].push_back(t);
+      insertBuckets(t);
+    }
+    for (uint32_t t = 0; t < tris_.size(); ++t)
+      for (int c = 0; c < 3; ++c) {
+        uint32_t a = tris_[t][c], b = tris_[t][(c + 1) % 3];
+        if (a < b) pushCandidate(a, b);  // each undirected edge once (closed mesh)
+      }
+  }
+
+  // ---- positions ------------------------------------------------------------------------
+  exact::P quantise(const V3& p) const {
+    exact::P q;
+    for (int k = 0; k < 3; ++k) q[k] = std::llround((p[k] - grid_.origin[k]) / grid_.voxel * kQuantum);
+    return q;
+  }
+
+  V3 placement(uint32_t a, uint32_t b, double* cost) const {
+    Quadric q = quad_[a];
+    q += quad_[b];
+    const V3 &pa = pos_[a], &pb = pos_[b];
+    double ca = q(pa), cb = q(pb);
+    V3 best = ca <= cb ? pa : pb;
+    *cost = std::min(ca, cb);
+    if (opt_.sharpFeatures) {
+      V3 mid = scale(add(pa, pb), 0.5);
+      V3 p = q.minimiser(mid);
+      double reach = std::max(norm(sub(pa, pb)), grid_.voxel);
+      double cp = q(p);
+      if (norm(sub(p, mid)) <= reach && std::isfinite(cp) && cp <= *cost) {
+        *cost = cp;
+        best = p;
+      }
+    }
+    return best;
+  }
+
+  void pushCandidate(uint32_t a, uint32_t b) {
+    if (a > b) std::swap(a, b);
+    double cost;
+    placement(a, b, &cost);
+    // Mean squared distance to the tangent planes above tol^2: the merged vertex cannot sit on
+    // all of them within the tolerance; not worth the model evaluations.
+    if (cost > tol_ * tol_ * (quad_[a].weight + quad_[b].weight)) return;
+    // Costs below 1e-6 tol^2 count as equal: then shorter edges first (even coarsening).
+    double key = std::floor(cost / (1e-6 * tol_ * tol_));
+    queue_.push({key, dot(sub(pos_[a], pos_[b]), sub(pos_[a], pos_[b])), a, b, version_[a], version_[b]});
+  }
+
+  // ---- spatial hash of triangles (for the self-intersection check) ------------------------
+  std::array<int32_t, 6> cellRange(const V3& a, const V3& b, const V3& c) const {
+    std::array<int32_t, 6> r;
+    const double s = kBucketVoxels * grid_.voxel;
+    for (int k = 0; k < 3; ++k) {
+      double lo = std::min({a[k], b[k], c[k]}) - grid_.origin[k], hi = std::max({a[k], b[k], c[k]}) - grid_.origin[k];
+      const double margin = 1e-3 * grid_.voxel;  // far above the quantisation step
+      r[k] = int32_t(std::floor((lo - margin) / s));
+      r[k + 3] = int32_t(std::floor((hi + margin) / s));
+    }
+    return r;
+  }
+  static uint64_t cellKey(int32_t x, int32_t y, int32_t z) {
+    return (uint64_t(uint32_t(x + (1 << 20)) & 0x1fffff) << 42) | (uint64_t(uint32_t(y + (1 << 20)) & 0x1fffff) << 21) |
+           uint64_t(uint32_t(z + (1 << 20)) & 0x1fffff);
+  }
+  template <typename F>
+  static void forCells(const std::array<int32_t, 6>& r, F&& f) {
+    for (int32_t x = r[0]; x <= r[3]; ++x)
+      for (int32_t y = r[1]; y <= r[4]; ++y)
+        for (int32_t z = r[2]; z <= r[5]; ++z) f(cellKey(x, y, z));
+  }
+  void insertBuckets(uint32_t t) {
+    cells_[t] = cellRange(pos_[tris_[t][0]], pos_[tris_[t][1]], pos_[tris_[t][2]]);
+    forCells(cells_[t], [&](uint64_t k) { buckets_[k].push_back(t); });
+  }
+  void eraseBuckets(uint32_t t) {
+    forCells(cells_[t], [&](uint64_t k) {
+      auto it = buckets_.find(k);
+      auto& v = it->second;
+      v.erase(std::find(v.begin(), v.end(), t));
+      if (v.empty()) buckets_.erase(it);
+    });
+  }
+
+  // ---- error against the model --------------------------------------------------------------
+  // Is every sample point p of triangle abc within e = tolerance * 2^level of the surface,
+  // along the normal? Certified when the model changes sign along [p - e d, p + e d] (inside at
+  // the start, outside at the end): the surface crosses it. d is the triangle's normal, or
+  // `primary` (for the mesher's slivers, whose own normal is noise). Measuring along the normal
+  // (not towards the nearest surface point) also keeps chords across a crease out: they are
+  // deeper along their normal than to the nearer face.
+  bool withinLevel(const V3& a, const V3& b, const V3& c, int level, const V3* primary = nullptr) {
+    const double e = 0.8 * std::ldexp(tol_, level);  // 0.8: a margin for the gaps between samples
+    auto unit = [](V3 d) {
+      double l = norm(d);
+      return l > 0 && std::isfinite(l) ? scale(d, 1 / l) : V3{0, 0, 0};
+    };
+    const V3 d = primary ? unit(*primary) : unit(cross(sub(b, a), sub(c, a)));
+    if (d == V3{0, 0, 0}) return false;
+    double longest = std::max({norm(sub(b, a)), norm(sub(c, b)), norm(sub(a, c))});
+    int m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
+    const V3 u = scale(sub(b, a), 1.0 / m), v = scale(sub(c, a), 1.0 / m);
+    // The centroids of the m^2 sub-triangles (not the corners or edges: on a crease of the
+    // model the sign test along the normal is ill-posed).
+    std::vector<V3>& pts = samplePoints_;
+    pts.clear();
+    auto at = [&](double i, double j) { pts.push_back(add(a, add(scale(u, i), scale(v, j)))); };
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; i + j < m; ++j) {
+        at(i + 1.0 / 3, j + 1.0 / 3);
+        if (i + j <= m - 2) at(i + 2.0 / 3, j + 2.0 / 3);
+      }
+    return crossedAlong(pts, scale(d, e));
+  }
+
+  // Is f(p - d) inside and f(p + d) outside at every point p of `pts`?
+  bool crossedAlong(const std::vector<V3>& pts, const V3& d) {
+    const uint32_t nvars = tape_->numVars();
+    batch_.reserve(*tape_);
+    const size_t perCall = BatchEvaluator<double>::kBatch / 2;
+    for (size_t s = 0; s < pts.size(); s += perCall) {
+      size_t n = std::min(perCall, pts.size() - s);
+      for (size_t i = 0; i < n; ++i)
+        for (int side = 0; side < 2; ++side) {
+          V3 q = side == 0 ? sub(pts[s + i], d) : add(pts[s + i], d);
+          for (uint32_t k = 0; k < nvars; ++k) batch_.in(k)[2 * i + side] = k < 3 ? q[k] : opt_.fixedCoords[k - 3];
+        }
+      const double* f = batch_.eval(*tape_, 2 * n);
+      stats_.modelEvals += 2 * n;
+      for (size_t i = 0; i < n; ++i)
+        if (std::signbit(f[2 * i]) || !std::signbit(f[2 * i + 1])) return false;
+    }
+    return true;
+  }
+
+  int levelOf(uint32_t t) {
+    if (level_[t] < 0) {
+      const Tri& tr = tris_[t];
+      int k = 0;
+      const V3 &a = pos_[tr[0]], &b = pos_[tr[1]], &c = pos_[tr[2]];
+      V3 along = add(normal_[tr[0]], add(normal_[tr[1]], normal_[tr[2]]));
+      const V3* dir = quality(a, b, c) < opt_.minQuality && norm(along) > 0 ? &along : nullptr;
+      while (k <= maxLevel_ && !withinLevel(a, b, c, k, dir)) ++k;
+      level_[t] = int8_t(std::min(k, maxLevel_));  // beyond the last level: no more allowance
+    }
+    return level_[t];
+  }
+
+  // ---- one collapse ---------------------------------------------------------------------------
+  void tryCollapse(uint32_t a, uint32_t b) {
+    // Link condition: exactly two triangles hold the edge, and a and b have no other common
+    // neighbour; neither opposite vertex may drop below valence 3.
+    std::vector<uint32_t> na, nb, opposite;
+    for (uint32_t t : vtris_[a])
+      for (uint32_t v : tris_[t])
+        if (v != a) na.push_back(v);
+    for (uint32_t t : vtris_[b]) {
+      bool hasA = false;
+      for (uint32_t v : tris_[t]) hasA |= v == a;
+      for (uint32_t v : tris_[t])
+        if (v != b) {
+          nb.push_back(v);
+          if (hasA && v != a) opposite.push_back(v);
+        }
+    }
+    std::sort(na.begin(), na.end());
+    na.erase(std::unique(na.begin(), na.end()), na.end());
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    std::vector<uint32_t> common;
+    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
+    std::sort(opposite.begin(), opposite.end());
+    if (opposite.size() != 2 || opposite[0] == opposite[1] || common != opposite || vtris_[opposite[0]].size() <= 3 ||
+        vtris_[opposite[1]].size() <= 3) {
+      ++stats_.rejectedTopology;
+      return;
+    }
+
+    double cost;
+    V3 p = placement(a, b, &cost);
+    std::vector<uint32_t> changed, removed;  // triangles kept with a new corner; the two dropped
+    for (uint32_t v : {a, b})
+      for (uint32_t t : vtris_[v]) {
+        const Tri& tr = tris_[t];
+        bool both = (tr[0] == a || tr[1] == a || tr[2] == a) && (tr[0] == b || tr[1] == b || tr[2] == b);
+        if (both) {
+          if (v == a) removed.push_back(t);
+        } else {
+          changed.push_back(t);
+        }
+      }
+    auto corner = [&](uint32_t v) { return v == a || v == b ? p : pos_[v]; };
+    auto renamed = [&](const Tri& tr) {
+      Tri r = tr;
+      for (uint32_t& v : r)
+        if (v == b) v = a;
+      return r;
+    };
+
+    // Shape: no flip or fold; below the quality bound, the worst triangle may not get more than
+    // 10% worse (the mesher leaves slivers where the surface grazes grid points; they go first).
+    double worstBefore = 1, worstAfter = 1;
+    for (uint32_t t : removed) worstBefore = std::min(worstBefore, quality(pos_[tris_[t][0]], pos_[tris_[t][1]], pos_[tris_[t][2]]));
+    for (uint32_t t : changed) {
+      const Tri& tr = tris_[t];
+      V3 o0 = pos_[tr[0]], o1 = pos_[tr[1]], o2 = pos_[tr[2]];
+      double q0 = quality(o0, o1, o2);
+      worstBefore = std::min(worstBefore, q0);
+      // The direction the triangle must keep facing: its own normal, or for a sliver (whose
+      // normal is noise: the mesher's triangles where the surface grazes a grid point) the
+      // model's normals at its corners.
+      V3 n0 = q0 < opt_.minQuality ? add(normal_[tr[0]], add(normal_[tr[1]], normal_[tr[2]])) : cross(sub(o1, o0), sub(o2, o0));
+      V3 c0 = corner(tr[0]), c1 = corner(tr[1]), c2 = corner(tr[2]);
+      V3 n1 = cross(sub(c1, c0), sub(c2, c0));
+      double l1 = norm(n1);
+      worstAfter = std::min(worstAfter, quality(c0, c1, c2));
+      if (!(l1 > 1e-12 * grid_.voxel * grid_.voxel) || dot(n0, n1) <= 0.2 * norm(n0) * l1) {
+        ++stats_.rejectedShape;
+        return;
+      }
+    }
+    if (worstAfter < opt_.minQuality && worstAfter < 0.9 * worstBefore) {
+      ++stats_.rejectedShape;
+      return;
+    }
+
+    // Error: allowed level = the worst of the replaced triangles (at least the tolerance).
+    int allowed = 0;
+    for (uint32_t t : changed) allowed = std::max(allowed, levelOf(t));
+    for (uint32_t t : removed) allowed = std::max(allowed, levelOf(t));
+    std::vector<int8_t> newLevel(changed.size());
+    for (size_t i = 0; i < changed.size(); ++i) {
+      const Tri& tr = tris_[changed[i]];
+      int k = 0;
+      while (k <= allowed && !withinLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), k)) ++k;
+      if (k > allowed) {
+        ++stats_.rejectedError;
+        return;
+      }
+      newLevel[i] = int8_t(k);
+    }
+    // The removed vertices stay within the allowed error of the new triangles.
+    const double e = std::ldexp(tol_, allowed);
+    for (uint32_t v : {a, b}) {
+      double d = INFINITY;
+      for (uint32_t t : changed) {
+        const Tri& tr = tris_[t];
+        d = std::min(d, pointTriangleDistance(pos_[v], corner(tr[0]), corner(tr[1]), corner(tr[2])));
+      }
+      if (d > e) {
+        ++stats_.rejectedError;
+        return;
+      }
+    }
+
+    // Self-intersection: the new triangles against each other and against their neighbourhood.
+    const exact::P qp = quantise(p);
+    auto qcorner = [&](uint32_t v) { return v == a || v == b ? qp : qpos_[v]; };
+    ++stampNow_;
+    for (uint32_t t : changed) stamp_[t] = stampNow_;
+    for (uint32_t t : removed) stamp_[t] = stampNow_;
+    for (size_t i = 0; i < changed.size(); ++i) {
+      Tri ti = renamed(tris_[changed[i]]);
+      std::array<exact::P, 3> Ti{qcorner(tris_[changed[i]][0]), qcorner(tris_[changed[i]][1]), qcorner(tris_[changed[i]][2])};
+      for (size_t j = i + 1; j < changed.size(); ++j) {
+        Tri tj = renamed(tris_[changed[j]]);
+        std::array<exact::P, 3> Tj{qcorner(tris_[changed[j]][0]), qcorner(tris_[changed[j]][1]), qcorner(tris_[changed[j]][2])};
+        if (improperPair(ti, Ti, tj, Tj)) {
+          ++stats_.rejectedIntersection;
+          return;
+        }
+      }
+      auto range = cellRange(corner(ti[0]), corner(ti[1]), corner(ti[2]));
+      bool bad = false;
+      ++probeNow_;
+      forCells(range, [&](uint64_t key) {
+        if (bad) return;
+        auto it = buckets_.find(key);
+        if (it == buckets_.end()) return;
+        for (uint32_t u : it->second) {
+          if (stamp_[u] == stampNow_ || probe_[u] == probeNow_) continue;
+          probe_[u] = probeNow_;
+          const Tri& tu = tris_[u];
+          std::array<exact::P, 3> Tu{qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]};
+          if (improperPair(ti, Ti, tu, Tu)) {
+            bad = true;
+            return;
+          }
+        }
+      });
+      if (bad) {
+        ++stats_.rejectedIntersection;
+        return;
+      }
+    }
+
+    // Apply.
+    for (uint32_t t : removed) {
+      eraseBuckets(t);
+      tAlive_[t] = 0;
+      for (uint32_t v : tris_[t]) {
+        auto& l = vtris_[v];
+        l.erase(std::find(l.begin(), l.end(), t));
+      }
+    }
+    for (uint32_t t : changed) eraseBuckets(t);
+    for (uint32_t t : vtris_[b]) {
+      for (uint32_t& v : tris_[t])
+        if (v == b) v = a;
+      vtris_[a].push_back(t);
+    }
+    vtris_[b].clear();
+    alive_[b] = 0;
+    if (p == pos_[b]) {  // stayed at b: a takes b's identity (its key and normal)
+      key_[a] = key_[b];
+      normal_[a] = normal_[b];
+      moved_[a] = moved_[b];
+    } else if (p != pos_[a]) {
+      moved_[a] = 1;
+    }
+    pos_[a] = p;
+    qpos_[a] = qp;
+    quad_[a] += quad_[b];
+    ++version_[a];
+    for (size_t i = 0; i < changed.size(); ++i) {
+      level_[changed[i]] = newLevel[i];
+      made_[changed[i]] = 1;
+      insertBuckets(changed[i]);
+    }
+    ++stats_.collapses;
+    std::vector<uint32_t> ring;
+    for (uint32_t t : vtris_[a])
+      for (uint32_t v : tris_[t])
+        if (v != a) ring.push_back(v);
+    std::sort(ring.begin(), ring.end());
+    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+    for (uint32_t v : ring) pushCandidate(a, v);
+  }
+
+  // ---- output -------------------------------------------------------------------------------
+  void finish() {
+    // Vertices in the order of their keys (as the mesher orders them), triangles by index
+    // triple rotated to start at the smallest.
+    const size_t nv = pos_.size();
+    std::vector<uint32_t> order;
+    for (uint32_t v = 0; v < nv; ++v)
+      if (alive_[v] && !vtris_[v].empty()) order.push_back(v);
+    std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return key_[x] != key_[y] ? key_[x] < key_[y] : x < y; });
+    std::vector<uint32_t> index(nv, UINT32_MAX);
+    Mesh out;
+    out.stats = mesh_.stats;
+    GradientEvaluator grad;
+    std::vector<double> x(std::max<uint32_t>(tape_->numVars(), 3)), g(x.size());
+    for (uint32_t v : order) {
+      index[v] = uint32_t(out.positions.size());
+      out.positions.push_back(pos_[v]);
+      out.keys.push_back(key_[v]);
+      V3 n = normal_[v];
+      if (moved_[v]) {
+        // Outward = -grad f; at an edge or a corner of the model the gradient is one face's (or
+        // undefined): then the area-weighted normal of the triangles around the vertex.
+        V3 fan{0, 0, 0};
+        for (uint32_t t : vtris_[v]) {
+          const Tri& tr = tris_[t];
+          fan = add(fan, cross(sub(pos_[tr[1]], pos_[tr[0]]), sub(pos_[tr[2]], pos_[tr[0]])));
+        }
+        for (uint32_t k = 0; k < x.size(); ++k) x[k] = k < 3 ? pos_[v][k] : opt_.fixedCoords[k - 3];
+        grad.eval(*tape_, x.data(), g.data());
+        V3 gn{-g[0], -g[1], -g[2]};
+        double lg = norm(gn), lf = norm(fan);
+        if (lg > 0 && std::isfinite(lg) && lf > 0 && dot(gn, fan) > 0.9 * lg * lf)
+          n = scale(gn, 1 / lg);
+        else if (lf > 0)
+          n = scale(fan, 1 / lf);
+      }
+      out.normals.push_back(n);
+    }
+    for (uint32_t t = 0; t < tris_.size(); ++t) {
+      if (!tAlive_[t]) continue;
+      Tri r{index[tris_[t][0]], index[tris_[t][1]], index[tris_[t][2]]};
+      int s = r[0] < r[1] ? (r[0] < r[2] ? 0 : 2) : (r[1] < r[2] ? 1 : 2);
+      out.triangles.push_back({r[s], r[(s + 1) % 3], r[(s + 2) % 3]});
+    }
+    std::sort(out.triangles.begin(), out.triangles.end());
+    mesh_ = std::move(out);
+  }
+
+  Mesh& mesh_;
+  TapePtr tape_;
+  GridSpec grid_;
+  SimplifyOptions opt_;
+  double tol_;
+  SimplifyStats stats_;
+  std::vector<V3> pos_, normal_;
+  std::vector<V3> samplePoints_;
+  std::vector<EdgeKey> key_;
+  std::vector<exact::P> qpos_;
+  std::vector<Quadric> quad_;
+  std::vector<char> alive_, moved_;
+  std::vector<uint32_t> version_;
+  std::vector<std::vector<uint32_t>> vtris_;
+  std::vector<Tri> tris_;
+  std::vector<char> tAlive_, made_;
+  std::vector<int8_t> level_;
+  std::vector<uint32_t> stamp_, probe_;
+  uint32_t stampNow_ = 0, probeNow_ = 0;
+  std::vector<std::array<int32_t, 6>> cells_;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> buckets_;
+  std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue_;
+  BatchEvaluator<double> batch_;
+  int maxLevel_ = 0;  // the last error level
+};
+
+}  // namespace
+
+SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options) {
+  if (!(options.tolerance > 0) || mesh.triangles.empty()) {
+    SimplifyStats s;
+    s.trianglesBefore = s.trianglesAfter = mesh.triangles.size();
+    return s;
+  }
+  return Simplifier(mesh, tape, grid, options).run();
+}
+
+}  // namespace frep
