@@ -129,10 +129,14 @@ int runMesh(const MeshRequest& request) {
   const double meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Adaptive simplification of the merged mesh, here in the master: deterministic, so the file
   // still does not depend on the split (docs/mesh.md).
+  // Not by default for models with extremum nodes: every check would run searches.
+  TapePtr tape = Tape::compile(m.field, 3);
   SimplifyOptions so;
-  so.tolerance = request.tolerance < 0 ? 0.1 : request.tolerance;
+  so.tolerance = request.tolerance >= 0 ? request.tolerance : tape->hasExtrema() ? 0.0 : 0.1;
   so.sharpFeatures = !request.noSharp;
-  SimplifyStats ss = simplifyMesh(mesh, Tape::compile(m.field, 3), grid, so);
+  if (request.tolerance < 0 && tape->hasExtrema())
+    spdlog::info("the model has extremum nodes: not simplified (each check would run a search); give --tolerance to");
+  SimplifyStats ss = simplifyMesh(mesh, tape, grid, so);
   report.simplifyTolerance = so.tolerance;
   report.sharpFeatures = so.sharpFeatures;
   report.simplify = ss;

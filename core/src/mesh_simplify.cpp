@@ -96,7 +96,7 @@ double quality(const V3& a, const V3& b, const V3& c) {
 
 constexpr int kMaxSamplesPerSide = 64;  // error samples per triangle <= 64^2
 constexpr double kQuantum = 65536;      // exact predicates: 2^16 steps per voxel
-constexpr double kBucketVoxels = 4;     // spatial hash cell
+constexpr double kBucketVoxels = 2;     // spatial hash cell
 
 class Simplifier {
  public:
@@ -160,6 +160,7 @@ class Simplifier {
     stamp_.assign(tris_.size(), 0);
     probe_.assign(tris_.size(), 0);
     cells_.resize(tris_.size());
+    qbox_.resize(tris_.size());
     for (uint32_t t = 0; t < tris_.size(); ++t) {
       for (uint32_t v : tris_[t]) vtris_[v].push_back(t);
       insertBuckets(t);
@@ -234,6 +235,11 @@ class Simplifier {
   }
   void insertBuckets(uint32_t t) {
     cells_[t] = cellRange(pos_[tris_[t][0]], pos_[tris_[t][1]], pos_[tris_[t][2]]);
+    const Tri& tr = tris_[t];
+    for (int k = 0; k < 3; ++k) {
+      qbox_[t][k] = std::min({qpos_[tr[0]][k], qpos_[tr[1]][k], qpos_[tr[2]][k]});
+      qbox_[t][k + 3] = std::max({qpos_[tr[0]][k], qpos_[tr[1]][k], qpos_[tr[2]][k]});
+    }
     forCells(cells_[t], [&](uint64_t k) { buckets_[k].push_back(t); });
   }
   void eraseBuckets(uint32_t t) {
@@ -434,6 +440,9 @@ class Simplifier {
         }
       }
       auto range = cellRange(corner(ti[0]), corner(ti[1]), corner(ti[2]));
+      exact::P lo = Ti[0], hi = Ti[0];
+      for (int k = 0; k < 3; ++k)
+        for (int c = 1; c < 3; ++c) lo[k] = std::min(lo[k], Ti[c][k]), hi[k] = std::max(hi[k], Ti[c][k]);
       bool bad = false;
       ++probeNow_;
       forCells(range, [&](uint64_t key) {
@@ -443,9 +452,11 @@ class Simplifier {
         for (uint32_t u : it->second) {
           if (stamp_[u] == stampNow_ || probe_[u] == probeNow_) continue;
           probe_[u] = probeNow_;
+          const auto& box = qbox_[u];  // disjoint boxes: no contact, not even a shared vertex
+          if (box[3] < lo[0] || box[0] > hi[0] || box[4] < lo[1] || box[1] > hi[1] || box[5] < lo[2] || box[2] > hi[2])
+            continue;
           const Tri& tu = tris_[u];
-          std::array<exact::P, 3> Tu{qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]};
-          if (improperPair(ti, Ti, tu, Tu)) {
+          if (improperPair(ti, Ti, tu, {qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]})) {
             bad = true;
             return;
           }
@@ -568,6 +579,7 @@ class Simplifier {
   std::vector<uint32_t> stamp_, probe_;
   uint32_t stampNow_ = 0, probeNow_ = 0;
   std::vector<std::array<int32_t, 6>> cells_;
+  std::vector<std::array<int64_t, 6>> qbox_;  // quantised bounding box of each triangle
   std::unordered_map<uint64_t, std::vector<uint32_t>> buckets_;
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue_;
   BatchEvaluator<double> batch_;

@@ -1,7 +1,8 @@
 // frepfarm's fr* extremum extensions (issue 6, docs/extremum.md "The language side"): Minkowski
 // sum and difference, projection, sweep, constant-radius offset and Minkowski metamorphosis of
 // OBJECTS defined earlier in the file. Each lowers to one extremum node (frep/extremum.h) over
-// the callee's compiled field, read through the caller's coordinate array.
+// the callee's compiled field, read through the caller's coordinate array. Sweeps also take
+// keyframe motions (frSweepKeys; frKeyframe is the interpolant alone, for motion objects).
 //
 // Options: an optional trailing array [method, tol, lo1, hi1, ..., lok, hik]: method 0 =
 // branch-and-bound (default), 1 = the paper's grid; tol = the B&B certified gap or the grid step
@@ -367,6 +368,138 @@ Expr frSweep(std::vector<Arg>& a) {
   return through(r, xs, n);
 }
 
+// ---- Keyframe motions ------------------------------------------------------------------
+// Piecewise-linear interpolation through keyframes (t_i, v_i), i = 1..k, t_i strictly
+// increasing constants; held at v_1 before t_1 and at v_k after t_k. Written as a sum of clamped
+// ramps, v_1 + sum_i s_i (clamp(t, t_i, t_{i+1}) - t_i) with s_i the segment slopes: continuous,
+// no branches, and on a t interval inside one segment its natural interval enclosure is exact
+// (the other clamps are constant there), which keeps the sweep's branch-and-bound over t tight.
+// Piecewise linear rather than Catmull-Rom: the path passes through the keyframes and stays in
+// their convex hull (no overshoot), and a ball swept along it is exactly a union of capsules.
+Expr keyframeLerp(const Expr& t, const std::vector<double>& ts, const std::vector<Expr>& vs) {
+  Expr r = vs[0];
+  for (size_t i = 0; i + 1 < ts.size(); ++i) {
+    Expr dv = vs[i + 1] - vs[i];
+    if (dv.isConst(0.0)) continue;  // a constant stretch adds nothing
+    Expr ramp = min(max(t, Expr(ts[i])), Expr(ts[i + 1])) - ts[i];
+    r = r + dv * (1.0 / (ts[i + 1] - ts[i])) * ramp;
+  }
+  return r;
+}
+
+// The keyframe times: an array of k >= minKeys constants, strictly increasing.
+std::vector<double> keyTimes(const char* fn, std::vector<Arg>& a, int i, size_t minKeys) {
+  if (i >= static_cast<int>(a.size()) || !a[i].isArray || !a[i].array)
+    throw LibraryError(std::string(fn) + ": argument " + std::to_string(i + 1) +
+                           " must be the array of keyframe times",
+                       i);
+  const std::vector<Expr>& v = *a[i].array;
+  if (v.size() < minKeys)
+    throw LibraryError(std::string(fn) + ": the times array '" + a[i].name + "' needs at least " +
+                           std::to_string(minKeys) + " keyframes (got " + std::to_string(v.size()) + ")",
+                       i);
+  std::vector<double> ts;
+  for (size_t k = 0; k < v.size(); ++k) {
+    if (!v[k].isConst() || !std::isfinite(v[k].constValue()))
+      throw LibraryError(std::string(fn) + ": time " + a[i].name + "[" + std::to_string(k + 1) +
+                             "] must be a finite constant known at compile time",
+                         i);
+    ts.push_back(v[k].constValue());
+    if (k > 0 && !(ts[k] > ts[k - 1]))
+      throw LibraryError(std::string(fn) + ": keyframe times must increase strictly (" + a[i].name +
+                             "[" + std::to_string(k) + "] = " + num(ts[k - 1]) + ", " + a[i].name + "[" +
+                             std::to_string(k + 1) + "] = " + num(ts[k]) + ")",
+                         i);
+  }
+  return ts;
+}
+
+// frKeyframe(t, times, values): the piecewise-linear function through (times[i], values[i]);
+// use it in a motion object of frSweep (px(x[1], a[1]) { ...; px = frKeyframe(x[1], ts, vs); }).
+Expr frKeyframe(std::vector<Arg>& a) {
+  const char* fn = "frKeyframe";
+  if (a.size() != 3) throw LibraryError("frKeyframe takes (t, times, values)");
+  const Expr& t = hf::scalarArg(fn, a, 0);
+  std::vector<double> ts = keyTimes(fn, a, 1, 1);
+  const std::vector<Expr>& vs = hf::arrayExactly(fn, a, 2, ts.size(), " (one value per keyframe time)");
+  return keyframeLerp(t, ts, vs);
+}
+
+// frSweepKeys(x, A, times, positions [, angles] [, options]): A moved through k keyframes,
+// positions = k n-vectors one after the other, angles = k rotations (2D: one angle; 3D: Rx Ry
+// Rz), interpolated piecewise linearly, swept over t in [times[1], times[k]].
+Expr frSweepKeys(std::vector<Arg>& a) {
+  const char* fn = "frSweepKeys";
+  const char* usage = "frSweepKeys takes (x, A, times, positions [, angles] [, options])";
+  if (a.size() < 4 || a.size() > 6) throw LibraryError(usage);
+  const Arg& A = objectArg(fn, a, 1, "A");
+  if (!a[0].isArray || !a[0].array)
+    throw LibraryError("frSweepKeys: argument 1 must be the coordinate array (x)", 0);
+  const size_t N = static_cast<size_t>(A.objectDims);
+  const bool timeVarying = N == a[0].array->size() + 1;
+  const size_t n = timeVarying ? N - 1 : N;
+  if (n < 1 || n > 3)
+    throw LibraryError("frSweepKeys: object '" + A.name + "' must have 1, 2 or 3 coordinates (plus time)", 1);
+  std::vector<Expr>& xs = coordArg(fn, a, n);
+  std::vector<double> ts = keyTimes(fn, a, 2, 2);
+  const size_t k = ts.size();
+  const std::vector<Expr>& ps =
+      hf::arrayExactly(fn, a, 3, k * n, " (" + std::to_string(n) + " coordinates for each of the " +
+                                           std::to_string(k) + " keyframes)");
+  const size_t rot = n == 2 ? 1 : n == 3 ? 3 : 0;
+  // A fifth array is the angles when its size is k * rot (2D with two keyframes: always the
+  // angles; give [0, 0] then to pass options), otherwise the options.
+  int anglesAt = -1, optionsAt = -1;
+  if (rot == 0 && a.size() == 6)
+    throw LibraryError("frSweepKeys: a 1D motion takes no angles: (x, A, times, positions [, options])", 4);
+  for (int i = 4; i < static_cast<int>(a.size()); ++i) {
+    if (!a[i].isArray || !a[i].array)
+      throw LibraryError(std::string(fn) + ": argument " + std::to_string(i + 1) +
+                             " must be an array (angles or options)",
+                         i);
+    if (i == 4 && rot > 0 && a[i].array->size() == k * rot)
+      anglesAt = i;
+    else if (i == static_cast<int>(a.size()) - 1 && a[i].array->size() == 2)
+      optionsAt = i;
+    else if (i == static_cast<int>(a.size()) - 1 && i == 5)
+      optionsAt = i;  // parseOptions explains the size
+    else if (rot == 0)
+      optionsAt = i;  // 1D: only options; parseOptions explains the size
+    else
+      throw LibraryError(std::string(fn) + ": array " + a[i].name + " must be the angles (" + std::to_string(rot) +
+                             " for each of the " + std::to_string(k) + " keyframes: " + std::to_string(k * rot) +
+                             " elements) or the options [method, tol] (got " + std::to_string(a[i].array->size()) +
+                             " elements)",
+                         i);
+  }
+  for (size_t j = 0; j < k * n; ++j)
+    if (numVars(ps[j]) > 0 || numParams(ps[j]) > 0)
+      throw LibraryError(std::string(fn) + ": position " + a[3].name + "[" + std::to_string(j + 1) +
+                             "] must not depend on x or a free a[] (use frKeyframe in motion objects and frSweep)",
+                         3);
+  Motion m;
+  const Expr t = Expr::x(0);
+  auto channel = [&](const std::vector<Expr>& v, size_t stride, size_t c) {
+    std::vector<Expr> vs;
+    for (size_t j = 0; j < k; ++j) vs.push_back(v[j * stride + c]);
+    return keyframeLerp(t, ts, vs);
+  };
+  for (size_t c = 0; c < n; ++c) m.translation.push_back(channel(ps, n, c));
+  if (anglesAt >= 0) {
+    const std::vector<Expr>& an = *a[anglesAt].array;
+    for (size_t j = 0; j < an.size(); ++j)
+      if (numVars(an[j]) > 0 || numParams(an[j]) > 0)
+        throw LibraryError(std::string(fn) + ": angle " + a[anglesAt].name + "[" + std::to_string(j + 1) +
+                               "] must not depend on x or a free a[]",
+                           anglesAt);
+    for (size_t c = 0; c < rot; ++c) m.rotation.push_back(channel(an, rot, c));
+  }
+  Options o = optionsAt >= 0 ? parseOptions(fn, a, optionsAt, 0) : Options{};
+  if (o.hasBox) throw LibraryError("frSweepKeys: the options take no box", optionsAt);
+  Expr r = guarded(fn, -1, [&] { return sweep(A.value, static_cast<uint32_t>(n), m, ts.front(), ts.back(), o.search); });
+  return through(r, xs, n);
+}
+
 const bool registered = registerAll({
     {"frMinkowski", "*", "A + B: max over u in box(B) of A(X - u) & B(u)", frMinkowski},
     {"frMinkowskiDiff", "*", "A - B: min over u in box(B) of max(A(X + u), -B(u))", frMinkowskiDiff},
@@ -374,6 +507,8 @@ const bool registered = registerAll({
     {"frMorphMinkowski", "*", "((1 - t) A) + (t B), t in [0, 1] constant", frMorphMinkowski},
     {"frProject", "*", "max over the given coordinates (1-based) of A", frProject},
     {"frSweep", "*", "max over t in [t0, t1] of A(M(t)^-1 X), M from motion objects of t", frSweep},
+    {"frSweepKeys", "*", "frSweep along keyframes: (x, A, times, positions [, angles] [, options])", frSweepKeys},
+    {"frKeyframe", "*", "piecewise-linear interpolation through (times[i], values[i]) at t", frKeyframe},
 });
 
 }  // namespace

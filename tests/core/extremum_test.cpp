@@ -4,7 +4,9 @@
 // closure (extremum inside other operations and inside another extremum) and sampling.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <stdexcept>
 
@@ -542,4 +544,56 @@ TEST(Extremum, SamplingMatchesPointEvaluation) {
   ASSERT_EQ(r2.leaves.size(), r.leaves.size());
   for (size_t i = 0; i < r.leaves.size(); ++i)
     for (int o = 0; o < kLeafVoxels; ++o) ASSERT_EQ(r.leaves[i].values[o], r2.leaves[i].values[o]);
+}
+
+// Issue 6: the volume of box (+) ball at 128^3 against Steiner's formula
+// V = abc + 2(ab + bc + ca) r + pi (a + b + c) r^2 + 4/3 pi r^3 (the rounded box's volume).
+// The volume is the number of lattice points with f >= 0 (band leaves and inside tiles of
+// frep::sample) times the voxel volume. Stated tolerances:
+//  - against Steiner: 0.6% (the lattice count's own error is first order in the voxel: the
+//    exact rounded box counted on the same lattice is off by -0.34%);
+//  - against the exact rounded box counted on the same lattice: 0.15% (what the search adds:
+//    the B&B gap is 0.05 voxel in value, i.e. ~0.1 voxel in position, on the band voxels).
+// Narrow band and two threads keep it a few seconds (measured 1.3-3.4 s wall on 2 cores shared
+// with other jobs, load 7). Measured: -0.339% against Steiner, -0.000% against the lattice.
+TEST(Extremum, BoxPlusBallVolumeMatchesSteinerAt128) {
+  const double a = 2.0, b = 1.5, c = 1.0, r = 0.25;
+  // Bounds such that no lattice plane coincides with a face of the shape.
+  GridSpec g = GridSpec::fromBounds({-1.4137, -1.4071, -1.4029}, {1.4137, 1.4071, 1.4029}, 128);
+  Expr m = minkowskiSum(box3(a / 2, b / 2, c / 2), ballSdf3(r), 3, cube(3, r), bnb(0.05 * g.voxel));
+  SampleOptions so;
+  so.threads = 2;
+  SampleResult res = sample(Tape::compile(m), g, so);
+  uint64_t inside = 0;
+  for (const Tile& t : res.tiles) {
+    if (!t.inside) continue;
+    uint64_t n = 1;
+    for (int k = 0; k < 3; ++k) n *= uint64_t(std::max(0, std::min(t.origin[k] + t.size, g.dims[k]) - t.origin[k]));
+    inside += n;
+  }
+  for (const LeafBlock& l : res.leaves)
+    for (int x = 0; x < 8; ++x)
+      for (int y = 0; y < 8; ++y)
+        for (int z = 0; z < 8; ++z)
+          if (l.origin[0] + x < g.dims[0] && l.origin[1] + y < g.dims[1] && l.origin[2] + z < g.dims[2] &&
+              l.values[leafOffset(x, y, z)] >= 0)
+            ++inside;
+  uint64_t exactInside = 0;
+  for (int i = 0; i < g.dims[0]; ++i)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int k = 0; k < g.dims[2]; ++k) {
+        auto p = g.world(i, j, k);
+        const double dx = std::max(0.0, std::fabs(p[0]) - a / 2), dy = std::max(0.0, std::fabs(p[1]) - b / 2),
+                     dz = std::max(0.0, std::fabs(p[2]) - c / 2);
+        exactInside += dx * dx + dy * dy + dz * dz <= r * r;
+      }
+  const double cell = g.voxel * g.voxel * g.voxel;
+  const double v = double(inside) * cell, vLattice = double(exactInside) * cell;
+  const double steiner =
+      a * b * c + 2 * (a * b + b * c + c * a) * r + kPi * (a + b + c) * r * r + 4 * kPi * r * r * r / 3;
+  std::printf("box + ball at 128^3: sampled %.5f, Steiner %.5f (%+.3f%%), exact shape on the lattice %.5f (%+.3f%%)\n",
+              v, steiner, 100 * (v - steiner) / steiner, vLattice, 100 * (v - vLattice) / vLattice);
+  EXPECT_EQ(g.dims[0], 128);
+  EXPECT_NEAR(v, steiner, 0.006 * steiner) << "sampled " << v << " lattice " << vLattice;
+  EXPECT_NEAR(v, vLattice, 0.0015 * vLattice) << "sampled " << v << " Steiner " << steiner;
 }

@@ -1,5 +1,7 @@
 // The fr* extremum extensions (lang/src/lib_fr_extremum.cpp): object operands, automatic
 // bounding boxes, and the exact answers of issue 6 at a few points each (coarse tolerances).
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "lang/lang_test_util.h"
@@ -172,6 +174,98 @@ TEST(FrExtremum, OperandParametersAndClosure) {
   EXPECT_LT(at(c, {0, 0, 1.1}), 0);
 }
 
+// Keyframe motions: frKeyframe interpolates piecewise linearly and holds the end values.
+TEST(FrExtremum, KeyframeInterpolatesPiecewiseLinearly) {
+  Model m = compileOk(
+      "my_model(x[3], a[1]) { array ts[4], vs[4]; ts = [0, 0.5, 1.5, 2]; vs = [1, 3, -1, -1]; "
+      "my_model = frKeyframe(x[1], ts, vs); }");
+  const std::vector<std::pair<double, double>> expect = {
+      {-1, 1}, {0, 1}, {0.25, 2}, {0.5, 3}, {1.0, 1}, {1.5, -1}, {1.75, -1}, {2, -1}, {3, -1}};
+  for (auto [t, v] : expect) {
+    SCOPED_TRACE(t);
+    EXPECT_CLOSE(at(m, {t, 0, 0}), v);
+  }
+  // One keyframe: a constant.
+  Model c = compileOk(
+      "my_model(x[3], a[1]) { array ts[1], vs[1]; ts = [0.3]; vs = [2.5]; my_model = frKeyframe(x[1], ts, vs); }");
+  EXPECT_CLOSE(at(c, {-5, 0, 0}), 2.5);
+  EXPECT_CLOSE(at(c, {5, 0, 0}), 2.5);
+}
+
+// Distance from p to the polyline through `pts` (3D).
+double polylineDistance(const std::vector<std::array<double, 3>>& pts, const std::vector<double>& p) {
+  double best = 1e300;
+  for (size_t i = 0; i + 1 < pts.size(); ++i) {
+    double d[3], q[3], dd = 0, qd = 0;
+    for (int k = 0; k < 3; ++k) {
+      d[k] = pts[i + 1][k] - pts[i][k];
+      q[k] = p[k] - pts[i][k];
+      dd += d[k] * d[k];
+      qd += q[k] * d[k];
+    }
+    const double s = std::clamp(qd / dd, 0.0, 1.0);
+    double e = 0;
+    for (int k = 0; k < 3; ++k) e += (q[k] - s * d[k]) * (q[k] - s * d[k]);
+    best = std::min(best, std::sqrt(e));
+  }
+  return best;
+}
+
+// A ball (exact distance, radius 0.3) swept through keyframes along an L-shaped path is the union
+// of two capsules: its value is 0.3 - dist(X, path) (up to the certified gap), inside and out.
+TEST(FrExtremum, SweepKeysAlongAnLIsTheUnionOfTwoCapsules) {
+  const std::string src =
+      "ball(x[3], a[1]) { ball = 0.3 - sqrt(x[1]^2 + x[2]^2 + x[3]^2); }\n"
+      "my_model(x[3], a[1]) {\n"
+      "  array ts[3], ps[9], o[2];\n"
+      "  ts = [0, 1, 3];\n"
+      "  ps = [0, 0, 0,  2, 0, 0,  2, 1.5, 0];\n"
+      "  o = [0, 0.0005];\n"
+      "  my_model = frSweepKeys(x, ball, ts, ps, o);\n"
+      "}";
+  Model m = compileOk(src);
+  const std::vector<std::array<double, 3>> path = {{0, 0, 0}, {2, 0, 0}, {2, 1.5, 0}};
+  const std::vector<std::vector<double>> pts = {
+      {1, 0.1, 0},    {1, 0.29, 0},  {1, 0.31, 0},   {-0.2, 0.2, 0}, {2.25, -0.2, 0}, {2.1, 0.7, 0.2},
+      {1.75, 0.7, 0}, {2.3, 1.6, 0}, {2, 1.82, 0},   {1.5, 1.0, 0},  {2.2, 0.2, 0.1}, {0.5, 0, 0.35},
+      {3, 3, 3},      {-1, 0, 0},    {2.21, 0.21, 0}};
+  for (const auto& p : pts) EXPECT_NEAR(at(m, p), 0.3 - polylineDistance(path, p), 1e-3) << p[0] << "," << p[1];
+  // The same path written with frKeyframe motion objects and frSweep gives the same values.
+  const std::string viaSweep =
+      "ball(x[3], a[1]) { ball = 0.3 - sqrt(x[1]^2 + x[2]^2 + x[3]^2); }\n"
+      "px(x[1], a[1]) { array ts[3], v[3]; ts = [0, 1, 3]; v = [0, 2, 2]; px = frKeyframe(x[1], ts, v); }\n"
+      "py(x[1], a[1]) { array ts[3], v[3]; ts = [0, 1, 3]; v = [0, 0, 1.5]; py = frKeyframe(x[1], ts, v); }\n"
+      "pz(x[1], a[1]) { pz = 0; }\n"
+      "my_model(x[3], a[1]) { array o[2]; o = [0, 0.0005]; my_model = frSweep(x, ball, px, py, pz, 0, 3, o); }";
+  Model s = compileOk(viaSweep);
+  for (const auto& p : pts) EXPECT_NEAR(at(s, p), at(m, p), 1e-3);
+}
+
+// Rotation keyframes: a 2D bar turned a quarter turn about the origin through a keyframe at
+// half way (0 -> pi/4 -> pi/2) equals the expression form; its translation keyframes move it.
+TEST(FrExtremum, SweepKeysWithAngles) {
+  const std::string bar = "bar(x[2], a[1]) { bar = min(1 - abs(x[1]), 0.05 - abs(x[2])); }\n";
+  Model keys = compileOk(bar +
+                         "my_model(x[2], a[1]) { array ts[3], ps[6], an[3], o[2]; ts = [0, 0.5, 1]; "
+                         "ps = [0, 0, 0, 0, 0, 0]; an = [0, 0.78539816339744831, 1.5707963267948966]; "
+                         "o = [0, 0.0005]; my_model = frSweepKeys(x, bar, ts, ps, an, o); }");
+  Model expr = compileOk(bar +
+                         "zero(x[1], a[1]) { zero = 0; }\n"
+                         "turn(x[1], a[1]) { turn = 1.5707963267948966 * x[1]; }\n"
+                         "my_model(x[2], a[1]) { array o[2]; o = [0, 0.0005]; "
+                         "my_model = frSweep(x, bar, zero, zero, turn, 0, 1, o); }");
+  for (auto p : std::vector<std::vector<double>>{{0.5, 0.5}, {0.7, 0.7}, {0.75, 0.72}, {0, 0.95}, {0, 1.05},
+                                                 {0.95, 0}, {1.05, 0}, {0.5, -0.2}, {-0.5, -0.5}, {-0.4, 0.6}})
+    EXPECT_NEAR(at(keys, p), at(expr, p), 1e-3) << p[0] << "," << p[1];
+  // Translation keyframes with angles: the bar (turned by pi/2 at t = 1) ends up vertical at x1 = 3.
+  Model moved = compileOk(bar +
+                          "my_model(x[2], a[1]) { array ts[2], ps[4], an[2]; ts = [0, 1]; ps = [0, 0, 3, 0]; "
+                          "an = [0, 1.5707963267948966]; my_model = frSweepKeys(x, bar, ts, ps, an); }");
+  EXPECT_GT(at(moved, {3, 0.9}), 0);
+  EXPECT_LT(at(moved, {3.5, 1.2}), 0);
+  EXPECT_GT(at(moved, {-0.9, 0}), 0);  // t = 0: horizontal at the origin
+}
+
 // The paper examples in examples/extremum/ compile, and a point of each is right.
 std::string exampleDir() {
   std::string f = __FILE__;  // .../tests/lang/lib_fr_extremum_test.cpp
@@ -201,6 +295,11 @@ TEST(FrExtremum, PaperExamples) {
   Model nc = compileExample("nc_machining.hf");
   EXPECT_LT(at(nc, {0, 0, 0.4}), 0);   // the groove at t = 0.5
   EXPECT_GT(at(nc, {0, 0.9, 0.4}), 0);  // block material beside it
+  Model keys = compileExample("keyframe_sweep.hf");
+  EXPECT_LT(at(keys, {0, -0.8, 0.35}), 0);   // the first pass's groove (tool centre at z = 0.3)
+  EXPECT_GT(at(keys, {0, -0.8, 0.0}), 0);    // below the ball end (z >= 0.05 is cut)
+  EXPECT_LT(at(keys, {0, 0.4, 0.35}), 0);    // the diagonal pass at x = 0: y = 0.4, z = 0.15
+  EXPECT_GT(at(keys, {0, 0.95, 0.4}), 0);    // block material beside it
   Model p4 = compileExample("project_4d.hf");
   EXPECT_GT(at(p4, {1, 0, -0.8}), 0);  // t = 0: ball of radius 0.35 at (1, 0, -0.8)
   EXPECT_LT(at(p4, {0, 0, 0}), 0);
@@ -243,6 +342,21 @@ TEST(FrExtremum, ErrorsAtTheirPlace) {
                3, 28, "defined later"});
   expectError({h + "m(x[3], a[1]) {\n  v = 2;\n  m = frMinkowski(x, ball, v);\n}", 4, 28,
                "must be the name of an object"});
+  expectError({h + "m(x[3], a[1]) {\n  array ts[3], ps[9];\n  ts = [0, 1, 1];\n  ps = [0, 0, 0, 1, 0, 0, 1, 1, 0];\n"
+                   "  m = frSweepKeys(x, ball, ts, ps);\n}",
+               6, 28, "keyframe times must increase strictly"});
+  expectError({h + "m(x[3], a[1]) {\n  array ts[2], ps[5];\n  ts = [0, 1];\n  ps = [0, 0, 0, 1, 0];\n"
+                   "  m = frSweepKeys(x, ball, ts, ps);\n}",
+               6, 32, "must have 6 elements (3 coordinates for each of the 2 keyframes)"});
+  expectError({h + "m(x[3], a[1]) {\n  array ts[2], ps[6], an[4];\n  ts = [0, 1];\n  ps = [0, 0, 0, 1, 0, 0];\n"
+                   "  an = [0, 0, 0, 1];\n  m = frSweepKeys(x, ball, ts, ps, an);\n}",
+               7, 36, "must be the angles (3 for each of the 2 keyframes: 6 elements) or the options"});
+  expectError({h + "m(x[3], a[1]) {\n  array ts[2], v[3];\n  ts = [0, 1];\n  v = [0, 1, 2];\n"
+                   "  m = frKeyframe(x[1], ts, v);\n}",
+               6, 28, "must have 2 elements (one value per keyframe time)"});
+  expectError({h + "m(x[3], a[1]) {\n  array ts[2], v[2];\n  ts = [0, x[1]];\n  v = [0, 1];\n"
+                   "  m = frKeyframe(x[1], ts, v);\n}",
+               6, 24, "must be a finite constant known at compile time"});
 }
 
 }  // namespace
