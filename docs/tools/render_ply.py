@@ -3,6 +3,10 @@
 with POV-Ray (Debian package povray), for previews in the README and docs.
 
     docs/tools/render_ply.py part.ply part.png [--width 640] [--elevation 25] [--azimuth 35]
+                             [--flat] [--edges]
+
+--flat ignores the vertex normals (faceted shading: sharp edges look sharp); --edges draws every
+triangle's edges (to show an adaptive mesh's triangles).
 """
 import argparse
 import math
@@ -40,6 +44,8 @@ def main():
     ap.add_argument("--width", type=int, default=640)
     ap.add_argument("--elevation", type=float, default=25.0)
     ap.add_argument("--azimuth", type=float, default=35.0)
+    ap.add_argument("--flat", action="store_true")
+    ap.add_argument("--edges", action="store_true")
     a = ap.parse_args()
     verts, faces = read_ply(a.ply)
     lo = [min(v[i] for v in verts) for i in range(3)]
@@ -62,11 +68,19 @@ def main():
             s.write("light_source { %s rgb 0.35 shadowless }\n" % pov([centre[0] - 3 * radius, centre[1] + radius, centre[2]]))
             s.write("mesh2 {\n vertex_vectors { %d,\n" % len(verts))
             s.write(",\n".join(pov(v[:3]) for v in verts))
-            s.write("}\n normal_vectors { %d,\n" % len(verts))
-            s.write(",\n".join(pov(v[3:]) for v in verts))
+            if not a.flat:
+                s.write("}\n normal_vectors { %d,\n" % len(verts))
+                s.write(",\n".join(pov(v[3:]) for v in verts))
             s.write("}\n face_indices { %d,\n" % len(faces))
             s.write(",\n".join("<%d,%d,%d>" % tuple(f[:3]) for f in faces))
             s.write("}\n texture { pigment { rgb <0.93,0.55,0.25> } finish { phong 0.4 diffuse 0.75 ambient 0.12 } }\n}\n")
+            if a.edges:
+                edges = {tuple(sorted((f[i], f[(i + 1) % 3]))) for f in faces for i in range(3)}
+                r = radius * 0.0015
+                s.write("union {\n")
+                for i, j in sorted(edges):
+                    s.write(" cylinder { %s, %s, %.6f }\n" % (pov(verts[i][:3]), pov(verts[j][:3]), r))
+                s.write(" pigment { rgb <0.25,0.12,0.05> }\n}\n")
         height = int(a.width * 0.75)
         subprocess.run(["povray", "-D", "+A", "+W%d" % a.width, "+H%d" % height, "+I" + scene, "+O" + a.png],
                        check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
