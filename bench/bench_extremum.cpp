@@ -22,7 +22,10 @@
 #include "frep/ops.h"
 #include "frep/sample.h"
 
+#include "bench_timing.h"
+
 using namespace frep;
+using frep::bench::cpuSeconds;
 
 namespace {
 
@@ -36,11 +39,6 @@ Expr boxSdf(double a, double b, double c) { return min(min(a - abs(X()), b - abs
 
 double seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-double cpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 struct Run {
@@ -67,26 +65,6 @@ Run runSample(const Expr& model, const GridSpec& g) {
   r.voxels = r.res.stats.pointEvals;
   r.uncertified = c.uncertified;
   return r;
-}
-
-// Inside voxels (value >= 0) x voxel volume.
-double volume(const SampleResult& r) {
-  const GridSpec& g = r.grid;
-  uint64_t inside = 0;
-  for (const Tile& t : r.tiles) {
-    if (!t.inside) continue;
-    uint64_t n = 1;
-    for (int a = 0; a < 3; ++a) n *= uint64_t(std::max(0, std::min(t.origin[a] + t.size, g.dims[a]) - t.origin[a]));
-    inside += n;
-  }
-  for (const LeafBlock& l : r.leaves)
-    for (int x = 0; x < 8; ++x)
-      for (int y = 0; y < 8; ++y)
-        for (int z = 0; z < 8; ++z)
-          if (l.origin[0] + x < g.dims[0] && l.origin[1] + y < g.dims[1] && l.origin[2] + z < g.dims[2] &&
-              l.values[leafOffset(x, y, z)] >= 0)
-            ++inside;
-  return double(inside) * g.voxel * g.voxel * g.voxel;
 }
 
 // a: the R-intersection in the Minkowski body (1: min, the default; 0: Pasko-Minkowski eq. 3.3).
@@ -181,19 +159,14 @@ void steiner(int res) {
   Expr m = minkowskiSum(box, ball, 3, {{-r, -r, -r}, {r, r, r}}, o);
   Run run = runSample(m, g);
   const double exact = a * b * c + 2 * (a * b + b * c + c * a) * r + kPi * (a + b + c) * r * r + 4 * kPi * r * r * r / 3;
-  const double v = volume(run.res);
+  const double v = insideVolume(run.res);
   // The same voxel count for the exact rounded box (distance to the box <= r) on the same
   // lattice: separates the lattice's own counting error from the search's.
-  uint64_t inExact = 0;
-  for (int i = 0; i < g.dims[0]; ++i)
-    for (int j = 0; j < g.dims[1]; ++j)
-      for (int k = 0; k < g.dims[2]; ++k) {
-        auto p = g.world(i, j, k);
-        const double dx = std::max(0.0, std::fabs(p[0]) - a / 2), dy = std::max(0.0, std::fabs(p[1]) - b / 2),
-                     dz = std::max(0.0, std::fabs(p[2]) - c / 2);
-        inExact += dx * dx + dy * dy + dz * dz <= r * r;
-      }
-  const double vExact = double(inExact) * g.voxel * g.voxel * g.voxel;
+  const double vExact = latticeVolume(g, [&](const std::array<double, 3>& p) {
+    const double dx = std::max(0.0, std::fabs(p[0]) - a / 2), dy = std::max(0.0, std::fabs(p[1]) - b / 2),
+                 dz = std::max(0.0, std::fabs(p[2]) - c / 2);
+    return dx * dx + dy * dy + dz * dz <= r * r;
+  });
   std::printf("  %4d^3: volume %.5f vs Steiner %.5f: rel. error %+.3f%%; exact shape on the same lattice %.5f "
               "(%+.3f%%), sampled vs exact-lattice %+.3f%%  (%.2f cpu s, %llu band voxels, voxel %.4f)\n",
               res, v, exact, 100 * (v - exact) / exact, vExact, 100 * (vExact - exact) / exact,

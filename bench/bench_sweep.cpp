@@ -27,39 +27,13 @@
 #include "frep/ops.h"
 #include "frep/sample.h"
 
+#include "bench_timing.h"
+
 using namespace frep;
 
 namespace {
 
 constexpr double kPi = 3.141592653589793;
-
-// CPU seconds of the process: both sides run on one thread, and the machine's cores are shared,
-// so CPU time is the stable measure (wall time varies with the load).
-double cpuNow() {
-  timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
-// Lattice points with f >= 0 (inside tiles and band leaves) times the voxel volume.
-double volume(const SampleResult& r) {
-  const GridSpec& g = r.grid;
-  uint64_t inside = 0;
-  for (const Tile& t : r.tiles) {
-    if (!t.inside) continue;
-    uint64_t n = 1;
-    for (int a = 0; a < 3; ++a) n *= uint64_t(std::max(0, std::min(t.origin[a] + t.size, g.dims[a]) - t.origin[a]));
-    inside += n;
-  }
-  for (const LeafBlock& l : r.leaves)
-    for (int x = 0; x < 8; ++x)
-      for (int y = 0; y < 8; ++y)
-        for (int z = 0; z < 8; ++z)
-          if (l.origin[0] + x < g.dims[0] && l.origin[1] + y < g.dims[1] && l.origin[2] + z < g.dims[2] &&
-              l.values[leafOffset(x, y, z)] >= 0)
-            ++inside;
-  return double(inside) * g.voxel * g.voxel * g.voxel;
-}
 
 struct Run {
   double seconds = 0, volume = 0;
@@ -70,11 +44,11 @@ Run runSample(const Expr& model, const GridSpec& g) {
   TapePtr t = Tape::compile(model);
   SampleOptions o;
   o.threads = 1;  // one core on both sides of every ratio
-  const double t0 = cpuNow();
+  const double t0 = bench::cpuSeconds();  // both sides run on one thread
   SampleResult res = sample(t, g, o);
   Run r;
-  r.seconds = cpuNow() - t0;
-  r.volume = volume(res);
+  r.seconds = bench::cpuSeconds() - t0;
+  r.volume = insideVolume(res);
   r.bandVoxels = res.stats.pointEvals;
   return r;
 }
@@ -115,18 +89,13 @@ void segment(int res) {
   const double sag = r - std::sqrt(r * r - 0.25 * (L / (N - 1)) * (L / (N - 1)));
 
   // The exact capsule on the same lattice.
-  uint64_t in = 0;
-  for (int i = 0; i < g.dims[0]; ++i)
-    for (int j = 0; j < g.dims[1]; ++j)
-      for (int k = 0; k < g.dims[2]; ++k) {
-        auto p = g.world(i, j, k);
-        double q[3] = {p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]};
-        double s = std::clamp((q[0] * d[0] + q[1] * d[1] + q[2] * d[2]) / (L * L), 0.0, 1.0);
-        double e2 = 0;
-        for (int a = 0; a < 3; ++a) e2 += (q[a] - s * d[a]) * (q[a] - s * d[a]);
-        in += e2 <= r * r;
-      }
-  const double vLattice = double(in) * g.voxel * g.voxel * g.voxel;
+  const double vLattice = latticeVolume(g, [&](const std::array<double, 3>& p) {
+    double q[3] = {p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]};
+    double s = std::clamp((q[0] * d[0] + q[1] * d[1] + q[2] * d[2]) / (L * L), 0.0, 1.0);
+    double e2 = 0;
+    for (int a = 0; a < 3; ++a) e2 += (q[a] - s * d[a]) * (q[a] - s * d[a]);
+    return e2 <= r * r;
+  });
   const double vCapsule = kPi * r * r * L + 4.0 * kPi * r * r * r / 3.0;
 
   Run sw = runSample(swept, g);

@@ -303,81 +303,168 @@ struct ExtremumSolver::Impl {
     return r;
   }
 
+  // ---- branch-and-bound building blocks (both searches and bound) ----
+
+  // Boxes are 2p doubles (lo, hi) in the pool; the heap holds (upper bound, box index), the
+  // largest upper bound on top. A box's index is also its index in tapes.
+  using HeapEntry = std::pair<double, uint32_t>;
+  struct HeapLess {
+    bool operator()(const HeapEntry& a, const HeapEntry& b) const { return a.first < b.first; }
+  };
+  void pushBox(const double* lo, const double* hi, double ub) {
+    const uint32_t id = static_cast<uint32_t>(pool.size() / (2 * p));
+    pool.insert(pool.end(), lo, lo + p);
+    pool.insert(pool.end(), hi, hi + p);
+    heap.emplace_back(ub, id);
+    std::push_heap(heap.begin(), heap.end(), HeapLess());
+  }
+  // Takes the box with the largest upper bound off the heap, into lo and hi.
+  HeapEntry popBox(std::vector<double>& lo, std::vector<double>& hi) {
+    std::pop_heap(heap.begin(), heap.end(), HeapLess());
+    const HeapEntry top = heap.back();
+    heap.pop_back();
+    const double* b = &pool[size_t(top.second) * 2 * p];
+    std::copy(b, b + p, lo.begin());
+    std::copy(b + p, b + 2 * p, hi.begin());
+    return top;
+  }
+  void centre(const double* lo, const double* hi, double* c) const {
+    for (uint32_t k = 0; k < p; ++k) c[k] = 0.5 * (lo[k] + hi[k]);
+  }
+
+  // One branch-and-bound search at X: the incumbent (best value and its parameters), the
+  // largest upper bound of the boxes dropped on the way, and the result being filled in.
+  struct Search {
+    Search(Impl& impl, const double* x, std::vector<double>& best) : I(impl), X(x), bestT(best) {}
+    Impl& I;
+    const double* X;
+    std::vector<double>& bestT;
+    ExtremumResult r;
+    double bestV = -kInf;
+    double prunedHi = -kInf;
+
+    // The objective at t (on tape; default: the body), kept when it beats the incumbent.
+    void tryPoint(const double* t, const Tape* tape = nullptr) {
+      const double v = I.evalPoint(X, t, tape);
+      ++r.pointEvals;
+      if (v > bestV) {
+        bestV = v;
+        std::copy(t, t + I.p, bestT.begin());
+      }
+    }
+    // Tries the domain's centre (written to c) and the warm start when it lies in the domain.
+    void seed(const double* warmT, std::vector<double>& c) {
+      I.centre(I.plo.data(), I.phi.data(), c.data());
+      tryPoint(c.data());
+      if (warmT) {
+        bool inside = true;
+        for (uint32_t k = 0; k < I.p; ++k) inside = inside && warmT[k] >= I.plo[k] && warmT[k] <= I.phi[k];
+        if (inside) tryPoint(warmT);
+      }
+    }
+    // Whether a box with upper bound ub is dropped: it cannot beat the incumbent by more than
+    // the tolerance (its bound is kept in prunedHi).
+    bool drop(double ub) {
+      if (!(ub <= bestV + I.s.tolerance)) return false;
+      prunedHi = std::max(prunedHi, ub);
+      return true;
+    }
+  };
+
+  // The best-first loop of both searches, over the boxes in the heap: stops when the largest
+  // upper bound cannot beat the incumbent by more than the tolerance (certified), after maxBoxes
+  // splits (not certified) or at a box too small to split (certified if its bound is within the
+  // tolerance). atTop(top) may try the box's centre and returns false when the box is dropped;
+  // split(d, mid) bounds and keeps the halves of [lo, hi] cut at mid along d. Then fills in the
+  // result: the incumbent's value, and the gap up to the largest bound left or dropped.
+  template <class AtTop, class Split>
+  void bestFirst(Search& S, std::vector<double>& lo, std::vector<double>& hi, AtTop&& atTop, Split&& split) {
+    const double tol = s.tolerance;
+    uint32_t splits = 0;
+    double hiBound = -kInf;
+    bool certified = true;
+    while (!heap.empty()) {
+      const HeapEntry top = popBox(lo, hi);
+      if (top.first <= S.bestV + tol) {
+        hiBound = top.first;  // the largest remaining upper bound
+        break;
+      }
+      if (splits >= s.maxBoxes) {
+        hiBound = top.first;
+        certified = false;
+        break;
+      }
+      if (!atTop(top)) continue;
+      ++splits;
+      const uint32_t d = widestDim(lo.data(), hi.data());
+      const double mid = 0.5 * (lo[d] + hi[d]);
+      if (!(mid > lo[d] && mid < hi[d])) {  // cannot split further: keep its bound
+        hiBound = top.first;
+        certified = top.first <= S.bestV + tol;
+        break;
+      }
+      split(d, mid);
+    }
+    ExtremumResult& r = S.r;
+    double hiAll = std::max({hiBound, S.prunedHi, S.bestV});
+    r.value = sign * S.bestV;
+    r.certified = certified;
+    if (sign > 0) {
+      r.lo = S.bestV;
+      r.hi = hiAll;
+    } else {
+      r.lo = -hiAll;
+      r.hi = -S.bestV;
+    }
+    finish(r, S.bestT);
+  }
+
   // Branch-and-bound on the body's min-of-terms form (extremum_terms.h): the incumbent is
   // polished by local ascent, and every box is contracted by constraint propagation against the
   // cut best + tolerance before it is bounded (boxes that cannot reach the cut are dropped
   // whole; the parts cut off a box are bounded by the cut).
   ExtremumResult branchAndBoundTerms(const double* X, const double* warmT) {
-    ExtremumResult r;
-    std::vector<double>& bestT = tBest;
-    std::vector<double>& c = tC;
-    bestT.assign(p, 0.0);
-    c.assign(p, 0.0);
-    double bestV = -kInf;
-    auto tryPoint = [&](const double* t) {
-      const double v = evalPoint(X, t);
-      ++r.pointEvals;
-      if (v > bestV) {
-        bestV = v;
-        std::copy(t, t + p, bestT.begin());
-      }
-    };
-    for (uint32_t k = 0; k < p; ++k) c[k] = 0.5 * (plo[k] + phi[k]);
-    tryPoint(c.data());
-    if (warmT) {
-      bool inside = true;
-      for (uint32_t k = 0; k < p; ++k) inside = inside && warmT[k] >= plo[k] && warmT[k] <= phi[k];
-      if (inside) tryPoint(warmT);
-    }
+    tBest.assign(p, 0.0);
+    tC.assign(p, 0.0);
+    Search S(*this, X, tBest);
+    S.seed(warmT, tC);
     const double tol = s.tolerance;
     tf.setX(X);
     {
       // Polish the better of the domain centre and the warm start: pruning then starts from a
       // nearly optimal value. A gradient evaluation is counted as 1 + p body evaluations.
       std::vector<double>& at = tAsc;
-      at = bestT;
+      at = tBest;
       const uint32_t calls = tf.ascend(at.data(), plo.data(), phi.data(), tol);
-      r.pointEvals += uint64_t(calls) * (1 + p);
-      tryPoint(at.data());
+      S.r.pointEvals += uint64_t(calls) * (1 + p);
+      S.tryPoint(at.data());
     }
     pool.clear();
     heap.clear();
-    auto cmp = [](const std::pair<double, uint32_t>& a, const std::pair<double, uint32_t>& b) {
-      return a.first < b.first;
-    };
-    double prunedHi = -kInf;
     std::vector<double>& clo = tLo;
     std::vector<double>& chi = tHi;
     // Contract, bound, and keep or drop one box.
     auto consider = [&](const double* lo, const double* hi) {
       clo.assign(lo, lo + p);
       chi.assign(hi, hi + p);
-      const double cut = bestV + tol;
+      const double cut = S.bestV + tol;
       double ub = kInf, ub0 = kInf;
       uint32_t passes = 0;
       const bool alive = tf.contract(clo.data(), chi.data(), cut, ub, ub0, passes);
-      r.intervalEvals += passes;
+      S.r.intervalEvals += passes;
       if (!alive) {  // nothing in the box reaches the cut
-        prunedHi = std::max(prunedHi, std::min(ub0, cut));
+        S.prunedHi = std::max(S.prunedHi, std::min(ub0, cut));
         return;
       }
       bool shrunk = false;
       for (uint32_t k = 0; k < p; ++k) shrunk = shrunk || clo[k] != lo[k] || chi[k] != hi[k];
-      if (shrunk) prunedHi = std::max(prunedHi, cut);  // the parts cut off stay below the cut
+      if (shrunk) S.prunedHi = std::max(S.prunedHi, cut);  // the parts cut off stay below the cut
       if (ub > cut && boxFraction(clo.data(), chi.data()) <= kCentredFraction) {
         // Centred bound (about 2 + p evaluations): only on small boxes, where it is tighter.
         ub = std::min(ub, tf.upper(clo.data(), chi.data()));
-        r.intervalEvals += 2 + p;
+        S.r.intervalEvals += 2 + p;
       }
-      if (ub <= cut) {
-        prunedHi = std::max(prunedHi, ub);
-        return;
-      }
-      const uint32_t id = static_cast<uint32_t>(pool.size() / (2 * p));
-      pool.insert(pool.end(), clo.begin(), clo.end());
-      pool.insert(pool.end(), chi.begin(), chi.end());
-      heap.emplace_back(ub, id);
-      std::push_heap(heap.begin(), heap.end(), cmp);
+      if (!S.drop(ub)) pushBox(clo.data(), chi.data(), ub);
     };
     consider(plo.data(), phi.data());
     std::vector<double>& lo = tLo2;
@@ -386,58 +473,21 @@ struct ExtremumSolver::Impl {
     lo.resize(p);
     hi.resize(p);
     half.resize(p);
-    uint32_t splits = 0;
-    double hiBound = -kInf;
-    bool certified = true;
-    while (!heap.empty()) {
-      std::pop_heap(heap.begin(), heap.end(), cmp);
-      const auto top = heap.back();
-      heap.pop_back();
-      if (top.first <= bestV + tol) {
-        hiBound = top.first;  // the largest remaining upper bound
-        break;
-      }
-      if (splits >= s.maxBoxes) {
-        hiBound = top.first;
-        certified = false;
-        break;
-      }
-      const double* blo = &pool[size_t(top.second) * 2 * p];
-      std::copy(blo, blo + p, lo.begin());
-      std::copy(blo + p, blo + 2 * p, hi.begin());
-      for (uint32_t k = 0; k < p; ++k) c[k] = 0.5 * (lo[k] + hi[k]);
-      tryPoint(c.data());
-      if (top.first <= bestV + tol) {
-        prunedHi = std::max(prunedHi, top.first);
-        continue;
-      }
-      ++splits;
-      const uint32_t d = widestDim(lo.data(), hi.data());
-      const double mid = 0.5 * (lo[d] + hi[d]);
-      if (!(mid > lo[d] && mid < hi[d])) {  // cannot split further: keep its bound
-        hiBound = top.first;
-        certified = top.first <= bestV + tol;
-        break;
-      }
+    auto atTop = [&](const HeapEntry& top) {
+      centre(lo.data(), hi.data(), tC.data());
+      S.tryPoint(tC.data());
+      return !S.drop(top.first);
+    };
+    auto split = [&](uint32_t d, double mid) {
       std::copy(hi.begin(), hi.end(), half.begin());
       half[d] = mid;
       consider(lo.data(), half.data());
       std::copy(lo.begin(), lo.end(), half.begin());
       half[d] = mid;
       consider(half.data(), hi.data());
-    }
-    double hiAll = std::max({hiBound, prunedHi, bestV});
-    r.value = sign * bestV;
-    r.certified = certified;
-    if (sign > 0) {
-      r.lo = bestV;
-      r.hi = hiAll;
-    } else {
-      r.lo = -hiAll;
-      r.hi = -bestV;
-    }
-    finish(r, bestT);
-    return r;
+    };
+    bestFirst(S, lo, hi, atTop, split);
+    return std::move(S.r);
   }
   std::vector<double> tBest, tC, tLo, tHi, tLo2, tHi2, tHalf, tAsc;
 
@@ -445,116 +495,51 @@ struct ExtremumSolver::Impl {
   // bodies without a term form (nested extrema): natural interval bounds and pruned tapes.
   ExtremumResult branchAndBound(const double* X, const double* warmT) {
     if (useTerms) return branchAndBoundTerms(X, warmT);
-    ExtremumResult r;
     std::vector<Interval> Xi(n);
     for (uint32_t k = 0; k < n; ++k) Xi[k] = Interval(X[k]);
     std::vector<double> bestT(p), c(p);
-    double bestV = -kInf;
-    auto tryPoint = [&](const double* t, const Tape* tape = nullptr) {
-      const double v = evalPoint(X, t, tape);
-      ++r.pointEvals;
-      if (v > bestV) {
-        bestV = v;
-        std::copy(t, t + p, bestT.begin());
-      }
-    };
-    for (uint32_t k = 0; k < p; ++k) c[k] = 0.5 * (plo[k] + phi[k]);
-    tryPoint(c.data());
-    if (warmT) {
-      bool inside = true;
-      for (uint32_t k = 0; k < p; ++k) inside = inside && warmT[k] >= plo[k] && warmT[k] <= phi[k];
-      if (inside) tryPoint(warmT);
-    }
-    const double tol = s.tolerance;
+    Search S(*this, X, bestT);
+    S.seed(warmT, c);
     pool.clear();
     heap.clear();
-    auto cmp = [](const std::pair<double, uint32_t>& a, const std::pair<double, uint32_t>& b) {
-      return a.first < b.first;
-    };
     tapes.clear();
     auto push = [&](const double* lo, const double* hi, double ub, TapePtr tape) {
-      const uint32_t id = static_cast<uint32_t>(pool.size() / (2 * p));
-      pool.insert(pool.end(), lo, lo + p);
-      pool.insert(pool.end(), hi, hi + p);
       tapes.push_back(std::move(tape));
-      heap.emplace_back(ub, id);
-      std::push_heap(heap.begin(), heap.end(), cmp);
+      pushBox(lo, hi, ub);
     };
     // Each box carries the body pruned by its own interval evaluation (min/max/select decided
     // over the box), so deeper boxes walk shorter tapes; values are bit-identical inside.
     const bool prune = body->numChoices() > 0;
-    double prunedHi = -kInf;
     {
       Interval root = evalBox(Xi.data(), plo.data(), phi.data());
-      ++r.intervalEvals;
-      if (root.hi <= bestV + tol) prunedHi = root.hi;
-      else push(plo.data(), phi.data(), root.hi, prune ? ie.pruned(body) : body);
+      ++S.r.intervalEvals;
+      if (!S.drop(root.hi)) push(plo.data(), phi.data(), root.hi, prune ? ie.pruned(body) : body);
     }
     std::vector<double> lo(p), hi(p), clo(p), chi(p);
-    uint32_t splits = 0;
-    double hiBound = -kInf;
-    bool certified = true;
-    while (!heap.empty()) {
-      std::pop_heap(heap.begin(), heap.end(), cmp);
-      const auto top = heap.back();
-      heap.pop_back();
-      if (top.first <= bestV + tol) {
-        hiBound = top.first;  // the largest remaining upper bound
-        break;
-      }
-      if (splits >= s.maxBoxes) {
-        hiBound = top.first;
-        certified = false;
-        break;
-      }
-      const double* blo = &pool[size_t(top.second) * 2 * p];
-      std::copy(blo, blo + p, lo.begin());
-      std::copy(blo + p, blo + 2 * p, hi.begin());
+    TapePtr boxTape;
+    auto atTop = [&](const HeapEntry& top) {
       // The incumbent improves at the centres of the most promising boxes, evaluated when the
       // box comes off the heap (once per split rather than once per child).
-      const TapePtr boxTape = tapes[top.second];
-      if (top.second != 0) {
-        for (uint32_t k = 0; k < p; ++k) c[k] = 0.5 * (lo[k] + hi[k]);
-        tryPoint(c.data(), boxTape.get());
-        if (top.first <= bestV + tol) {
-          prunedHi = std::max(prunedHi, top.first);
-          continue;
-        }
-      }
-      ++splits;
-      const uint32_t d = widestDim(lo.data(), hi.data());
-      const double mid = 0.5 * (lo[d] + hi[d]);
-      if (!(mid > lo[d] && mid < hi[d])) {  // cannot split further: keep its bound
-        hiBound = top.first;
-        certified = top.first <= bestV + tol;
-        break;
-      }
+      boxTape = tapes[top.second];
+      if (top.second == 0) return true;
+      centre(lo.data(), hi.data(), c.data());
+      S.tryPoint(c.data(), boxTape.get());
+      return !S.drop(top.first);
+    };
+    auto split = [&](uint32_t d, double mid) {
       for (int half = 0; half < 2; ++half) {
         clo = lo;
         chi = hi;
         if (half == 0) chi[d] = mid;
         else clo[d] = mid;
         Interval iv = evalBox(Xi.data(), clo.data(), chi.data(), boxTape.get());
-        ++r.intervalEvals;
-        if (iv.hi <= bestV + tol) {
-          prunedHi = std::max(prunedHi, iv.hi);
-          continue;
-        }
+        ++S.r.intervalEvals;
+        if (S.drop(iv.hi)) continue;
         push(clo.data(), chi.data(), iv.hi, prune && boxTape->numChoices() > 0 ? ie.pruned(boxTape) : boxTape);
       }
-    }
-    double hiAll = std::max({hiBound, prunedHi, bestV});
-    r.value = sign * bestV;
-    r.certified = certified;
-    if (sign > 0) {
-      r.lo = bestV;
-      r.hi = hiAll;
-    } else {
-      r.lo = -hiAll;
-      r.hi = -bestV;
-    }
-    finish(r, bestT);
-    return r;
+    };
+    bestFirst(S, lo, hi, atTop, split);
+    return std::move(S.r);
   }
 
   // Sound enclosure over an X box: the upper side is the largest interval upper bound over a
@@ -566,20 +551,10 @@ struct ExtremumSolver::Impl {
     std::vector<double> lo(p), hi(p), clo(p), chi(p), c(p);
     pool.clear();
     heap.clear();
-    auto cmp = [](const std::pair<double, uint32_t>& a, const std::pair<double, uint32_t>& b) {
-      return a.first < b.first;
-    };
-    auto push = [&](const double* l, const double* h, double ub) {
-      const uint32_t id = static_cast<uint32_t>(pool.size() / (2 * p));
-      pool.insert(pool.end(), l, l + p);
-      pool.insert(pool.end(), h, h + p);
-      heap.emplace_back(ub, id);
-      std::push_heap(heap.begin(), heap.end(), cmp);
-    };
     double L = -kInf;
     double wx = kInf;  // width due to the X box alone (at fixed u): what D refinement cannot remove
     auto witness = [&](const double* l, const double* h) {
-      for (uint32_t k = 0; k < p; ++k) c[k] = 0.5 * (l[k] + h[k]);
+      centre(l, h, c.data());
       Interval v = evalBox(X, c.data(), c.data());
       ++evals;
       L = std::max(L, v.lo);
@@ -587,7 +562,7 @@ struct ExtremumSolver::Impl {
     };
     Interval root = evalBox(X, plo.data(), phi.data());
     ++evals;
-    push(plo.data(), phi.data(), root.hi);
+    pushBox(plo.data(), phi.data(), root.hi);
     witness(plo.data(), phi.data());
     // Soft budget: intervalBudget evaluations, then continue (up to 8x) only while the
     // enclosure is much wider than what the X box alone explains (tiny X boxes, e.g. inside an
@@ -598,16 +573,11 @@ struct ExtremumSolver::Impl {
       const double U = std::max(L, heap.front().first);
       if ((signOnly && (L > 0 || U < 0)) || U - L <= s.tolerance) break;
       if (evals + 3 > soft && U - L <= 4.0 * wx) break;
-      std::pop_heap(heap.begin(), heap.end(), cmp);
-      const auto top = heap.back();
-      heap.pop_back();
-      const double* b = &pool[size_t(top.second) * 2 * p];
-      std::copy(b, b + p, lo.begin());
-      std::copy(b + p, b + 2 * p, hi.begin());
+      const HeapEntry top = popBox(lo, hi);
       const uint32_t d = widestDim(lo.data(), hi.data());
       const double mid = 0.5 * (lo[d] + hi[d]);
       if (!(mid > lo[d] && mid < hi[d])) {
-        push(lo.data(), hi.data(), top.first);
+        pushBox(lo.data(), hi.data(), top.first);
         break;
       }
       for (int half = 0; half < 2; ++half) {
@@ -618,7 +588,7 @@ struct ExtremumSolver::Impl {
         Interval iv = evalBox(X, clo.data(), chi.data());
         ++evals;
         if (iv.hi <= L) continue;  // cannot raise the upper bound above L
-        push(clo.data(), chi.data(), iv.hi);
+        pushBox(clo.data(), chi.data(), iv.hi);
       }
       if (!heap.empty()) {
         const double* t = &pool[size_t(heap.front().second) * 2 * p];

@@ -1,10 +1,10 @@
 // The search objective as a min of terms: constraint propagation against the branch-and-bound
 // cut, centred (mean-value) upper bounds and local ascent (see extremum_terms.h).
 #include "extremum_terms.h"
+#include "interval_fast.h"
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <functional>
 #include <limits>
 #include <unordered_map>
@@ -25,87 +25,49 @@ std::vector<Expr> product(const Expr& e, const std::vector<Expr>& a, const std::
   return out;
 }
 
+// The terms of e under min (isMin: e == min of them) or max: min (max) itself concatenates,
+// +, - and negation distribute (a max under a minus or a negation gives min terms), and, under
+// max, |a| = max(a, -a).
+std::vector<Expr> splitTerms(const Expr& e, bool isMin) {
+  const Node& nd = e.node();
+  if (nd.op == (isMin ? Op::Min : Op::Max)) {
+    std::vector<Expr> a = splitTerms(e.arg(0), isMin), b = splitTerms(e.arg(1), isMin);
+    if (a.size() + b.size() > kMaxTerms) return {e};
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+  }
+  switch (nd.op) {
+    case Op::Abs:
+      if (isMin) return {e};
+      return {e.arg(0), -e.arg(0)};
+    case Op::Add:
+      return product(e, splitTerms(e.arg(0), isMin), splitTerms(e.arg(1), isMin),
+                     [](const Expr& x, const Expr& y) { return x + y; });
+    case Op::Sub:
+      return product(e, splitTerms(e.arg(0), isMin), splitTerms(e.arg(1), !isMin),
+                     [](const Expr& x, const Expr& y) { return x - y; });
+    case Op::Neg: {
+      std::vector<Expr> out;
+      for (const Expr& t : splitTerms(e.arg(0), !isMin)) out.push_back(-t);
+      return out;
+    }
+    default:
+      return {e};
+  }
+}
+
 }  // namespace
 
-std::vector<Expr> minTerms(const Expr& e) {
-  const Node& nd = e.node();
-  switch (nd.op) {
-    case Op::Min: {
-      std::vector<Expr> a = minTerms(e.arg(0)), b = minTerms(e.arg(1));
-      if (a.size() + b.size() > kMaxTerms) return {e};
-      a.insert(a.end(), b.begin(), b.end());
-      return a;
-    }
-    case Op::Add:
-      return product(e, minTerms(e.arg(0)), minTerms(e.arg(1)), [](const Expr& x, const Expr& y) { return x + y; });
-    case Op::Sub:
-      return product(e, minTerms(e.arg(0)), maxTerms(e.arg(1)), [](const Expr& x, const Expr& y) { return x - y; });
-    case Op::Neg: {
-      std::vector<Expr> out;
-      for (const Expr& t : maxTerms(e.arg(0))) out.push_back(-t);
-      return out;
-    }
-    default:
-      return {e};
-  }
-}
-
-std::vector<Expr> maxTerms(const Expr& e) {
-  const Node& nd = e.node();
-  switch (nd.op) {
-    case Op::Max: {
-      std::vector<Expr> a = maxTerms(e.arg(0)), b = maxTerms(e.arg(1));
-      if (a.size() + b.size() > kMaxTerms) return {e};
-      a.insert(a.end(), b.begin(), b.end());
-      return a;
-    }
-    case Op::Abs: return {e.arg(0), -e.arg(0)};
-    case Op::Add:
-      return product(e, maxTerms(e.arg(0)), maxTerms(e.arg(1)), [](const Expr& x, const Expr& y) { return x + y; });
-    case Op::Sub:
-      return product(e, maxTerms(e.arg(0)), minTerms(e.arg(1)), [](const Expr& x, const Expr& y) { return x - y; });
-    case Op::Neg: {
-      std::vector<Expr> out;
-      for (const Expr& t : minTerms(e.arg(0))) out.push_back(-t);
-      return out;
-    }
-    default:
-      return {e};
-  }
-}
-
+std::vector<Expr> minTerms(const Expr& e) { return splitTerms(e, true); }
+std::vector<Expr> maxTerms(const Expr& e) { return splitTerms(e, false); }
 
 namespace {
 
-// Outward-rounded interval ops on finite operands (the same arithmetic as interval.cpp, inlined:
-// this runs for every node of every box); anything else goes through applyOp.
-inline double nextUp(double x) {
-  if (!(x < kInf)) return x;
-  if (x == 0.0) return std::numeric_limits<double>::denorm_min();
-  uint64_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  bits = x > 0.0 ? bits + 1 : bits - 1;
-  std::memcpy(&x, &bits, sizeof bits);
-  return x;
-}
-inline double up(double x) { return nextUp(x); }
-inline double down(double x) { return -nextUp(-x); }
-inline bool fin(const Interval& a) { return std::fabs(a.lo) < kInf && std::fabs(a.hi) < kInf; }
-inline Interval iadd(const Interval& a, const Interval& b) {
-  if (fin(a) && fin(b)) return Interval(down(a.lo + b.lo), up(a.hi + b.hi));
-  return applyOp(Op::Add, a, b);
-}
-inline Interval isub(const Interval& a, const Interval& b) {
-  if (fin(a) && fin(b)) return Interval(down(a.lo - b.hi), up(a.hi - b.lo));
-  return applyOp(Op::Sub, a, b);
-}
-inline Interval imul(const Interval& a, const Interval& b) {
-  if (fin(a) && fin(b)) {
-    const double p0 = a.lo * b.lo, p1 = a.lo * b.hi, p2 = a.hi * b.lo, p3 = a.hi * b.hi;
-    return Interval(down(std::min(std::min(p0, p1), std::min(p2, p3))), up(std::max(std::max(p0, p1), std::max(p2, p3))));
-  }
-  return applyOp(Op::Mul, a, b);
-}
+// Outward-rounded interval ops (interval_fast.h: inlined on finite operands, this runs for every
+// node of every box; anything else goes through applyOp).
+inline Interval iadd(const Interval& a, const Interval& b) { return applyOpFast(Op::Add, a, b); }
+inline Interval isub(const Interval& a, const Interval& b) { return applyOpFast(Op::Sub, a, b); }
+inline Interval imul(const Interval& a, const Interval& b) { return applyOpFast(Op::Mul, a, b); }
 inline Interval ineg(const Interval& a) { return Interval(-a.hi, -a.lo); }
 inline bool isZeroIv(const Interval& a) { return a.lo == 0.0 && a.hi == 0.0; }
 // Value of one op over intervals: inlined common cases, else applyOp.
@@ -114,35 +76,9 @@ inline Interval ival(Op op, const Interval& a, const Interval& b, const Interval
     op = Op::PowI;
     imm = 2.0;
   }
-  switch (op) {
-    case Op::Add: return iadd(a, b);
-    case Op::Sub: return isub(a, b);
-    case Op::Neg: return ineg(a);
-    case Op::Mul: return imul(a, b);
-    case Op::Min:
-      if (fin(a) && fin(b)) return Interval(std::min(a.lo, b.lo), std::min(a.hi, b.hi));
-      break;
-    case Op::Max:
-      if (fin(a) && fin(b)) return Interval(std::max(a.lo, b.lo), std::max(a.hi, b.hi));
-      break;
-    case Op::Abs:
-      if (!fin(a)) break;
-      if (a.lo >= 0.0) return a;
-      if (a.hi <= 0.0) return Interval(-a.hi, -a.lo);
-      return Interval(0.0, std::max(-a.lo, a.hi));
-    case Op::Sqrt:
-      if (!fin(a)) break;
-      if (a.hi <= 0.0) return Interval(0.0, 0.0);
-      return Interval(a.lo > 0.0 ? std::max(0.0, down(std::sqrt(a.lo))) : 0.0, up(std::sqrt(a.hi)));
-    case Op::PowI:
-      if (imm == 2.0 && fin(a)) {
-        const double mn = (a.lo <= 0.0 && a.hi >= 0.0) ? 0.0 : std::min(std::fabs(a.lo), std::fabs(a.hi));
-        const double mx = std::max(std::fabs(a.lo), std::fabs(a.hi));
-        return Interval(std::max(down(mn * mn), 0.0), up(mx * mx));
-      }
-      break;
-    default: break;
-  }
+  if (op == Op::Neg) return ineg(a);  // exact, whatever the bounds
+  Interval r;
+  if (fastOp(op, a, b, imm, r)) return r;
   return applyOp(op, a, b, c, imm);
 }
 
@@ -274,9 +210,9 @@ bool TermForm::project(uint32_t k) {
   Interval& B = q.b >= 0 ? con_[size_t(q.b)] : dummy;
   auto square = [&](Interval& a) {
     if (V.hi < 0.0) return false;
-    const double sh = up(std::sqrt(V.hi));
+    const double sh = up1(std::sqrt(V.hi));
     if (!meet(a, Interval(-sh, sh))) return false;
-    if (V.lo > 0.0) return excludeAround0(a, down(std::sqrt(V.lo)));
+    if (V.lo > 0.0) return excludeAround0(a, down1(std::sqrt(V.lo)));
     return true;
   };
   switch (q.op) {
@@ -296,8 +232,8 @@ bool TermForm::project(uint32_t k) {
       return true;
     case Op::Sqrt:
       if (V.hi < 0.0) return false;
-      if (!meetHi(A, up(V.hi * V.hi))) return false;
-      if (V.lo > 0.0) return meetLo(A, down(V.lo * V.lo));
+      if (!meetHi(A, up1(V.hi * V.hi))) return false;
+      if (V.lo > 0.0) return meetLo(A, down1(V.lo * V.lo));
       return true;
     case Op::Abs:
       if (!meet(A, Interval(-V.hi, V.hi))) return false;
@@ -471,7 +407,7 @@ void TermForm::evalBox(const double* tlo, const double* thi) {
         Interval p1 = range, p2 = range;
         const Interval s2 = isub(iadd(ival(Op::PowI, A, {}, {}, 2.0, false), ival(Op::PowI, B, {}, {}, 2.0, false)),
                                  imul(Interval(2.0 * al), imul(A, B)));
-        if (s2.lo > 0.0 && fin(s2)) {
+        if (s2.lo > 0.0 && finiteIv(s2)) {
           const Interval s = ival(Op::Sqrt, s2, {}, {}, 0.0, false);
           Interval q1 = applyOp(Op::Div, isub(A, imul(Interval(al), B)), s);
           Interval q2 = applyOp(Op::Div, isub(B, imul(Interval(al), A)), s);
@@ -532,7 +468,7 @@ double TermForm::upper(const double* tlo, const double* thi) {
     const Interval vc = valC_[node];
     double ub = val_[node].hi;
     if (std::isnan(ub)) ub = kInf;
-    if (!fin(vc)) {
+    if (!finiteIv(vc)) {
       best = std::min(best, ub);
       continue;
     }
@@ -540,7 +476,7 @@ double TermForm::upper(const double* tlo, const double* thi) {
     bool finiteG = true;
     for (uint32_t j = 0; j < p; ++j) {
       const Interval g = nodes_[node].dep ? der_[node * p + j] : Interval(0.0);
-      if (!fin(g)) finiteG = false;
+      if (!finiteIv(g)) finiteG = false;
       Gl_[i * p + j] = g.lo;
       Gh_[i * p + j] = g.hi;
       acc = iadd(acc, imul(g, Dv_[j]));
@@ -634,7 +570,7 @@ double TermForm::upper(const double* tlo, const double* thi) {
         if (clam_[a] > 0.0) g = iadd(g, imul(Interval(clam_[a]), Interval(Gl_[csel_[a] * p + j], Gh_[csel_[a] * p + j])));
       num = iadd(num, imul(g, Dv_[j]));
     }
-    if (den.lo > 0.0 && fin(num)) {
+    if (den.lo > 0.0 && finiteIv(num)) {
       const Interval u = applyOp(Op::Div, num, den);
       if (u.hi < best) best = u.hi;
     }

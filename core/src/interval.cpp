@@ -8,11 +8,11 @@
 //    pushed outward: 1 ulp for correctly rounded ops, kTransUlps for libm transcendentals.
 #include "frep/interval.h"
 #include "frep/pow_int.h"
+#include "interval_fast.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 
 namespace frep {
 
@@ -22,19 +22,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPi = 3.141592653589793;
 constexpr int kTransUlps = 4;
 
-// One step to the next double above x: std::nextafter(x, inf) without the libm call (this
-// runs twice per instruction). +inf and NaN stay as they are.
-inline double nextUp(double x) {
-  if (!(x < kInf)) return x;
-  if (x == 0.0) return std::numeric_limits<double>::denorm_min();
-  uint64_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  bits = x > 0.0 ? bits + 1 : bits - 1;
-  std::memcpy(&x, &bits, sizeof bits);
-  return x;
-}
+// Bounds pushed outward by ulps steps of detail::nextUp (interval_fast.h).
 inline double up(double x, int ulps = 1) {
-  for (int i = 0; i < ulps; ++i) x = nextUp(x);
+  for (int i = 0; i < ulps; ++i) x = detail::nextUp(x);
   return x;
 }
 inline double down(double x, int ulps = 1) { return -up(-x, ulps); }

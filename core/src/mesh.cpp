@@ -21,89 +21,91 @@
 #include <unordered_map>
 
 #include "frep/eval.h"
+#include "kuhn_tables.h"
 
 namespace frep {
 
 namespace {
 
-// ---- Tables: the oriented polygons of each Kuhn tetrahedron for each sign pattern ----------
+// ---- Tables: the oriented polygons of each cell's Kuhn tetrahedra (kuhn_tables.h) -----------
 
-// A cube corner is a 3-bit mask (bit a: +1 along axis a). An edge of a Kuhn tetrahedron joins
-// two corners one of which contains the other: it starts at the smaller one (lo) with steps dir.
-struct LocalEdge {
-  uint8_t lo, dir;
-};
-struct Polygon {
-  int count = 0;  // 3 or 4
-  LocalEdge edges[4];
-};
-struct TetCase {
-  int numPolys = 0;
-  Polygon polys[1];  // marching tetrahedra gives one triangle or one quad
-};
+std::array<int, 3> cornerPos(uint8_t m) { return {m & 1, (m >> 1) & 1, (m >> 2) & 1}; }
+// Twice the midpoint of the edge between corners a and b (exact integers).
+std::array<int, 3> mid2(uint8_t a, uint8_t b) {
+  auto p = cornerPos(a), q = cornerPos(b);
+  return {p[0] + q[0], p[1] + q[1], p[2] + q[2]};
+}
 
-struct Tables {
-  uint8_t tetCorners[6][4];
-  TetCase cases[6][16];
+// The polygon of tetrahedron v (corner masks) for an inside pattern (bit i: corner v[i] inside).
+KuhnPolygon tetPolygon(const uint8_t v[4], int pattern) {
+  KuhnPolygon poly{};
+  std::vector<int> in, out;
+  for (int i = 0; i < 4; ++i) ((pattern >> i) & 1 ? in : out).push_back(i);
+  if (in.empty() || out.empty()) return poly;
+  std::vector<std::pair<uint8_t, uint8_t>> cycle;  // (corner a, corner b) per polygon vertex
+  std::array<int, 3> dir;                          // from inside towards outside
+  if (in.size() == 1 || out.size() == 1) {
+    bool oneIn = in.size() == 1;
+    int apex = oneIn ? in[0] : out[0];
+    const std::vector<int>& rest = oneIn ? out : in;
+    for (int r : rest) cycle.push_back({v[apex], v[r]});
+    auto pa = cornerPos(v[apex]), pr = cornerPos(v[rest[0]]);
+    for (int a = 0; a < 3; ++a) dir[a] = oneIn ? pr[a] - pa[a] : pa[a] - pr[a];
+  } else {
+    int a = in[0], b = in[1], cc = out[0], d = out[1];
+    cycle = {{v[a], v[cc]}, {v[a], v[d]}, {v[b], v[d]}, {v[b], v[cc]}};
+    auto pa = cornerPos(v[a]), pb = cornerPos(v[b]), pc = cornerPos(v[cc]), pd = cornerPos(v[d]);
+    for (int k = 0; k < 3; ++k) dir[k] = pc[k] + pd[k] - pa[k] - pb[k];
+  }
+  std::array<int, 3> m0 = mid2(cycle[0].first, cycle[0].second), m1 = mid2(cycle[1].first, cycle[1].second),
+                     m2 = mid2(cycle[2].first, cycle[2].second);
+  int u[3] = {m1[0] - m0[0], m1[1] - m0[1], m1[2] - m0[2]};
+  int w[3] = {m2[0] - m0[0], m2[1] - m0[1], m2[2] - m0[2]};
+  int n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+  int dot = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
+  if (dot == 0) throw std::logic_error("mesh tables: degenerate tetrahedron case");
+  if (dot < 0) std::reverse(cycle.begin() + 1, cycle.end());
+  poly.count = uint8_t(cycle.size());
+  for (size_t i = 0; i < cycle.size(); ++i) {
+    poly.lo[i] = uint8_t(cycle[i].first & cycle[i].second);
+    poly.dir[i] = uint8_t(cycle[i].first ^ cycle[i].second);
+  }
+  return poly;
+}
 
-  Tables() {
+struct KuhnCellTable {
+  KuhnCell cells[256];
+
+  KuhnCellTable() {
     const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    uint8_t corners[6][4];
     for (int t = 0; t < 6; ++t) {
       uint8_t c1 = uint8_t(1 << perms[t][0]);
       uint8_t c2 = uint8_t(c1 | (1 << perms[t][1]));
-      uint8_t v[4] = {0, c1, c2, 7};
-      for (int i = 0; i < 4; ++i) tetCorners[t][i] = v[i];
-      for (int pattern = 0; pattern < 16; ++pattern) cases[t][pattern] = makeCase(v, pattern);
+      const uint8_t v[4] = {0, c1, c2, 7};
+      for (int i = 0; i < 4; ++i) corners[t][i] = v[i];
     }
-  }
-
-  static std::array<int, 3> pos(uint8_t m) { return {m & 1, (m >> 1) & 1, (m >> 2) & 1}; }
-  static LocalEdge edge(uint8_t a, uint8_t b) { return {uint8_t(a & b), uint8_t(a ^ b)}; }
-  // Twice the edge's midpoint (exact integers).
-  static std::array<int, 3> mid2(uint8_t a, uint8_t b) {
-    auto p = pos(a), q = pos(b);
-    return {p[0] + q[0], p[1] + q[1], p[2] + q[2]};
-  }
-
-  static TetCase makeCase(const uint8_t v[4], int pattern) {
-    TetCase c;
-    std::vector<int> in, out;
-    for (int i = 0; i < 4; ++i) ((pattern >> i) & 1 ? in : out).push_back(i);
-    if (in.empty() || out.empty()) return c;
-    std::vector<std::pair<uint8_t, uint8_t>> cycle;  // (corner a, corner b) per polygon vertex
-    std::array<int, 3> dir;                          // from inside towards outside
-    if (in.size() == 1 || out.size() == 1) {
-      bool oneIn = in.size() == 1;
-      int apex = oneIn ? in[0] : out[0];
-      const std::vector<int>& rest = oneIn ? out : in;
-      for (int r : rest) cycle.push_back({v[apex], v[r]});
-      auto pa = pos(v[apex]), pr = pos(v[rest[0]]);
-      for (int a = 0; a < 3; ++a) dir[a] = oneIn ? pr[a] - pa[a] : pa[a] - pr[a];
-    } else {
-      int a = in[0], b = in[1], cc = out[0], d = out[1];
-      cycle = {{v[a], v[cc]}, {v[a], v[d]}, {v[b], v[d]}, {v[b], v[cc]}};
-      auto pa = pos(v[a]), pb = pos(v[b]), pc = pos(v[cc]), pd = pos(v[d]);
-      for (int k = 0; k < 3; ++k) dir[k] = pc[k] + pd[k] - pa[k] - pb[k];
+    for (unsigned mask = 0; mask < 256; ++mask) {
+      KuhnCell& cell = cells[mask];
+      cell = KuhnCell{};
+      for (int t = 0; t < 6; ++t) {
+        int pattern = 0;
+        for (int v = 0; v < 4; ++v) pattern |= int((mask >> corners[t][v]) & 1) << v;
+        KuhnPolygon poly = tetPolygon(corners[t], pattern);
+        if (poly.count != 0) cell.polygons[cell.count++] = poly;
+      }
     }
-    std::array<int, 3> m0 = mid2(cycle[0].first, cycle[0].second), m1 = mid2(cycle[1].first, cycle[1].second),
-                       m2 = mid2(cycle[2].first, cycle[2].second);
-    int u[3] = {m1[0] - m0[0], m1[1] - m0[1], m1[2] - m0[2]};
-    int w[3] = {m2[0] - m0[0], m2[1] - m0[1], m2[2] - m0[2]};
-    int n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-    int dot = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
-    if (dot == 0) throw std::logic_error("mesh tables: degenerate tetrahedron case");
-    if (dot < 0) std::reverse(cycle.begin() + 1, cycle.end());
-    c.numPolys = 1;
-    c.polys[0].count = int(cycle.size());
-    for (size_t i = 0; i < cycle.size(); ++i) c.polys[0].edges[i] = edge(cycle[i].first, cycle[i].second);
-    return c;
   }
 };
 
-const Tables& tables() {
-  static const Tables t;
-  return t;
+}  // namespace
+
+const KuhnCell& kuhnCell(unsigned insideMask) {
+  static const KuhnCellTable table;
+  return table.cells[insideMask & 255];
 }
+
+namespace {
 
 // Inside: sign bit clear and not NaN (+0 inside, -0 outside), for floats and doubles alike, so
 // the sampler's float values and direct double evaluations classify every point the same way.
@@ -296,21 +298,11 @@ class RegionMesher {
     std::vector<std::array<uint32_t, 3>> tris;
     tris.reserve(keyTris.size() + 2 * quads.size());
     for (const auto& t : keyTris) tris.push_back({index.at(t[0]), index.at(t[1]), index.at(t[2])});
-    auto dist2 = [&](uint32_t i, uint32_t j) {
-      const auto &a = piece.vertices[i].position, &b = piece.vertices[j].position;
-      double s = 0;
-      for (int c = 0; c < 3; ++c) s += (a[c] - b[c]) * (a[c] - b[c]);
-      return s;
-    };
     for (const auto& q : quads) {
-      uint32_t v[4] = {index.at(q[0]), index.at(q[1]), index.at(q[2]), index.at(q[3])};
-      if (dist2(v[0], v[2]) <= dist2(v[1], v[3])) {
-        tris.push_back({v[0], v[1], v[2]});
-        tris.push_back({v[0], v[2], v[3]});
-      } else {
-        tris.push_back({v[1], v[2], v[3]});
-        tris.push_back({v[1], v[3], v[0]});
-      }
+      const std::array<uint32_t, 4> v{index.at(q[0]), index.at(q[1]), index.at(q[2]), index.at(q[3])};
+      const std::array<double, 3>* p[4];
+      for (int c = 0; c < 4; ++c) p[c] = &piece.vertices[v[c]].position;
+      splitKuhnQuad(v, p, tris);
     }
     for (auto& t : tris) canonicalRotate(t);
     std::sort(tris.begin(), tris.end());
@@ -396,7 +388,6 @@ class RegionMesher {
           else inside = evalInside(out, x, y, z);
           in[lx][ly][lz] = inside;
         }
-    const Tables& tb = tables();
     for (int64_t x = o[0]; x < end[0]; ++x)
       for (int64_t y = o[1]; y < end[1]; ++y)
         for (int64_t z = o[2]; z < end[2]; ++z) {
@@ -406,21 +397,17 @@ class RegionMesher {
           for (int c = 0; c < 8; ++c) mask |= unsigned(in[lx + (c & 1)][ly + ((c >> 1) & 1)][lz + ((c >> 2) & 1)]) << c;
           if (mask == 0 || mask == 255) continue;
           ++out.cellsCrossed;
-          for (int t = 0; t < 6; ++t) {
-            int pattern = 0;
-            for (int v = 0; v < 4; ++v) pattern |= int((mask >> tb.tetCorners[t][v]) & 1) << v;
-            const TetCase& tc = tb.cases[t][pattern];
-            for (int p = 0; p < tc.numPolys; ++p) {
-              const Polygon& poly = tc.polys[p];
-              EdgeKey keys[4];
-              for (int q = 0; q < poly.count; ++q) {
-                const LocalEdge& le = poly.edges[q];
-                keys[q] = edgeKey(x + (le.lo & 1), y + ((le.lo >> 1) & 1), z + ((le.lo >> 2) & 1), le.dir);
-                out.edges.push_back({keys[q], bool((mask >> le.lo) & 1)});
-              }
-              if (poly.count == 3) out.tris.push_back({keys[0], keys[1], keys[2]});
-              else out.quads.push_back({keys[0], keys[1], keys[2], keys[3]});
+          const KuhnCell& cell = kuhnCell(mask);
+          for (int p = 0; p < cell.count; ++p) {
+            const KuhnPolygon& poly = cell.polygons[p];
+            EdgeKey keys[4];
+            for (int q = 0; q < poly.count; ++q) {
+              const uint8_t lo = poly.lo[q];
+              keys[q] = edgeKey(x + (lo & 1), y + ((lo >> 1) & 1), z + ((lo >> 2) & 1), poly.dir[q]);
+              out.edges.push_back({keys[q], bool((mask >> lo) & 1)});
             }
+            if (poly.count == 3) out.tris.push_back({keys[0], keys[1], keys[2]});
+            else out.quads.push_back({keys[0], keys[1], keys[2], keys[3]});
           }
         }
   }
@@ -589,78 +576,6 @@ class RegionMesher {
 MeshPiece meshRegion(const TapePtr& tape, const GridSpec& grid, const std::array<int32_t, 3>& lo,
                      const std::array<int32_t, 3>& hi, const MeshOptions& options) {
   return RegionMesher(tape, grid, lo, hi, options).run();
-}
-
-Mesh mergePieces(const std::vector<MeshPiece>& pieces) {
-  Mesh mesh;
-  std::vector<MeshVertex> verts;
-  size_t ntris = 0;
-  for (const MeshPiece& p : pieces) {
-    verts.insert(verts.end(), p.vertices.begin(), p.vertices.end());
-    ntris += p.triangles.size();
-    MeshStats& s = mesh.stats;
-    s.cellsVisited += p.stats.cellsVisited;
-    s.cellsCrossed += p.stats.cellsCrossed;
-    s.rootEvals += p.stats.rootEvals;
-    s.gradientEvals += p.stats.gradientEvals;
-    s.samplePointEvals += p.stats.samplePointEvals;
-    s.fallbackEdges += p.stats.fallbackEdges;
-  }
-  // Shared vertices are computed identically by each piece; should they ever differ, the
-  // smallest record wins, so the result still does not depend on the order of the pieces.
-  std::sort(verts.begin(), verts.end(), [](const MeshVertex& a, const MeshVertex& b) {
-    if (a.key != b.key) return a.key < b.key;
-    if (a.position != b.position) return a.position < b.position;
-    return a.normal < b.normal;
-  });
-  verts.erase(std::unique(verts.begin(), verts.end(),
-                          [](const MeshVertex& a, const MeshVertex& b) { return a.key == b.key; }),
-              verts.end());
-  mesh.positions.reserve(verts.size());
-  mesh.normals.reserve(verts.size());
-  mesh.keys.reserve(verts.size());
-  for (const MeshVertex& v : verts) {
-    mesh.positions.push_back(v.position);
-    mesh.normals.push_back(v.normal);
-    mesh.keys.push_back(v.key);
-  }
-  // Local -> global indices by walking each piece's sorted keys along the global ones. Global
-  // indices are in key order, so sorting index triples sorts by key triples.
-  std::vector<std::array<uint32_t, 3>> tris;
-  tris.reserve(ntris);
-  std::vector<uint32_t> remap;
-  std::vector<size_t> runs{0};  // each piece's triangles stay sorted under the monotone remap
-  for (const MeshPiece& p : pieces) {
-    remap.resize(p.vertices.size());
-    size_t g = 0;
-    for (size_t i = 0; i < p.vertices.size(); ++i) {
-      EdgeKey k = p.vertices[i].key;
-      if (i > 0 && k <= p.vertices[i - 1].key) throw std::invalid_argument("mergePieces: piece vertices not sorted by key");
-      while (mesh.keys[g] < k) ++g;
-      remap[i] = uint32_t(g);
-    }
-    for (const auto& t : p.triangles) {
-      std::array<uint32_t, 3> r{remap.at(t[0]), remap.at(t[1]), remap.at(t[2])};
-      canonicalRotate(r);
-      tris.push_back(r);
-    }
-    if (!std::is_sorted(tris.begin() + long(runs.back()), tris.end()))
-      std::sort(tris.begin() + long(runs.back()), tris.end());
-    runs.push_back(tris.size());
-  }
-  while (runs.size() > 2) {  // merge sorted runs pairwise
-    std::vector<size_t> next{0};
-    for (size_t i = 0; i + 1 < runs.size(); i += 2) {
-      size_t end = i + 2 < runs.size() ? runs[i + 2] : runs[i + 1];
-      if (i + 2 < runs.size())
-        std::inplace_merge(tris.begin() + long(runs[i]), tris.begin() + long(runs[i + 1]), tris.begin() + long(end));
-      next.push_back(end);
-    }
-    runs = std::move(next);
-  }
-  tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
-  mesh.triangles = std::move(tris);
-  return mesh;
 }
 
 Mesh meshGrid(const TapePtr& tape, const GridSpec& grid, const MeshOptions& options, int brick) {

@@ -14,89 +14,11 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "kuhn_tables.h"
+
 namespace frep {
 
 namespace {
-
-// ---- The Kuhn tetrahedra's oriented polygons ------------------------------------------------
-// The same decomposition and orientation rule as the model mesher (docs/mesh.md): tetrahedron t
-// is 0 -> e_a -> e_a + e_b -> (1,1,1) for the t-th permutation (a, b, c); corners are 3-bit
-// masks; an edge is (its smaller corner, the steps to the larger one); a polygon's normal,
-// taken on the edges' midpoints, points from the inside corners to the outside ones.
-
-struct KuhnPolygon {
-  int count = 0;  // 0 (no crossing), 3 or 4
-  uint8_t lo[4] = {0, 0, 0, 0}, dir[4] = {0, 0, 0, 0};
-};
-
-struct KuhnTables {
-  uint8_t corners[6][4];
-  KuhnPolygon polygon[6][16];  // by tetrahedron and inside pattern (bit v: corner v inside)
-
-  KuhnTables() {
-    const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-    for (int t = 0; t < 6; ++t) {
-      const uint8_t c1 = uint8_t(1 << perms[t][0]), c2 = uint8_t(c1 | (1 << perms[t][1]));
-      const uint8_t v[4] = {0, c1, c2, 7};
-      for (int i = 0; i < 4; ++i) corners[t][i] = v[i];
-      for (int p = 0; p < 16; ++p) polygon[t][p] = build(v, p);
-    }
-  }
-
-  static int axis(uint8_t m, int a) { return (m >> a) & 1; }
-
-  static KuhnPolygon build(const uint8_t v[4], int pattern) {
-    KuhnPolygon poly;
-    int in[4], out[4], ni = 0, no = 0;
-    for (int i = 0; i < 4; ++i) ((pattern >> i) & 1 ? in[ni++] : out[no++]) = i;
-    if (ni == 0 || no == 0) return poly;
-    uint8_t ends[4][2];
-    int n = 0, towardsOut[3];
-    if (ni == 1 || no == 1) {  // a triangle around the lone corner
-      const int apex = ni == 1 ? in[0] : out[0];
-      const int* rest = ni == 1 ? out : in;
-      for (int r = 0; r < 3; ++r, ++n) {
-        ends[n][0] = v[apex];
-        ends[n][1] = v[rest[r]];
-      }
-      for (int a = 0; a < 3; ++a) {
-        const int d = axis(v[rest[0]], a) - axis(v[apex], a);
-        towardsOut[a] = ni == 1 ? d : -d;
-      }
-    } else {  // a quad between two inside and two outside corners
-      const int cyc[4][2] = {{in[0], out[0]}, {in[0], out[1]}, {in[1], out[1]}, {in[1], out[0]}};
-      for (; n < 4; ++n) {
-        ends[n][0] = v[cyc[n][0]];
-        ends[n][1] = v[cyc[n][1]];
-      }
-      for (int a = 0; a < 3; ++a)
-        towardsOut[a] = axis(v[out[0]], a) + axis(v[out[1]], a) - axis(v[in[0]], a) - axis(v[in[1]], a);
-    }
-    int mid[3][3];  // twice the midpoints of the first three edges
-    for (int k = 0; k < 3; ++k)
-      for (int a = 0; a < 3; ++a) mid[k][a] = axis(ends[k][0], a) + axis(ends[k][1], a);
-    int u[3], w[3];
-    for (int a = 0; a < 3; ++a) {
-      u[a] = mid[1][a] - mid[0][a];
-      w[a] = mid[2][a] - mid[0][a];
-    }
-    const int normal[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-    const int dot = normal[0] * towardsOut[0] + normal[1] * towardsOut[1] + normal[2] * towardsOut[2];
-    if (dot == 0) throw std::logic_error("mesh_grid tables: degenerate tetrahedron case");
-    if (dot < 0) std::reverse(ends + 1, ends + n);
-    poly.count = n;
-    for (int k = 0; k < n; ++k) {
-      poly.lo[k] = uint8_t(ends[k][0] & ends[k][1]);
-      poly.dir[k] = uint8_t(ends[k][0] ^ ends[k][1]);
-    }
-    return poly;
-  }
-};
-
-const KuhnTables& kuhn() {
-  static const KuhnTables t;
-  return t;
-}
 
 inline bool insideValue(double f) { return !std::isnan(f) && !std::signbit(f); }
 
@@ -337,7 +259,6 @@ class SampledMesher {
     if (end[0] <= 0 || end[1] <= 0 || end[2] <= 0) return;
     Window& w = out.window;
     fillWindow(w, leaf);
-    const KuhnTables& tb = kuhn();
     out.edges.clear();
     out.quads.clear();
     out.leafVerts.clear();
@@ -362,11 +283,10 @@ class SampledMesher {
           }
           if (mask == 0 || mask == 255) continue;
           ++out.cellsCrossed;
-          for (int t = 0; t < 6; ++t) {
-            int pattern = 0;
-            for (int v = 0; v < 4; ++v) pattern |= int((mask >> tb.corners[t][v]) & 1) << v;
-            const KuhnPolygon& poly = tb.polygon[t][pattern];
-            if (poly.count == 0) continue;
+          // The same cell polygons as the model mesher's (kuhn_tables.h).
+          const KuhnCell& cell = kuhnCell(mask);
+          for (int p = 0; p < cell.count; ++p) {
+            const KuhnPolygon& poly = cell.polygons[p];
             EdgeKey keys[4];
             for (int q = 0; q < poly.count; ++q) {
               const uint8_t lo = poly.lo[q];
@@ -385,23 +305,13 @@ class SampledMesher {
       out.leafVerts.push_back(vertex(w, o, int(p[0] - o[0] + 1), int(p[1] - o[1] + 1), int(p[2] - o[2] + 1), int(p[3])));
     }
     // Quads: split along the shorter diagonal (ties: 0-2), from the quad alone (as meshGrid).
-    auto pos = [&](EdgeKey k) -> const std::array<double, 3>& {
-      size_t i = size_t(std::lower_bound(out.edges.begin(), out.edges.end(), k) - out.edges.begin());
-      return out.leafVerts[i].position;
-    };
-    auto dist2 = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
-      double s = 0;
-      for (int c = 0; c < 3; ++c) s += (a[c] - b[c]) * (a[c] - b[c]);
-      return s;
-    };
     for (const auto& q : out.quads) {
-      if (dist2(pos(q[0]), pos(q[2])) <= dist2(pos(q[1]), pos(q[3]))) {
-        out.tris.push_back({q[0], q[1], q[2]});
-        out.tris.push_back({q[0], q[2], q[3]});
-      } else {
-        out.tris.push_back({q[1], q[2], q[3]});
-        out.tris.push_back({q[1], q[3], q[0]});
+      const std::array<double, 3>* p[4];
+      for (int c = 0; c < 4; ++c) {
+        size_t i = size_t(std::lower_bound(out.edges.begin(), out.edges.end(), q[c]) - out.edges.begin());
+        p[c] = &out.leafVerts[i].position;
       }
+      splitKuhnQuad(q, p, out.tris);
     }
     out.vertices.insert(out.vertices.end(), out.leafVerts.begin(), out.leafVerts.end());
   }

@@ -1,19 +1,19 @@
-// mergePiecesReleasing (see mesh_merge.h): mergePieces' result with a smaller footprint.
+// mergePieces (mesh.h) and mergePiecesReleasing (mesh_merge.h): one merge, which the latter runs
+// while freeing each piece once it has been consumed.
 //
-// mergePieces copies every piece's vertices into one array, sorts it, builds the mesh's arrays
-// from it and merges the triangle runs with a buffer, all while the pieces are alive: about
-// three copies of the output at its peak. Here (1) only the keys are gathered and sorted; (2)
-// the mesh's positions and normals are filled piece by piece, each piece's triangles remapped,
-// and the piece freed at once (memory handed back to the system every few pieces); (3) the
-// triangles are sorted in place. Where two pieces disagree on a shared vertex (they never do:
-// a vertex depends on its edge only) the smaller record (position, then normal) wins, as in
-// mergePieces, so the result is the same whatever the order of the pieces.
+// (1) Only the keys are gathered and sorted; (2) the mesh's positions and normals are filled
+// piece by piece and each piece's triangles remapped (mergePiecesReleasing then frees the piece,
+// handing the memory back to the system every few pieces, so it holds about one copy of the
+// output instead of three); (3) the triangles are sorted. Where two pieces disagree on a shared
+// vertex (they never do: a vertex depends on its edge only) the smaller record (position, then
+// normal) wins, so the result is the same whatever the order of the pieces.
 #include "frep/mesh_merge.h"
 
 #include <malloc.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <functional>
 #include <stdexcept>
 
 namespace frep {
@@ -23,9 +23,10 @@ inline void canonicalRotate(std::array<uint32_t, 3>& t) {
   if (t[1] < t[0] && t[1] < t[2]) t = {t[1], t[2], t[0]};
   else if (t[2] < t[0] && t[2] < t[1]) t = {t[2], t[0], t[1]};
 }
-}  // namespace
 
-Mesh mergePiecesReleasing(std::vector<MeshPiece>& pieces) {
+// The merge of both entry points; `consumed(i)`, when given, is called once piece i has been
+// stitched (it is not read again).
+Mesh mergeKeyed(const std::vector<MeshPiece>& pieces, const std::function<void(size_t)>& consumed) {
   Mesh mesh;
   size_t nv = 0, nt = 0;
   for (const MeshPiece& p : pieces) {
@@ -57,8 +58,8 @@ Mesh mergePiecesReleasing(std::vector<MeshPiece>& pieces) {
   std::vector<uint8_t> filled(n, 0);
   mesh.triangles.reserve(nt);
   std::vector<uint32_t> remap;
-  size_t released = 0;
-  for (MeshPiece& p : pieces) {
+  for (size_t pi = 0; pi < pieces.size(); ++pi) {
+    const MeshPiece& p = pieces[pi];
     remap.resize(p.vertices.size());
     size_t g = 0;
     if (!p.vertices.empty())
@@ -80,14 +81,25 @@ Mesh mergePiecesReleasing(std::vector<MeshPiece>& pieces) {
       canonicalRotate(r);
       mesh.triangles.push_back(r);
     }
-    std::vector<MeshVertex>().swap(p.vertices);
-    std::vector<std::array<uint32_t, 3>>().swap(p.triangles);
-    released += 1;
-    if (released % 16 == 0) malloc_trim(0);  // hand the freed pieces back (they are small heap blocks)
+    if (consumed) consumed(pi);
   }
-  malloc_trim(0);
   tbb::parallel_sort(mesh.triangles.begin(), mesh.triangles.end());
   mesh.triangles.erase(std::unique(mesh.triangles.begin(), mesh.triangles.end()), mesh.triangles.end());
+  return mesh;
+}
+
+}  // namespace
+
+Mesh mergePieces(const std::vector<MeshPiece>& pieces) { return mergeKeyed(pieces, nullptr); }
+
+Mesh mergePiecesReleasing(std::vector<MeshPiece>& pieces) {
+  size_t released = 0;
+  Mesh mesh = mergeKeyed(pieces, [&](size_t i) {
+    std::vector<MeshVertex>().swap(pieces[i].vertices);
+    std::vector<std::array<uint32_t, 3>>().swap(pieces[i].triangles);
+    if (++released % 16 == 0) malloc_trim(0);  // hand the freed pieces back (they are small heap blocks)
+  });
+  malloc_trim(0);
   return mesh;
 }
 

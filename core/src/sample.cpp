@@ -308,4 +308,31 @@ SampleResult sample(const TapePtr& tape, const GridSpec& grid, const SampleOptio
   return Sampler(tape, grid, options).run();
 }
 
+double insideVolume(const SampleResult& r) {
+  const GridSpec& g = r.grid;
+  uint64_t inside = 0;
+  for (const Tile& t : r.tiles) {
+    if (!t.inside) continue;
+    uint64_t n = 1;
+    for (int a = 0; a < 3; ++a) n *= uint64_t(std::max(0, std::min(t.origin[a] + t.size, g.dims[a]) - t.origin[a]));
+    inside += n;
+  }
+  for (const LeafBlock& l : r.leaves)
+    for (int x = 0; x < 8; ++x)
+      for (int y = 0; y < 8; ++y)
+        for (int z = 0; z < 8; ++z)
+          if (l.origin[0] + x < g.dims[0] && l.origin[1] + y < g.dims[1] && l.origin[2] + z < g.dims[2] &&
+              l.values[leafOffset(x, y, z)] >= 0)
+            ++inside;
+  return double(inside) * g.voxel * g.voxel * g.voxel;
+}
+
+double latticeVolume(const GridSpec& g, const std::function<bool(const std::array<double, 3>&)>& inside) {
+  uint64_t count = 0;
+  for (int i = 0; i < g.dims[0]; ++i)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int k = 0; k < g.dims[2]; ++k) count += inside(g.world(i, j, k));
+  return double(count) * g.voxel * g.voxel * g.voxel;
+}
+
 }  // namespace frep

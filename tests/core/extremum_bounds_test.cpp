@@ -46,6 +46,19 @@ double eval(const Expr& e, const std::vector<double>& p) {
   return pe.eval(*Tape::compile(e, uint32_t(p.size())), p.data());
 }
 
+// A random outer point X in [-1.5, 1.5]^3 and a random parameter box [lo, hi] inside
+// [-0.5, 0.5]^3 whose sides are 10^-decades .. 1 (log-uniform).
+std::vector<double> randomPointAndBox(std::mt19937_64& rng, std::uniform_real_distribution<double>& U,
+                                      double decades, double* lo, double* hi) {
+  std::vector<double> X = {3 * U(rng) - 1.5, 3 * U(rng) - 1.5, 3 * U(rng) - 1.5};
+  for (int k = 0; k < 3; ++k) {
+    const double w = std::pow(10.0, -decades * U(rng));
+    lo[k] = -0.5 + (1.0 - w) * U(rng);
+    hi[k] = lo[k] + w;
+  }
+  return X;
+}
+
 }  // namespace
 
 TEST(ExtremumTerms, MinOfTermsEqualsTheBody) {
@@ -90,13 +103,8 @@ TEST(ExtremumTerms, ContractionNeverLosesAPointAboveTheCut) {
       TapePtr tape = Tape::compile(body, 6);
       PointEvaluator pe;
       for (int trial = 0; trial < 150; ++trial) {
-        std::vector<double> X = {3 * U(rng) - 1.5, 3 * U(rng) - 1.5, 3 * U(rng) - 1.5};
         double lo[3], hi[3];
-        for (int k = 0; k < 3; ++k) {
-          const double w = std::pow(10.0, -2.0 * U(rng));  // sizes 0.01 .. 1
-          lo[k] = -0.5 + (1.0 - w) * U(rng);
-          hi[k] = lo[k] + w;
-        }
+        const std::vector<double> X = randomPointAndBox(rng, U, 2.0, lo, hi);  // sides 0.01 .. 1
         // sample the box (corners included) and pick a cut among the sampled values
         std::vector<std::array<double, 4>> pts;
         double p[6] = {X[0], X[1], X[2], 0, 0, 0};
@@ -159,13 +167,8 @@ TEST(ExtremumTerms, CentredBoundHoldsEverySampledValue) {
       PointEvaluator pe;
       IntervalEvaluator ie;
       for (int trial = 0; trial < 100; ++trial) {
-        std::vector<double> X = {3 * U(rng) - 1.5, 3 * U(rng) - 1.5, 3 * U(rng) - 1.5};
         double lo[3], hi[3];
-        for (int k = 0; k < 3; ++k) {
-          const double w = std::pow(10.0, -3.0 * U(rng));  // sizes 0.001 .. 1
-          lo[k] = -0.5 + (1.0 - w) * U(rng);
-          hi[k] = lo[k] + w;
-        }
+        const std::vector<double> X = randomPointAndBox(rng, U, 3.0, lo, hi);  // sides 0.001 .. 1
         tf.setX(X.data());
         const double ub = tf.upper(lo, hi);
         Interval box[6] = {X[0], X[1], X[2], {lo[0], hi[0]}, {lo[1], hi[1]}, {lo[2], hi[2]}};

@@ -564,31 +564,12 @@ TEST(Extremum, BoxPlusBallVolumeMatchesSteinerAt128) {
   SampleOptions so;
   so.threads = 2;
   SampleResult res = sample(Tape::compile(m), g, so);
-  uint64_t inside = 0;
-  for (const Tile& t : res.tiles) {
-    if (!t.inside) continue;
-    uint64_t n = 1;
-    for (int k = 0; k < 3; ++k) n *= uint64_t(std::max(0, std::min(t.origin[k] + t.size, g.dims[k]) - t.origin[k]));
-    inside += n;
-  }
-  for (const LeafBlock& l : res.leaves)
-    for (int x = 0; x < 8; ++x)
-      for (int y = 0; y < 8; ++y)
-        for (int z = 0; z < 8; ++z)
-          if (l.origin[0] + x < g.dims[0] && l.origin[1] + y < g.dims[1] && l.origin[2] + z < g.dims[2] &&
-              l.values[leafOffset(x, y, z)] >= 0)
-            ++inside;
-  uint64_t exactInside = 0;
-  for (int i = 0; i < g.dims[0]; ++i)
-    for (int j = 0; j < g.dims[1]; ++j)
-      for (int k = 0; k < g.dims[2]; ++k) {
-        auto p = g.world(i, j, k);
-        const double dx = std::max(0.0, std::fabs(p[0]) - a / 2), dy = std::max(0.0, std::fabs(p[1]) - b / 2),
-                     dz = std::max(0.0, std::fabs(p[2]) - c / 2);
-        exactInside += dx * dx + dy * dy + dz * dz <= r * r;
-      }
-  const double cell = g.voxel * g.voxel * g.voxel;
-  const double v = double(inside) * cell, vLattice = double(exactInside) * cell;
+  const double v = insideVolume(res);
+  const double vLattice = latticeVolume(g, [&](const std::array<double, 3>& p) {
+    const double dx = std::max(0.0, std::fabs(p[0]) - a / 2), dy = std::max(0.0, std::fabs(p[1]) - b / 2),
+                 dz = std::max(0.0, std::fabs(p[2]) - c / 2);
+    return dx * dx + dy * dy + dz * dz <= r * r;
+  });
   const double steiner =
       a * b * c + 2 * (a * b + b * c + c * a) * r + kPi * (a + b + c) * r * r + 4 * kPi * r * r * r / 3;
   std::printf("box + ball at 128^3: sampled %.5f, Steiner %.5f (%+.3f%%), exact shape on the lattice %.5f (%+.3f%%)\n",

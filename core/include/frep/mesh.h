@@ -88,6 +88,8 @@ MeshPiece meshRegion(const TapePtr& tape, const GridSpec& grid, const std::array
                      const std::array<int32_t, 3>& hi, const MeshOptions& options = {});
 
 // Stitches pieces by key into one mesh, independent of the pieces' order and of the split.
+// Throws std::invalid_argument for a piece whose vertices are not sorted by key or whose
+// triangles index past its vertices. The same code as mergePiecesReleasing (mesh_merge.h).
 Mesh mergePieces(const std::vector<MeshPiece>& pieces);
 
 // The whole grid, split into cubic regions of `brick` voxels (a multiple of 8; 0: one region).

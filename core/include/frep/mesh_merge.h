@@ -1,6 +1,5 @@
-// A lean variant of mergePieces (mesh.h) for the farm's master: the same mesh, vertex for vertex
-// and triangle for triangle, built while the pieces are released one by one, so the merge holds
-// about one copy of the output instead of three (docs/mesh.md, "Memory").
+// mergePieces (mesh.h) for the farm's master: the same merge, run while the pieces are released
+// one by one, so it holds about one copy of the output instead of three (docs/mesh.md, "Memory").
 #pragma once
 
 #include <vector>

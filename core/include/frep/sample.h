@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "frep/tape.h"
@@ -77,5 +78,12 @@ SampleResult sample(const TapePtr& tape, const GridSpec& grid, const SampleOptio
 // Puts leaves and tiles in the canonical order (by origin: x, then y, then z). Leaves are 2 KiB
 // each, so they are ordered through an index and moved once.
 void sortByOrigin(std::vector<LeafBlock>& leaves, std::vector<Tile>& tiles);
+
+// Volume of the inside of a sampled model as counted on its lattice: the grid points with
+// f >= 0 (voxels of inside tiles and leaf values >= 0, within the grid) times the voxel volume.
+double insideVolume(const SampleResult& r);
+// The same count for a shape given by a predicate on world points: the grid points p of g with
+// inside(p), times the voxel volume.
+double latticeVolume(const GridSpec& g, const std::function<bool(const std::array<double, 3>&)>& inside);
 
 }  // namespace frep
