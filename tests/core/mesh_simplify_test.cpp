@@ -12,6 +12,7 @@
 #include <cstdio>
 
 #include "core/mesh_checks.h"
+#include "core/mesh_models.h"
 #include "frep/eval.h"
 #include "frep/mesh.h"
 #include "frep/mesh_simplify.h"
@@ -19,24 +20,9 @@
 
 using namespace frep;
 namespace mc = mesh_checks;
+using namespace mesh_models;
 
 namespace {
-
-Expr X() { return Expr::x(0); }
-Expr Y() { return Expr::x(1); }
-Expr Z() { return Expr::x(2); }
-constexpr double kPi = 3.14159265358979323846;
-
-Expr sphereAt(double cx, double cy, double cz, double r) {
-  return r * r - square(X() - cx) - square(Y() - cy) - square(Z() - cz);
-}
-Expr blockAt(double cx, double cy, double cz, double hx, double hy, double hz) {
-  return min(min(min(hx - (X() - cx), hx + (X() - cx)), min(hy - (Y() - cy), hy + (Y() - cy))),
-             min(hz - (Z() - cz), hz + (Z() - cz)));
-}
-Expr torusZ(double R, double r) { return r * r - square(sqrt(square(X()) + square(Y())) - R) - square(Z()); }
-
-GridSpec cubeGrid(double half, int res) { return GridSpec::fromBounds({-half, -half, -half}, {half, half, half}, res); }
 
 struct Result {
   Mesh mesh;
@@ -197,8 +183,12 @@ TEST(MeshSimplify, ModelsAt128AreClosedEmbeddedAndWithinTheBound) {
     EXPECT_LT(r.mesh.triangles.size(), r.rawTriangles / 4) << c.name;
     const double area = c.area > 0 ? c.area : r.area;
     EXPECT_NEAR(r.volume, c.volume, r.stats.errorBound * area + 1e-3 * c.volume) << c.name;
-    if (c.area > 0) EXPECT_NEAR(r.area, c.area, 2e-3 * c.area) << c.name;
-    if (c.fewTriangles) EXPECT_LE(r.mesh.triangles.size(), 600u) << c.name;
+    if (c.area > 0) {
+      EXPECT_NEAR(r.area, c.area, 2e-3 * c.area) << c.name;
+    }
+    if (c.fewTriangles) {
+      EXPECT_LE(r.mesh.triangles.size(), 600u) << c.name;
+    }
   }
 }
 

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "core/mesh_checks.h"
+#include "core/mesh_models.h"
 #include "frep/eval.h"
 #include "frep/extremum.h"
 #include "frep/mesh.h"
@@ -18,28 +19,9 @@
 
 using namespace frep;
 namespace mc = mesh_checks;
+using namespace mesh_models;
 
 namespace {
-
-Expr X() { return Expr::x(0); }
-Expr Y() { return Expr::x(1); }
-Expr Z() { return Expr::x(2); }
-
-Expr sphereAt(double cx, double cy, double cz, double r) {
-  return r * r - square(X() - cx) - square(Y() - cy) - square(Z() - cz);
-}
-// hfBlock-like: min of the six half-spaces, centre c, half sizes h.
-Expr blockAt(double cx, double cy, double cz, double hx, double hy, double hz) {
-  return min(min(min(hx - (X() - cx), hx + (X() - cx)), min(hy - (Y() - cy), hy + (Y() - cy))),
-             min(hz - (Z() - cz), hz + (Z() - cz)));
-}
-Expr torusZ(double R, double r) {
-  return r * r - square(sqrt(square(X()) + square(Y())) - R) - square(Z());
-}
-
-constexpr double kPi = 3.14159265358979323846;
-
-GridSpec cubeGrid(double half, int res) { return GridSpec::fromBounds({-half, -half, -half}, {half, half, half}, res); }
 
 struct Checked {
   Mesh mesh;
