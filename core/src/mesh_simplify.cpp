@@ -157,10 +157,8 @@ class Simplifier {
     tAlive_.assign(tris_.size(), 1);
     made_.assign(tris_.size(), 0);
     level_.assign(tris_.size(), -1);
-    stamp_.assign(tris_.size(), 0);
-    probe_.assign(tris_.size(), 0);
     cells_.resize(tris_.size());
-    qbox_.resize(tris_.size());
+    probe_.resize(tris_.size());
     for (uint32_t t = 0; t < tris_.size(); ++t) {
       for (uint32_t v : tris_[t]) vtris_[v].push_back(t);
       insertBuckets(t);
@@ -237,8 +235,8 @@ class Simplifier {
     cells_[t] = cellRange(pos_[tris_[t][0]], pos_[tris_[t][1]], pos_[tris_[t][2]]);
     const Tri& tr = tris_[t];
     for (int k = 0; k < 3; ++k) {
-      qbox_[t][k] = std::min({qpos_[tr[0]][k], qpos_[tr[1]][k], qpos_[tr[2]][k]});
-      qbox_[t][k + 3] = std::max({qpos_[tr[0]][k], qpos_[tr[1]][k], qpos_[tr[2]][k]});
+      probe_[t].box[k] = std::min({qpos_[tr[0]][k], qpos_[tr[1]][k], qpos_[tr[2]][k]});
+      probe_[t].box[k + 3] = std::max({qpos_[tr[0]][k], qpos_[tr[1]][k], qpos_[tr[2]][k]});
     }
     forCells(cells_[t], [&](uint64_t k) { buckets_[k].push_back(t); });
   }
@@ -426,8 +424,8 @@ class Simplifier {
     const exact::P qp = quantise(p);
     auto qcorner = [&](uint32_t v) { return v == a || v == b ? qp : qpos_[v]; };
     ++stampNow_;
-    for (uint32_t t : changed) stamp_[t] = stampNow_;
-    for (uint32_t t : removed) stamp_[t] = stampNow_;
+    for (uint32_t t : changed) probe_[t].skip = stampNow_;
+    for (uint32_t t : removed) probe_[t].skip = stampNow_;
     for (size_t i = 0; i < changed.size(); ++i) {
       Tri ti = renamed(tris_[changed[i]]);
       std::array<exact::P, 3> Ti{qcorner(tris_[changed[i]][0]), qcorner(tris_[changed[i]][1]), qcorner(tris_[changed[i]][2])};
@@ -450,9 +448,10 @@ class Simplifier {
         auto it = buckets_.find(key);
         if (it == buckets_.end()) return;
         for (uint32_t u : it->second) {
-          if (stamp_[u] == stampNow_ || probe_[u] == probeNow_) continue;
-          probe_[u] = probeNow_;
-          const auto& box = qbox_[u];  // disjoint boxes: no contact, not even a shared vertex
+          Probe& pr = probe_[u];
+          if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
+          pr.seen = probeNow_;
+          const auto& box = pr.box;  // disjoint boxes: no contact, not even a shared vertex
           if (box[3] < lo[0] || box[0] > hi[0] || box[4] < lo[1] || box[1] > hi[1] || box[5] < lo[2] || box[2] > hi[2])
             continue;
           const Tri& tu = tris_[u];
@@ -576,10 +575,15 @@ class Simplifier {
   std::vector<Tri> tris_;
   std::vector<char> tAlive_, made_;
   std::vector<int8_t> level_;
-  std::vector<uint32_t> stamp_, probe_;
+  // What the self-intersection queries read of each triangle, in one cache line.
+  struct Probe {
+    std::array<int64_t, 6> box;  // quantised bounding box
+    uint32_t skip = 0;           // == stampNow_: part of the collapse being checked
+    uint32_t seen = 0;           // == probeNow_: already tested in this query
+  };
+  std::vector<Probe> probe_;
   uint32_t stampNow_ = 0, probeNow_ = 0;
   std::vector<std::array<int32_t, 6>> cells_;
-  std::vector<std::array<int64_t, 6>> qbox_;  // quantised bounding box of each triangle
   std::unordered_map<uint64_t, std::vector<uint32_t>> buckets_;
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue_;
   BatchEvaluator<double> batch_;
