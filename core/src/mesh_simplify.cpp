@@ -157,7 +157,6 @@ class Simplifier {
     tAlive_.assign(tris_.size(), 1);
     made_.assign(tris_.size(), 0);
     level_.assign(tris_.size(), -1);
-    cells_.resize(tris_.size());
     probe_.resize(tris_.size());
     for (uint32_t t = 0; t < tris_.size(); ++t) {
       for (uint32_t v : tris_[t]) vtris_[v].push_back(t);
@@ -225,26 +224,57 @@ class Simplifier {
     return (uint64_t(uint32_t(x + (1 << 20)) & 0x1fffff) << 42) | (uint64_t(uint32_t(y + (1 << 20)) & 0x1fffff) << 21) |
            uint64_t(uint32_t(z + (1 << 20)) & 0x1fffff);
   }
+  // Calls f(key) for the cells of the range that the triangle abc may touch: all of them for a
+  // small range, else those passing a conservative separating-axis test (the triangle's plane
+  // and the nine edge x axis directions, the cell grown by a margin), so a large tilted
+  // triangle is filed under the cells along its surface, not every cell of its box.
   template <typename F>
-  static void forCells(const std::array<int32_t, 6>& r, F&& f) {
+  void forTriangleCells(const V3& a, const V3& b, const V3& c, F&& f) const {
+    const std::array<int32_t, 6> r = cellRange(a, b, c);
+    const int64_t count = int64_t(r[3] - r[0] + 1) * (r[4] - r[1] + 1) * (r[5] - r[2] + 1);
+    const double s = kBucketVoxels * grid_.voxel, h = 0.5 * s + 1e-3 * grid_.voxel;
+    const V3 e[3] = {sub(b, a), sub(c, b), sub(a, c)};
+    const V3 n = cross(e[0], e[2]);
     for (int32_t x = r[0]; x <= r[3]; ++x)
       for (int32_t y = r[1]; y <= r[4]; ++y)
-        for (int32_t z = r[2]; z <= r[5]; ++z) f(cellKey(x, y, z));
+        for (int32_t z = r[2]; z <= r[5]; ++z) {
+          if (count > 8) {
+            const V3 cc{grid_.origin[0] + (x + 0.5) * s, grid_.origin[1] + (y + 0.5) * s, grid_.origin[2] + (z + 0.5) * s};
+            const V3 v[3] = {sub(a, cc), sub(b, cc), sub(c, cc)};
+            auto separated = [&](const V3& axis) {
+              double p0 = dot(axis, v[0]), p1 = dot(axis, v[1]), p2 = dot(axis, v[2]);
+              double rad = h * (std::abs(axis[0]) + std::abs(axis[1]) + std::abs(axis[2]));
+              return std::min({p0, p1, p2}) > rad * (1 + 1e-9) || std::max({p0, p1, p2}) < -rad * (1 + 1e-9);
+            };
+            bool apart = separated(n);
+            for (int i = 0; i < 3 && !apart; ++i)
+              apart = separated({0, -e[i][2], e[i][1]}) || separated({e[i][2], 0, -e[i][0]}) ||
+                      separated({-e[i][1], e[i][0], 0});
+            if (apart) continue;
+          }
+          f(cellKey(x, y, z));
+        }
   }
   void insertBuckets(uint32_t t) {
-    cells_[t] = cellRange(pos_[tris_[t][0]], pos_[tris_[t][1]], pos_[tris_[t][2]]);
     const Tri& tr = tris_[t];
+    const V3 &a = pos_[tr[0]], &b = pos_[tr[1]], &c = pos_[tr[2]];
+    // The entry carries the triangle's box (float, rounded outwards past a 1e-3 voxel margin), so
+    // a query scans its cells' entries in order and touches a triangle only if the boxes meet.
+    Entry e{t, {}, {}};
+    const double margin = 1e-3 * grid_.voxel;
     for (int k = 0; k < 3; ++k) {
-      probe_[t].box[k] = std::min({qpos_[tr[0]][k], qpos_[tr[1]][k], qpos_[tr[2]][k]});
-      probe_[t].box[k + 3] = std::max({qpos_[tr[0]][k], qpos_[tr[1]][k], qpos_[tr[2]][k]});
+      e.lo[k] = std::nextafter(float(std::min({a[k], b[k], c[k]}) - margin), -INFINITY);
+      e.hi[k] = std::nextafter(float(std::max({a[k], b[k], c[k]}) + margin), INFINITY);
     }
-    forCells(cells_[t], [&](uint64_t k) { buckets_[k].push_back(t); });
+    forTriangleCells(a, b, c, [&](uint64_t k) { buckets_[k].push_back(e); });
   }
+  // Before any corner of t moves (the same cells as its insertion).
   void eraseBuckets(uint32_t t) {
-    forCells(cells_[t], [&](uint64_t k) {
+    const Tri& tr = tris_[t];
+    forTriangleCells(pos_[tr[0]], pos_[tr[1]], pos_[tr[2]], [&](uint64_t k) {
       auto it = buckets_.find(k);
       auto& v = it->second;
-      v.erase(std::find(v.begin(), v.end(), t));
+      v.erase(std::find_if(v.begin(), v.end(), [t](const Entry& e) { return e.tri == t; }));
       if (v.empty()) buckets_.erase(it);
     });
   }
@@ -420,51 +450,63 @@ class Simplifier {
       }
     }
 
-    // Self-intersection: the new triangles against each other and against their neighbourhood.
+    // Self-intersection: the new triangles against each other, then against every other
+    // triangle whose box meets theirs (one pass over the cells of the ring's box).
     const exact::P qp = quantise(p);
     auto qcorner = [&](uint32_t v) { return v == a || v == b ? qp : qpos_[v]; };
     ++stampNow_;
     for (uint32_t t : changed) probe_[t].skip = stampNow_;
     for (uint32_t t : removed) probe_[t].skip = stampNow_;
-    for (size_t i = 0; i < changed.size(); ++i) {
-      Tri ti = renamed(tris_[changed[i]]);
-      std::array<exact::P, 3> Ti{qcorner(tris_[changed[i]][0]), qcorner(tris_[changed[i]][1]), qcorner(tris_[changed[i]][2])};
-      for (size_t j = i + 1; j < changed.size(); ++j) {
-        Tri tj = renamed(tris_[changed[j]]);
-        std::array<exact::P, 3> Tj{qcorner(tris_[changed[j]][0]), qcorner(tris_[changed[j]][1]), qcorner(tris_[changed[j]][2])};
-        if (improperPair(ti, Ti, tj, Tj)) {
+    std::vector<NewTri>& fresh = freshTris_;
+    fresh.clear();
+    V3 ringLo{INFINITY, INFINITY, INFINITY}, ringHi{-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t t : changed) {
+      const Tri& tr = tris_[t];
+      NewTri n{renamed(tr), {qcorner(tr[0]), qcorner(tr[1]), qcorner(tr[2])}, corner(tr[0]), corner(tr[0])};
+      for (int c = 1; c < 3; ++c)
+        for (int k = 0; k < 3; ++k) n.lo[k] = std::min(n.lo[k], corner(tr[c])[k]), n.hi[k] = std::max(n.hi[k], corner(tr[c])[k]);
+      for (int k = 0; k < 3; ++k) ringLo[k] = std::min(ringLo[k], n.lo[k]), ringHi[k] = std::max(ringHi[k], n.hi[k]);
+      fresh.push_back(n);
+    }
+    for (size_t i = 0; i < fresh.size(); ++i)
+      for (size_t j = i + 1; j < fresh.size(); ++j)
+        if (improperPair(fresh[i].t, fresh[i].q, fresh[j].t, fresh[j].q)) {
           ++stats_.rejectedIntersection;
           return;
         }
-      }
-      auto range = cellRange(corner(ti[0]), corner(ti[1]), corner(ti[2]));
-      exact::P lo = Ti[0], hi = Ti[0];
-      for (int k = 0; k < 3; ++k)
-        for (int c = 1; c < 3; ++c) lo[k] = std::min(lo[k], Ti[c][k]), hi[k] = std::max(hi[k], Ti[c][k]);
-      bool bad = false;
-      ++probeNow_;
-      forCells(range, [&](uint64_t key) {
-        if (bad) return;
-        auto it = buckets_.find(key);
-        if (it == buckets_.end()) return;
-        for (uint32_t u : it->second) {
-          Probe& pr = probe_[u];
-          if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
-          pr.seen = probeNow_;
-          const auto& box = pr.box;  // disjoint boxes: no contact, not even a shared vertex
-          if (box[3] < lo[0] || box[0] > hi[0] || box[4] < lo[1] || box[1] > hi[1] || box[5] < lo[2] || box[2] > hi[2])
-            continue;
-          const Tri& tu = tris_[u];
-          if (improperPair(ti, Ti, tu, {qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]})) {
-            bad = true;
-            return;
+    bool bad = false;
+    ++probeNow_;
+    const std::array<int32_t, 6> range = cellRange(ringLo, ringHi, ringHi);
+    for (int32_t x = range[0]; x <= range[3] && !bad; ++x)
+      for (int32_t y = range[1]; y <= range[4] && !bad; ++y)
+        for (int32_t z = range[2]; z <= range[5] && !bad; ++z) {
+          auto it = buckets_.find(cellKey(x, y, z));
+          if (it == buckets_.end()) continue;
+          for (const Entry& e : it->second) {
+            // Disjoint boxes: no contact, not even a shared vertex.
+            if (e.hi[0] < ringLo[0] || e.lo[0] > ringHi[0] || e.hi[1] < ringLo[1] || e.lo[1] > ringHi[1] ||
+                e.hi[2] < ringLo[2] || e.lo[2] > ringHi[2])
+              continue;
+            Probe& pr = probe_[e.tri];
+            if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
+            pr.seen = probeNow_;
+            const Tri& tu = tris_[e.tri];
+            const std::array<exact::P, 3> qu{qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]};
+            for (const NewTri& n : fresh) {
+              if (e.hi[0] < n.lo[0] || e.lo[0] > n.hi[0] || e.hi[1] < n.lo[1] || e.lo[1] > n.hi[1] || e.hi[2] < n.lo[2] ||
+                  e.lo[2] > n.hi[2])
+                continue;
+              if (improperPair(n.t, n.q, tu, qu)) {
+                bad = true;
+                break;
+              }
+            }
+            if (bad) break;
           }
         }
-      });
-      if (bad) {
-        ++stats_.rejectedIntersection;
-        return;
-      }
+    if (bad) {
+      ++stats_.rejectedIntersection;
+      return;
     }
 
     // Apply.
@@ -566,6 +608,12 @@ class Simplifier {
   SimplifyStats stats_;
   std::vector<V3> pos_, normal_;
   std::vector<V3> samplePoints_;
+  struct NewTri {  // a triangle as a collapse would leave it
+    Tri t;
+    std::array<exact::P, 3> q;  // quantised corners
+    V3 lo, hi;                  // box
+  };
+  std::vector<NewTri> freshTris_;
   std::vector<EdgeKey> key_;
   std::vector<exact::P> qpos_;
   std::vector<Quadric> quad_;
@@ -575,16 +623,18 @@ class Simplifier {
   std::vector<Tri> tris_;
   std::vector<char> tAlive_, made_;
   std::vector<int8_t> level_;
-  // What the self-intersection queries read of each triangle, in one cache line.
+  // Per-triangle marks of the self-intersection queries.
   struct Probe {
-    std::array<int64_t, 6> box;  // quantised bounding box
-    uint32_t skip = 0;           // == stampNow_: part of the collapse being checked
-    uint32_t seen = 0;           // == probeNow_: already tested in this query
+    uint32_t skip = 0;  // == stampNow_: part of the collapse being checked
+    uint32_t seen = 0;  // == probeNow_: already tested in this query
   };
   std::vector<Probe> probe_;
   uint32_t stampNow_ = 0, probeNow_ = 0;
-  std::vector<std::array<int32_t, 6>> cells_;
-  std::unordered_map<uint64_t, std::vector<uint32_t>> buckets_;
+  struct Entry {
+    uint32_t tri;
+    float lo[3], hi[3];
+  };
+  std::unordered_map<uint64_t, std::vector<Entry>> buckets_;
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue_;
   BatchEvaluator<double> batch_;
   int maxLevel_ = 0;  // the last error level
