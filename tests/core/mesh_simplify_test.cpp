@@ -101,6 +101,33 @@ Result simplifyAndCheck(const Expr& model, const GridSpec& g, double tolVoxels, 
       }
   }
   EXPECT_EQ(far, 0u);
+  // Every vertex within half a voxel of the surface (an inside and an outside point within 0.49
+  // voxel of it), and every vertex normal outward: on the side of its fan's area-weighted normal.
+  std::vector<mc::Vec3> fan(m.positions.size(), mc::Vec3{0, 0, 0});
+  for (const auto& t : m.triangles) {
+    auto n = mc::cross(mc::sub(m.positions[t[1]], m.positions[t[0]]), mc::sub(m.positions[t[2]], m.positions[t[0]]));
+    for (uint32_t v : t)
+      for (int k = 0; k < 3; ++k) fan[v][k] += n[k];
+  }
+  size_t farVertices = 0, inward = 0;
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    bool in = false, out = false;
+    auto probe = [&](double dx, double dy, double dz) {
+      double len = std::sqrt(dx * dx + dy * dy + dz * dz);
+      double s = len > 0 ? 0.49 * g.voxel / len : 0;
+      std::array<double, 3> q{m.positions[i][0] + s * dx, m.positions[i][1] + s * dy, m.positions[i][2] + s * dz};
+      (pe.eval(*tape, q.data()) >= 0 ? in : out) = true;
+    };
+    probe(0, 0, 0);
+    probe(m.normals[i][0], m.normals[i][1], m.normals[i][2]);
+    probe(-m.normals[i][0], -m.normals[i][1], -m.normals[i][2]);
+    for (int d = 0; d < 27 && !(in && out); ++d)
+      if (d != 13) probe(d / 9 - 1, (d / 3) % 3 - 1, d % 3 - 1);
+    farVertices += !(in && out);
+    inward += mc::dot(m.normals[i], fan[i]) <= 0;
+  }
+  EXPECT_EQ(farVertices, 0u);
+  EXPECT_EQ(inward, 0u);
   return r;
 }
 
