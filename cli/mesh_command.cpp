@@ -136,6 +136,10 @@ int runMesh(const MeshRequest& request) {
   so.sharpFeatures = !request.noSharp;
   if (request.tolerance < 0 && tape->hasExtrema())
     spdlog::info("the model has extremum nodes: not simplified (each check would run a search); give --tolerance to");
+  if (so.tolerance > 0)
+    spdlog::info("simplifying {} triangles (tolerance {} voxel, sharp features {}); a signal now ends the run, "
+                 "--resume then redoes only this step",
+                 mesh.triangles.size(), so.tolerance, so.sharpFeatures ? "on" : "off");
   SimplifyStats ss = simplifyMesh(mesh, tape, grid, so);
   report.simplifyTolerance = so.tolerance;
   report.sharpFeatures = so.sharpFeatures;
