@@ -4,11 +4,16 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
 #include <queue>
 #include <unordered_map>
 
 #include "frep/eval.h"
 #include "frep/mesh_predicates.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace frep {
 
@@ -98,10 +103,39 @@ constexpr int kMaxSamplesPerSide = 64;  // error samples per triangle <= 64^2
 constexpr double kQuantum = 65536;      // exact predicates: 2^16 steps per voxel
 constexpr double kBucketVoxels = 2;     // spatial hash cell
 
+// The state a simplification works on: the whole mesh, or one block of it (locked vertices and
+// the triangles around the block held fixed, placements confined to the block).
+struct Work {
+  std::vector<V3> pos, normal;
+  std::vector<EdgeKey> key;
+  std::vector<Quadric> quad;
+  std::vector<char> moved, locked;  // per vertex
+  std::vector<Tri> tris;
+  std::vector<int8_t> level;  // per triangle: error level (-1: not measured yet)
+  std::vector<char> made;     // per triangle: made by a collapse
+  bool confined = false;      // placements stay inside [regionLo, regionHi]
+  V3 regionLo{}, regionHi{};
+};
+
+Work workOf(const Mesh& mesh) {
+  Work w;
+  w.pos = mesh.positions;
+  w.normal = mesh.normals;
+  w.key = mesh.keys;
+  w.quad.resize(mesh.positions.size());
+  for (size_t v = 0; v < w.pos.size(); ++v) w.quad[v].addPlane(w.normal[v], w.pos[v]);
+  w.moved.assign(w.pos.size(), 0);
+  w.locked.assign(w.pos.size(), 0);
+  w.tris = mesh.triangles;
+  w.level.assign(w.tris.size(), -1);
+  w.made.assign(w.tris.size(), 0);
+  return w;
+}
+
 class Simplifier {
  public:
-  Simplifier(Mesh& mesh, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt)
-      : mesh_(mesh), tape_(tape), grid_(grid), opt_(opt), tol_(opt.tolerance * grid.voxel) {
+  Simplifier(Work&& work, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt)
+      : w_(std::move(work)), tape_(tape), grid_(grid), opt_(opt), tol_(opt.tolerance * grid.voxel) {
     // Error levels e_k = tol * 2^k up to two voxels (or the tolerance if larger): a replaced
     // triangle allows its new ones at most that much error, however far its own chord was (the
     // mesher's chords across a crease can be most of a voxel deep).
@@ -111,8 +145,9 @@ class Simplifier {
                                   " coordinates; give values for x[4..] (fixedCoords)");
   }
 
-  SimplifyStats run() {
-    stats_.trianglesBefore = mesh_.triangles.size();
+  // Collapses until no candidate is left; then work(), vertexAlive() and triangleAlive() hold
+  // the result.
+  const SimplifyStats& run() {
     setUp();
     while (!queue_.empty()) {
       Candidate c = queue_.top();
@@ -120,14 +155,16 @@ class Simplifier {
       if (!alive_[c.a] || !alive_[c.b] || version_[c.a] != c.va || version_[c.b] != c.vb) continue;
       tryCollapse(c.a, c.b);
     }
-    finish();
-    stats_.trianglesAfter = mesh_.triangles.size();
     int worst = -1;  // over the triangles that collapses made
-    for (uint32_t t = 0; t < tris_.size(); ++t)
-      if (tAlive_[t] && made_[t]) worst = std::max<int>(worst, level_[t]);
+    for (uint32_t t = 0; t < w_.tris.size(); ++t)
+      if (tAlive_[t] && w_.made[t]) worst = std::max<int>(worst, w_.level[t]);
     stats_.errorBound = worst < 0 ? 0 : std::ldexp(tol_, worst);
     return stats_;
   }
+  const Work& work() const { return w_; }
+  const SimplifyStats& stats() const { return stats_; }
+  bool vertexAlive(uint32_t v) const { return alive_[v] && !vtris_[v].empty(); }
+  bool triangleAlive(uint32_t t) const { return tAlive_[t]; }
 
  private:
   struct Candidate {
@@ -141,31 +178,23 @@ class Simplifier {
   };
 
   void setUp() {
-    const size_t nv = mesh_.positions.size();
-    pos_ = mesh_.positions;
-    key_ = mesh_.keys;
-    normal_ = mesh_.normals;
-    quad_.resize(nv);
-    for (size_t v = 0; v < nv; ++v) quad_[v].addPlane(mesh_.normals[v], pos_[v]);
+    const size_t nv = w_.pos.size();
     alive_.assign(nv, 1);
-    moved_.assign(nv, 0);
     version_.assign(nv, 0);
     vtris_.assign(nv, {});
     qpos_.resize(nv);
-    for (size_t v = 0; v < nv; ++v) qpos_[v] = quantise(pos_[v]);
-    tris_ = mesh_.triangles;
-    tAlive_.assign(tris_.size(), 1);
-    made_.assign(tris_.size(), 0);
-    level_.assign(tris_.size(), -1);
-    probe_.resize(tris_.size());
-    for (uint32_t t = 0; t < tris_.size(); ++t) {
-      for (uint32_t v : tris_[t]) vtris_[v].push_back(t);
+    for (size_t v = 0; v < nv; ++v) qpos_[v] = quantise(w_.pos[v]);
+    tAlive_.assign(w_.tris.size(), 1);
+    probe_.resize(w_.tris.size());
+    for (uint32_t t = 0; t < w_.tris.size(); ++t) {
+      for (uint32_t v : w_.tris[t]) vtris_[v].push_back(t);
       insertBuckets(t);
     }
-    for (uint32_t t = 0; t < tris_.size(); ++t)
+    for (uint32_t t = 0; t < w_.tris.size(); ++t)
       for (int c = 0; c < 3; ++c) {
-        uint32_t a = tris_[t][c], b = tris_[t][(c + 1) % 3];
-        if (a < b) pushCandidate(a, b);  // each undirected edge once (closed mesh)
+        uint32_t a = w_.tris[t][c], b = w_.tris[t][(c + 1) % 3];
+        // Each undirected edge once (in a closed mesh; a block's open rim is locked anyway).
+        if (a < b || !std::count(vtris_[b].begin(), vtris_[b].end(), t)) pushCandidate(a, b);
       }
   }
 
@@ -177,9 +206,9 @@ class Simplifier {
   }
 
   V3 placement(uint32_t a, uint32_t b, double* cost) const {
-    Quadric q = quad_[a];
-    q += quad_[b];
-    const V3 &pa = pos_[a], &pb = pos_[b];
+    Quadric q = w_.quad[a];
+    q += w_.quad[b];
+    const V3 &pa = w_.pos[a], &pb = w_.pos[b];
     double ca = q(pa), cb = q(pb);
     V3 best = ca <= cb ? pa : pb;
     *cost = std::min(ca, cb);
@@ -188,7 +217,9 @@ class Simplifier {
       V3 p = q.minimiser(mid);
       double reach = std::max(norm(sub(pa, pb)), grid_.voxel);
       double cp = q(p);
-      if (norm(sub(p, mid)) <= reach && std::isfinite(cp) && cp <= *cost) {
+      bool inside = true;
+      for (int k = 0; k < 3 && w_.confined; ++k) inside = inside && p[k] >= w_.regionLo[k] && p[k] <= w_.regionHi[k];
+      if (inside && norm(sub(p, mid)) <= reach && std::isfinite(cp) && cp <= *cost) {
         *cost = cp;
         best = p;
       }
@@ -197,15 +228,16 @@ class Simplifier {
   }
 
   void pushCandidate(uint32_t a, uint32_t b) {
+    if (w_.locked[a] || w_.locked[b]) return;
     if (a > b) std::swap(a, b);
     double cost;
     placement(a, b, &cost);
     // Mean squared distance to the tangent planes above tol^2: the merged vertex cannot sit on
     // all of them within the tolerance; not worth the model evaluations.
-    if (cost > tol_ * tol_ * (quad_[a].weight + quad_[b].weight)) return;
+    if (cost > tol_ * tol_ * (w_.quad[a].weight + w_.quad[b].weight)) return;
     // Costs below 1e-6 tol^2 count as equal: then shorter edges first (even coarsening).
     double key = std::floor(cost / (1e-6 * tol_ * tol_));
-    queue_.push({key, dot(sub(pos_[a], pos_[b]), sub(pos_[a], pos_[b])), a, b, version_[a], version_[b]});
+    queue_.push({key, dot(sub(w_.pos[a], w_.pos[b]), sub(w_.pos[a], w_.pos[b])), a, b, version_[a], version_[b]});
   }
 
   // ---- spatial hash of triangles (for the self-intersection check) ------------------------
@@ -256,8 +288,8 @@ class Simplifier {
         }
   }
   void insertBuckets(uint32_t t) {
-    const Tri& tr = tris_[t];
-    const V3 &a = pos_[tr[0]], &b = pos_[tr[1]], &c = pos_[tr[2]];
+    const Tri& tr = w_.tris[t];
+    const V3 &a = w_.pos[tr[0]], &b = w_.pos[tr[1]], &c = w_.pos[tr[2]];
     // The entry carries the triangle's box (float, rounded outwards past a 1e-3 voxel margin), so
     // a query scans its cells' entries in order and touches a triangle only if the boxes meet.
     Entry e{t, {}, {}};
@@ -270,8 +302,8 @@ class Simplifier {
   }
   // Before any corner of t moves (the same cells as its insertion).
   void eraseBuckets(uint32_t t) {
-    const Tri& tr = tris_[t];
-    forTriangleCells(pos_[tr[0]], pos_[tr[1]], pos_[tr[2]], [&](uint64_t k) {
+    const Tri& tr = w_.tris[t];
+    forTriangleCells(w_.pos[tr[0]], w_.pos[tr[1]], w_.pos[tr[2]], [&](uint64_t k) {
       auto it = buckets_.find(k);
       auto& v = it->second;
       v.erase(std::find_if(v.begin(), v.end(), [t](const Entry& e) { return e.tri == t; }));
@@ -331,16 +363,16 @@ class Simplifier {
   }
 
   int levelOf(uint32_t t) {
-    if (level_[t] < 0) {
-      const Tri& tr = tris_[t];
+    if (w_.level[t] < 0) {
+      const Tri& tr = w_.tris[t];
       int k = 0;
-      const V3 &a = pos_[tr[0]], &b = pos_[tr[1]], &c = pos_[tr[2]];
-      V3 along = add(normal_[tr[0]], add(normal_[tr[1]], normal_[tr[2]]));
+      const V3 &a = w_.pos[tr[0]], &b = w_.pos[tr[1]], &c = w_.pos[tr[2]];
+      V3 along = add(w_.normal[tr[0]], add(w_.normal[tr[1]], w_.normal[tr[2]]));
       const V3* dir = quality(a, b, c) < opt_.minQuality && norm(along) > 0 ? &along : nullptr;
       while (k <= maxLevel_ && !withinLevel(a, b, c, k, dir)) ++k;
-      level_[t] = int8_t(std::min(k, maxLevel_));  // beyond the last level: no more allowance
+      w_.level[t] = int8_t(std::min(k, maxLevel_));  // beyond the last level: no more allowance
     }
-    return level_[t];
+    return w_.level[t];
   }
 
   // ---- one collapse ---------------------------------------------------------------------------
@@ -349,12 +381,12 @@ class Simplifier {
     // neighbour; neither opposite vertex may drop below valence 3.
     std::vector<uint32_t> na, nb, opposite;
     for (uint32_t t : vtris_[a])
-      for (uint32_t v : tris_[t])
+      for (uint32_t v : w_.tris[t])
         if (v != a) na.push_back(v);
     for (uint32_t t : vtris_[b]) {
       bool hasA = false;
-      for (uint32_t v : tris_[t]) hasA |= v == a;
-      for (uint32_t v : tris_[t])
+      for (uint32_t v : w_.tris[t]) hasA |= v == a;
+      for (uint32_t v : w_.tris[t])
         if (v != b) {
           nb.push_back(v);
           if (hasA && v != a) opposite.push_back(v);
@@ -378,7 +410,7 @@ class Simplifier {
     std::vector<uint32_t> changed, removed;  // triangles kept with a new corner; the two dropped
     for (uint32_t v : {a, b})
       for (uint32_t t : vtris_[v]) {
-        const Tri& tr = tris_[t];
+        const Tri& tr = w_.tris[t];
         bool both = (tr[0] == a || tr[1] == a || tr[2] == a) && (tr[0] == b || tr[1] == b || tr[2] == b);
         if (both) {
           if (v == a) removed.push_back(t);
@@ -386,7 +418,7 @@ class Simplifier {
           changed.push_back(t);
         }
       }
-    auto corner = [&](uint32_t v) { return v == a || v == b ? p : pos_[v]; };
+    auto corner = [&](uint32_t v) { return v == a || v == b ? p : w_.pos[v]; };
     auto renamed = [&](const Tri& tr) {
       Tri r = tr;
       for (uint32_t& v : r)
@@ -397,16 +429,16 @@ class Simplifier {
     // Shape: no flip or fold; below the quality bound, the worst triangle may not get more than
     // 10% worse (the mesher leaves slivers where the surface grazes grid points; they go first).
     double worstBefore = 1, worstAfter = 1;
-    for (uint32_t t : removed) worstBefore = std::min(worstBefore, quality(pos_[tris_[t][0]], pos_[tris_[t][1]], pos_[tris_[t][2]]));
+    for (uint32_t t : removed) worstBefore = std::min(worstBefore, quality(w_.pos[w_.tris[t][0]], w_.pos[w_.tris[t][1]], w_.pos[w_.tris[t][2]]));
     for (uint32_t t : changed) {
-      const Tri& tr = tris_[t];
-      V3 o0 = pos_[tr[0]], o1 = pos_[tr[1]], o2 = pos_[tr[2]];
+      const Tri& tr = w_.tris[t];
+      V3 o0 = w_.pos[tr[0]], o1 = w_.pos[tr[1]], o2 = w_.pos[tr[2]];
       double q0 = quality(o0, o1, o2);
       worstBefore = std::min(worstBefore, q0);
       // The direction the triangle must keep facing: its own normal, or for a sliver (whose
       // normal is noise: the mesher's triangles where the surface grazes a grid point) the
       // model's normals at its corners.
-      V3 n0 = q0 < opt_.minQuality ? add(normal_[tr[0]], add(normal_[tr[1]], normal_[tr[2]])) : cross(sub(o1, o0), sub(o2, o0));
+      V3 n0 = q0 < opt_.minQuality ? add(w_.normal[tr[0]], add(w_.normal[tr[1]], w_.normal[tr[2]])) : cross(sub(o1, o0), sub(o2, o0));
       V3 c0 = corner(tr[0]), c1 = corner(tr[1]), c2 = corner(tr[2]);
       V3 n1 = cross(sub(c1, c0), sub(c2, c0));
       double l1 = norm(n1);
@@ -427,7 +459,7 @@ class Simplifier {
     for (uint32_t t : removed) allowed = std::max(allowed, levelOf(t));
     std::vector<int8_t> newLevel(changed.size());
     for (size_t i = 0; i < changed.size(); ++i) {
-      const Tri& tr = tris_[changed[i]];
+      const Tri& tr = w_.tris[changed[i]];
       int k = 0;
       while (k <= allowed && !withinLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), k)) ++k;
       if (k > allowed) {
@@ -441,8 +473,8 @@ class Simplifier {
     for (uint32_t v : {a, b}) {
       double d = INFINITY;
       for (uint32_t t : changed) {
-        const Tri& tr = tris_[t];
-        d = std::min(d, pointTriangleDistance(pos_[v], corner(tr[0]), corner(tr[1]), corner(tr[2])));
+        const Tri& tr = w_.tris[t];
+        d = std::min(d, pointTriangleDistance(w_.pos[v], corner(tr[0]), corner(tr[1]), corner(tr[2])));
       }
       if (d > e) {
         ++stats_.rejectedError;
@@ -461,7 +493,7 @@ class Simplifier {
     fresh.clear();
     V3 ringLo{INFINITY, INFINITY, INFINITY}, ringHi{-INFINITY, -INFINITY, -INFINITY};
     for (uint32_t t : changed) {
-      const Tri& tr = tris_[t];
+      const Tri& tr = w_.tris[t];
       NewTri n{renamed(tr), {qcorner(tr[0]), qcorner(tr[1]), qcorner(tr[2])}, corner(tr[0]), corner(tr[0])};
       for (int c = 1; c < 3; ++c)
         for (int k = 0; k < 3; ++k) n.lo[k] = std::min(n.lo[k], corner(tr[c])[k]), n.hi[k] = std::max(n.hi[k], corner(tr[c])[k]);
@@ -490,7 +522,7 @@ class Simplifier {
             Probe& pr = probe_[e.tri];
             if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
             pr.seen = probeNow_;
-            const Tri& tu = tris_[e.tri];
+            const Tri& tu = w_.tris[e.tri];
             const std::array<exact::P, 3> qu{qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]};
             for (const NewTri& n : fresh) {
               if (e.hi[0] < n.lo[0] || e.lo[0] > n.hi[0] || e.hi[1] < n.lo[1] || e.lo[1] > n.hi[1] || e.hi[2] < n.lo[2] ||
@@ -513,39 +545,39 @@ class Simplifier {
     for (uint32_t t : removed) {
       eraseBuckets(t);
       tAlive_[t] = 0;
-      for (uint32_t v : tris_[t]) {
+      for (uint32_t v : w_.tris[t]) {
         auto& l = vtris_[v];
         l.erase(std::find(l.begin(), l.end(), t));
       }
     }
     for (uint32_t t : changed) eraseBuckets(t);
     for (uint32_t t : vtris_[b]) {
-      for (uint32_t& v : tris_[t])
+      for (uint32_t& v : w_.tris[t])
         if (v == b) v = a;
       vtris_[a].push_back(t);
     }
     vtris_[b].clear();
     alive_[b] = 0;
-    if (p == pos_[b]) {  // stayed at b: a takes b's identity (its key and normal)
-      key_[a] = key_[b];
-      normal_[a] = normal_[b];
-      moved_[a] = moved_[b];
-    } else if (p != pos_[a]) {
-      moved_[a] = 1;
+    if (p == w_.pos[b]) {  // stayed at b: a takes b's identity (its key and normal)
+      w_.key[a] = w_.key[b];
+      w_.normal[a] = w_.normal[b];
+      w_.moved[a] = w_.moved[b];
+    } else if (p != w_.pos[a]) {
+      w_.moved[a] = 1;
     }
-    pos_[a] = p;
+    w_.pos[a] = p;
     qpos_[a] = qp;
-    quad_[a] += quad_[b];
+    w_.quad[a] += w_.quad[b];
     ++version_[a];
     for (size_t i = 0; i < changed.size(); ++i) {
-      level_[changed[i]] = newLevel[i];
-      made_[changed[i]] = 1;
+      w_.level[changed[i]] = newLevel[i];
+      w_.made[changed[i]] = 1;
       insertBuckets(changed[i]);
     }
     ++stats_.collapses;
     std::vector<uint32_t> ring;
     for (uint32_t t : vtris_[a])
-      for (uint32_t v : tris_[t])
+      for (uint32_t v : w_.tris[t])
         if (v != a) ring.push_back(v);
     std::sort(ring.begin(), ring.end());
     ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
@@ -553,33 +585,35 @@ class Simplifier {
   }
 
   // ---- output -------------------------------------------------------------------------------
-  void finish() {
-    // Vertices in the order of their keys (as the mesher orders them), triangles by index
-    // triple rotated to start at the smallest.
-    const size_t nv = pos_.size();
+ public:
+  // The mesh: vertices in the order of their keys (as the mesher orders them), triangles by
+  // index triple rotated to start at the smallest.
+  Mesh output(const MeshStats& stats) {
+    const size_t nv = w_.pos.size();
     std::vector<uint32_t> order;
     for (uint32_t v = 0; v < nv; ++v)
       if (alive_[v] && !vtris_[v].empty()) order.push_back(v);
-    std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return key_[x] != key_[y] ? key_[x] < key_[y] : x < y; });
+    std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return w_.key[x] != w_.key[y] ? w_.key[x] < w_.key[y] : x < y; });
     std::vector<uint32_t> index(nv, UINT32_MAX);
     Mesh out;
-    out.stats = mesh_.stats;
+    out.stats = stats;
     GradientEvaluator grad;
     std::vector<double> x(std::max<uint32_t>(tape_->numVars(), 3)), g(x.size());
     for (uint32_t v : order) {
       index[v] = uint32_t(out.positions.size());
-      out.positions.push_back(pos_[v]);
-      out.keys.push_back(key_[v]);
-      V3 n = normal_[v];
-      if (moved_[v]) {
+      out.positions.push_back(w_.pos[v]);
+      out.keys.push_back(w_.key[v]);
+      V3 n = w_.normal[v];
+      V3 fan{0, 0, 0};  // area-weighted normal of the triangles around the vertex
+      for (uint32_t t : vtris_[v]) {
+        const Tri& tr = w_.tris[t];
+        fan = add(fan, cross(sub(w_.pos[tr[1]], w_.pos[tr[0]]), sub(w_.pos[tr[2]], w_.pos[tr[0]])));
+      }
+      if (w_.moved[v] || dot(n, fan) <= 0) {
         // Outward = -grad f; at an edge or a corner of the model the gradient is one face's (or
-        // undefined): then the area-weighted normal of the triangles around the vertex.
-        V3 fan{0, 0, 0};
-        for (uint32_t t : vtris_[v]) {
-          const Tri& tr = tris_[t];
-          fan = add(fan, cross(sub(pos_[tr[1]], pos_[tr[0]]), sub(pos_[tr[2]], pos_[tr[0]])));
-        }
-        for (uint32_t k = 0; k < x.size(); ++k) x[k] = k < 3 ? pos_[v][k] : opt_.fixedCoords[k - 3];
+        // undefined), and a kept vertex near a corner may now carry triangles of several faces:
+        // then the fan's normal.
+        for (uint32_t k = 0; k < x.size(); ++k) x[k] = k < 3 ? w_.pos[v][k] : opt_.fixedCoords[k - 3];
         grad.eval(*tape_, x.data(), g.data());
         V3 gn{-g[0], -g[1], -g[2]};
         double lg = norm(gn), lf = norm(fan);
@@ -590,23 +624,24 @@ class Simplifier {
       }
       out.normals.push_back(n);
     }
-    for (uint32_t t = 0; t < tris_.size(); ++t) {
+    for (uint32_t t = 0; t < w_.tris.size(); ++t) {
       if (!tAlive_[t]) continue;
-      Tri r{index[tris_[t][0]], index[tris_[t][1]], index[tris_[t][2]]};
+      Tri r{index[w_.tris[t][0]], index[w_.tris[t][1]], index[w_.tris[t][2]]};
       int s = r[0] < r[1] ? (r[0] < r[2] ? 0 : 2) : (r[1] < r[2] ? 1 : 2);
       out.triangles.push_back({r[s], r[(s + 1) % 3], r[(s + 2) % 3]});
     }
     std::sort(out.triangles.begin(), out.triangles.end());
-    mesh_ = std::move(out);
+    return out;
   }
 
-  Mesh& mesh_;
+ private:
+
+  Work w_;
   TapePtr tape_;
   GridSpec grid_;
   SimplifyOptions opt_;
   double tol_;
   SimplifyStats stats_;
-  std::vector<V3> pos_, normal_;
   std::vector<V3> samplePoints_;
   struct NewTri {  // a triangle as a collapse would leave it
     Tri t;
@@ -614,15 +649,11 @@ class Simplifier {
     V3 lo, hi;                  // box
   };
   std::vector<NewTri> freshTris_;
-  std::vector<EdgeKey> key_;
   std::vector<exact::P> qpos_;
-  std::vector<Quadric> quad_;
-  std::vector<char> alive_, moved_;
+  std::vector<char> alive_;
   std::vector<uint32_t> version_;
   std::vector<std::vector<uint32_t>> vtris_;
-  std::vector<Tri> tris_;
-  std::vector<char> tAlive_, made_;
-  std::vector<int8_t> level_;
+  std::vector<char> tAlive_;
   // Per-triangle marks of the self-intersection queries.
   struct Probe {
     uint32_t skip = 0;  // == stampNow_: part of the collapse being checked
@@ -640,15 +671,196 @@ class Simplifier {
   int maxLevel_ = 0;  // the last error level
 };
 
+constexpr int kBlockVoxels = 32;  // the first pass's blocks (fixed in index space)
+
+void addStats(SimplifyStats& s, const SimplifyStats& b) {
+  s.collapses += b.collapses;
+  s.rejectedTopology += b.rejectedTopology;
+  s.rejectedShape += b.rejectedShape;
+  s.rejectedError += b.rejectedError;
+  s.rejectedIntersection += b.rejectedIntersection;
+  s.modelEvals += b.modelEvals;
+}
+
+// First pass, in parallel: the grid's index space is cut into fixed blocks of kBlockVoxels (so
+// the cut does not depend on the farm's bricks). A vertex belongs to its block if it and every
+// neighbour lie inside the block shrunk by a voxel; each block simplifies the triangles around
+// its own vertices, with the other vertices locked, placements confined to the shrunk block,
+// and every other triangle meeting it as a fixed obstacle. Those triangles are never changed by
+// another block (each block's triangles stay inside its own shrunk box), so the blocks are
+// independent: the result does not depend on the thread count or the order. The second pass
+// (the caller) then works across the block faces.
+void firstPass(Work& g, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt, SimplifyStats& stats) {
+  const size_t nv = g.pos.size(), nt = g.tris.size();
+  const double side = kBlockVoxels * grid.voxel, margin = grid.voxel;
+  using BlockKey = std::array<int32_t, 3>;
+  auto blockOf = [&](const V3& p) {
+    BlockKey b;
+    for (int k = 0; k < 3; ++k) b[k] = int32_t(std::floor((p[k] - grid.origin[k]) / side));
+    return b;
+  };
+  auto shrunk = [&](const BlockKey& b, V3& lo, V3& hi) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = grid.origin[k] + b[k] * side + margin;
+      hi[k] = grid.origin[k] + (b[k] + 1) * side - margin;
+    }
+  };
+  auto inside = [](const V3& p, const V3& lo, const V3& hi) {
+    return p[0] > lo[0] && p[0] < hi[0] && p[1] > lo[1] && p[1] < hi[1] && p[2] > lo[2] && p[2] < hi[2];
+  };
+  std::vector<std::vector<uint32_t>> vt(nv);
+  for (uint32_t t = 0; t < nt; ++t)
+    for (uint32_t v : g.tris[t]) vt[v].push_back(t);
+  // Owned vertices by block (ordered: the write-back order is fixed).
+  std::map<BlockKey, std::vector<uint32_t>> owned;
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (vt[v].empty()) continue;
+    BlockKey b = blockOf(g.pos[v]);
+    V3 lo, hi;
+    shrunk(b, lo, hi);
+    bool ok = true;
+    for (uint32_t t : vt[v])
+      for (uint32_t u : g.tris[t]) ok = ok && inside(g.pos[u], lo, hi);
+    if (ok) owned[b].push_back(v);
+  }
+  if (owned.empty()) return;
+  std::vector<BlockKey> blocks;
+  for (auto& [b, vs] : owned) blocks.push_back(b);
+  // Obstacle candidates: every triangle under each block its box meets.
+  std::map<BlockKey, std::vector<uint32_t>> near;
+  for (uint32_t t = 0; t < nt; ++t) {
+    V3 lo = g.pos[g.tris[t][0]], hi = lo;
+    for (uint32_t v : g.tris[t])
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], g.pos[v][k]), hi[k] = std::max(hi[k], g.pos[v][k]);
+    BlockKey a = blockOf(lo), b = blockOf(hi);
+    for (int32_t x = a[0]; x <= b[0]; ++x)
+      for (int32_t y = a[1]; y <= b[1]; ++y)
+        for (int32_t z = a[2]; z <= b[2]; ++z) {
+          auto it = owned.find({x, y, z});
+          if (it != owned.end()) near[{x, y, z}].push_back(t);
+        }
+  }
+
+  struct Result {
+    std::vector<uint32_t> globalOf;  // local vertex -> global
+    std::vector<uint32_t> active;    // the block's triangles (global ids), replaced by its output
+    std::unique_ptr<Simplifier> s;
+  };
+  std::vector<Result> results(blocks.size());
+  auto solve = [&](size_t i) {
+    const BlockKey& b = blocks[i];
+    Result& r = results[i];
+    std::vector<uint32_t>& own = owned[b];
+    for (uint32_t v : own) r.active.insert(r.active.end(), vt[v].begin(), vt[v].end());
+    std::sort(r.active.begin(), r.active.end());
+    r.active.erase(std::unique(r.active.begin(), r.active.end()), r.active.end());
+    V3 lo, hi;
+    shrunk(b, lo, hi);
+    std::vector<uint32_t> obstacles;
+    for (uint32_t t : near[b]) {
+      if (std::binary_search(r.active.begin(), r.active.end(), t)) continue;
+      V3 tl = g.pos[g.tris[t][0]], th = tl;
+      for (uint32_t v : g.tris[t])
+        for (int k = 0; k < 3; ++k) tl[k] = std::min(tl[k], g.pos[v][k]), th[k] = std::max(th[k], g.pos[v][k]);
+      if (th[0] >= lo[0] && tl[0] <= hi[0] && th[1] >= lo[1] && tl[1] <= hi[1] && th[2] >= lo[2] && tl[2] <= hi[2])
+        obstacles.push_back(t);
+    }
+    for (uint32_t t : r.active)
+      for (uint32_t v : g.tris[t]) r.globalOf.push_back(v);
+    for (uint32_t t : obstacles)
+      for (uint32_t v : g.tris[t]) r.globalOf.push_back(v);
+    std::sort(r.globalOf.begin(), r.globalOf.end());
+    r.globalOf.erase(std::unique(r.globalOf.begin(), r.globalOf.end()), r.globalOf.end());
+    auto local = [&](uint32_t v) {
+      return uint32_t(std::lower_bound(r.globalOf.begin(), r.globalOf.end(), v) - r.globalOf.begin());
+    };
+    Work w;
+    for (uint32_t v : r.globalOf) {
+      w.pos.push_back(g.pos[v]);
+      w.normal.push_back(g.normal[v]);
+      w.key.push_back(g.key[v]);
+      w.quad.push_back(g.quad[v]);
+      w.moved.push_back(g.moved[v]);
+      w.locked.push_back(!std::binary_search(own.begin(), own.end(), v));
+    }
+    for (const std::vector<uint32_t>* list : {&r.active, &obstacles})
+      for (uint32_t t : *list) {
+        w.tris.push_back({local(g.tris[t][0]), local(g.tris[t][1]), local(g.tris[t][2])});
+        w.level.push_back(g.level[t]);
+        w.made.push_back(g.made[t]);
+      }
+    w.confined = true;
+    w.regionLo = lo;
+    w.regionHi = hi;
+    r.s = std::make_unique<Simplifier>(std::move(w), tape, grid, opt);
+    r.s->run();
+  };
+  tbb::task_arena arena(opt.threads > 0 ? opt.threads : tbb::task_arena::automatic);
+  arena.execute([&] { tbb::parallel_for(size_t(0), blocks.size(), solve); });
+
+  // Write back, block by block: owned vertices' new state, the block's triangles replaced.
+  std::vector<char> vAlive(nv, 1), tAlive(nt, 1);
+  for (Result& r : results) {
+    const Work& w = r.s->work();
+    for (uint32_t i = 0; i < r.globalOf.size(); ++i) {
+      if (w.locked[i]) continue;
+      const uint32_t v = r.globalOf[i];
+      vAlive[v] = r.s->vertexAlive(i);
+      g.pos[v] = w.pos[i];
+      g.normal[v] = w.normal[i];
+      g.key[v] = w.key[i];
+      g.quad[v] = w.quad[i];
+      g.moved[v] = w.moved[i];
+    }
+    for (uint32_t t : r.active) tAlive[t] = 0;
+    for (uint32_t t = 0; t < r.active.size(); ++t) {  // the active triangles come first
+      if (!r.s->triangleAlive(t)) continue;
+      const Tri& tr = w.tris[t];
+      g.tris.push_back({r.globalOf[tr[0]], r.globalOf[tr[1]], r.globalOf[tr[2]]});
+      g.level.push_back(w.level[t]);
+      g.made.push_back(w.made[t]);
+      tAlive.push_back(1);
+    }
+    addStats(stats, r.s->stats());
+    r.s.reset();
+  }
+  // Compact.
+  std::vector<uint32_t> index(nv, UINT32_MAX);
+  Work c;
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (!vAlive[v]) continue;
+    index[v] = uint32_t(c.pos.size());
+    c.pos.push_back(g.pos[v]);
+    c.normal.push_back(g.normal[v]);
+    c.key.push_back(g.key[v]);
+    c.quad.push_back(g.quad[v]);
+    c.moved.push_back(g.moved[v]);
+    c.locked.push_back(0);
+  }
+  for (uint32_t t = 0; t < g.tris.size(); ++t) {
+    if (!tAlive[t]) continue;
+    c.tris.push_back({index[g.tris[t][0]], index[g.tris[t][1]], index[g.tris[t][2]]});
+    c.level.push_back(g.level[t]);
+    c.made.push_back(g.made[t]);
+  }
+  g = std::move(c);
+}
+
 }  // namespace
 
 SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options) {
-  if (!(options.tolerance > 0) || mesh.triangles.empty()) {
-    SimplifyStats s;
-    s.trianglesBefore = s.trianglesAfter = mesh.triangles.size();
-    return s;
-  }
-  return Simplifier(mesh, tape, grid, options).run();
+  SimplifyStats stats;
+  stats.trianglesBefore = stats.trianglesAfter = mesh.triangles.size();
+  if (!(options.tolerance > 0) || mesh.triangles.empty()) return stats;
+  Work w = workOf(mesh);
+  firstPass(w, tape, grid, options, stats);
+  Simplifier second(std::move(w), tape, grid, options);
+  const SimplifyStats& s2 = second.run();
+  addStats(stats, s2);
+  stats.errorBound = s2.errorBound;  // over every triangle a collapse made, in either pass
+  mesh = second.output(mesh.stats);
+  stats.trianglesAfter = mesh.triangles.size();
+  return stats;
 }
 
 }  // namespace frep

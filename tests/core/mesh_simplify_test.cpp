@@ -248,6 +248,24 @@ TEST(MeshSimplify, SameResultWhateverTheSplit) {
   EXPECT_EQ(a.keys, b.keys);
 }
 
+TEST(MeshSimplify, SameResultForAnyThreadCount) {
+  // 100 points: 3 x 3 x 3 first-pass blocks of 32 voxels, run by 1 and by 2 threads.
+  Expr m = max(torusZ(0.55, 0.22), min(blockAt(0.1, 0.1, 0.1, 0.5, 0.3, 0.4), -sphereAt(0.4, 0.3, 0.4, 0.3)));
+  GridSpec g = cubeGrid(1.0, 100);
+  TapePtr tape = Tape::compile(m, 3);
+  Mesh a = meshGrid(tape, g), b = a;
+  SimplifyOptions one, two;
+  one.tolerance = two.tolerance = 0.1;
+  one.threads = 1;
+  two.threads = 2;
+  SimplifyStats sa = simplifyMesh(a, tape, g, one), sb = simplifyMesh(b, tape, g, two);
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.normals, b.normals);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(sa.collapses, sb.collapses);
+  EXPECT_EQ(sa.modelEvals, sb.modelEvals);
+}
+
 TEST(MeshSimplify, WithoutSharpFeaturesEveryVertexStaysAMesherVertex) {
   Expr m = blockAt(0.013, -0.021, 0.007, 0.9, 0.7, 0.5);
   GridSpec g = cubeGrid(1.2, 48);

@@ -37,6 +37,7 @@ struct SimplifyOptions {
   bool sharpFeatures = true;
   std::vector<double> fixedCoords;  // x[3], x[4], ... for models of dimension > 3
   double minQuality = 0.02;  // 4 sqrt(3) area / sum of squared edges (1: equilateral)
+  int threads = 0;           // the first pass's independent blocks; 0: all cores (same result)
 };
 
 struct SimplifyStats {
