@@ -33,6 +33,25 @@ struct KuhnCell {
 // c = 0..7); no polygon for 0 and 255.
 const KuhnCell& kuhnCell(unsigned insideMask);
 
+// Calls polygon(keys, count) for each polygon of the cell at (x, y, z) with that inside mask, its
+// corners given as the global keys of their edges (mesh.h), and edge(key, loInside) for each
+// of those corners (the edge and whether its smaller-corner end is inside).
+template <typename EdgeKeyFn, typename EdgeFn, typename PolygonFn>
+void forCellPolygons(unsigned mask, int64_t x, int64_t y, int64_t z, EdgeKeyFn&& edgeKeyOf, EdgeFn&& edge,
+                     PolygonFn&& polygon) {
+  const KuhnCell& cell = kuhnCell(mask);
+  for (int p = 0; p < cell.count; ++p) {
+    const KuhnPolygon& poly = cell.polygons[p];
+    uint64_t keys[4];
+    for (int q = 0; q < poly.count; ++q) {
+      const uint8_t lo = poly.lo[q];
+      keys[q] = edgeKeyOf(x + (lo & 1), y + ((lo >> 1) & 1), z + ((lo >> 2) & 1), poly.dir[q]);
+      edge(keys[q], bool((mask >> lo) & 1));
+    }
+    polygon(keys, poly.count);
+  }
+}
+
 // Appends the two triangles of quad q (corners p), split along its shorter diagonal (ties: 0-2),
 // a choice made from the quad alone; both keep the quad's winding.
 template <typename V>

@@ -397,18 +397,12 @@ class RegionMesher {
           for (int c = 0; c < 8; ++c) mask |= unsigned(in[lx + (c & 1)][ly + ((c >> 1) & 1)][lz + ((c >> 2) & 1)]) << c;
           if (mask == 0 || mask == 255) continue;
           ++out.cellsCrossed;
-          const KuhnCell& cell = kuhnCell(mask);
-          for (int p = 0; p < cell.count; ++p) {
-            const KuhnPolygon& poly = cell.polygons[p];
-            EdgeKey keys[4];
-            for (int q = 0; q < poly.count; ++q) {
-              const uint8_t lo = poly.lo[q];
-              keys[q] = edgeKey(x + (lo & 1), y + ((lo >> 1) & 1), z + ((lo >> 2) & 1), poly.dir[q]);
-              out.edges.push_back({keys[q], bool((mask >> lo) & 1)});
-            }
-            if (poly.count == 3) out.tris.push_back({keys[0], keys[1], keys[2]});
-            else out.quads.push_back({keys[0], keys[1], keys[2], keys[3]});
-          }
+          forCellPolygons(
+              mask, x, y, z, edgeKey, [&](EdgeKey k, bool loInside) { out.edges.push_back({k, loInside}); },
+              [&](const EdgeKey* k, int n) {
+                if (n == 3) out.tris.push_back({k[0], k[1], k[2]});
+                else out.quads.push_back({k[0], k[1], k[2], k[3]});
+              });
         }
   }
 

@@ -284,18 +284,12 @@ class SampledMesher {
           if (mask == 0 || mask == 255) continue;
           ++out.cellsCrossed;
           // The same cell polygons as the model mesher's (kuhn_tables.h).
-          const KuhnCell& cell = kuhnCell(mask);
-          for (int p = 0; p < cell.count; ++p) {
-            const KuhnPolygon& poly = cell.polygons[p];
-            EdgeKey keys[4];
-            for (int q = 0; q < poly.count; ++q) {
-              const uint8_t lo = poly.lo[q];
-              keys[q] = edgeKey(o[0] + x + (lo & 1), o[1] + y + ((lo >> 1) & 1), o[2] + z + ((lo >> 2) & 1), poly.dir[q]);
-              out.edges.push_back(keys[q]);
-            }
-            if (poly.count == 3) out.tris.push_back({keys[0], keys[1], keys[2]});
-            else out.quads.push_back({keys[0], keys[1], keys[2], keys[3]});
-          }
+          forCellPolygons(
+              mask, o[0] + x, o[1] + y, o[2] + z, edgeKey, [&](EdgeKey k, bool) { out.edges.push_back(k); },
+              [&](const EdgeKey* k, int n) {
+                if (n == 3) out.tris.push_back({k[0], k[1], k[2]});
+                else out.quads.push_back({k[0], k[1], k[2], k[3]});
+              });
         }
     if (out.edges.empty()) return;
     std::sort(out.edges.begin(), out.edges.end());

@@ -96,6 +96,29 @@ inline double minTriangleArea(const std::vector<Vec3>& p, const std::vector<Tri>
   return a;
 }
 
+// Vertices not certified within `radius` of the surface {f = 0} (inside: f >= 0): none of the
+// vertex itself, +-normal and the 26 grid directions at that distance gives both an inside and
+// an outside point (when some do, the segment between them, inside the ball, crosses it).
+template <typename F>
+size_t verticesFarFromSurface(const std::vector<Vec3>& pos, const std::vector<Vec3>& normals, double radius, F&& f) {
+  size_t far = 0;
+  for (size_t i = 0; i < pos.size(); ++i) {
+    bool in = false, out = false;
+    auto probe = [&](double dx, double dy, double dz) {
+      double len = std::sqrt(dx * dx + dy * dy + dz * dz);
+      double s = len > 0 ? radius / len : 0;
+      (f(Vec3{pos[i][0] + s * dx, pos[i][1] + s * dy, pos[i][2] + s * dz}) >= 0 ? in : out) = true;
+    };
+    probe(0, 0, 0);
+    probe(normals[i][0], normals[i][1], normals[i][2]);
+    probe(-normals[i][0], -normals[i][1], -normals[i][2]);
+    for (int d = 0; d < 27 && !(in && out); ++d)
+      if (d != 13) probe(d / 9 - 1, (d / 3) % 3 - 1, d % 3 - 1);
+    far += !(in && out);
+  }
+  return far;
+}
+
 // ---- Self-intersections, with exact predicates --------------------------------------------
 // Coordinates are quantised to a 2^24 grid over the mesh's bounding box (int64), and every
 // orientation is an exact integer determinant (__int128), so the verdict is exact for the

@@ -91,24 +91,9 @@ void checkVerticesOnSurface(const Expr& model, const Mesh& m, double voxel, doub
 void checkVerticesNearSurface(const Expr& model, const Mesh& m, double voxel) {
   TapePtr tape = Tape::compile(model, 3);
   PointEvaluator pe;
-  size_t bad = 0;
-  for (size_t i = 0; i < m.positions.size(); ++i) {
-    bool in = false, out = false;
-    auto probe = [&](double dx, double dy, double dz) {
-      double len = std::sqrt(dx * dx + dy * dy + dz * dz);
-      double s = len > 0 ? 0.49 * voxel / len : 0;
-      std::array<double, 3> p{m.positions[i][0] + s * dx, m.positions[i][1] + s * dy, m.positions[i][2] + s * dz};
-      double f = pe.eval(*tape, p.data());
-      (f >= 0 ? in : out) = true;
-    };
-    probe(0, 0, 0);
-    probe(m.normals[i][0], m.normals[i][1], m.normals[i][2]);
-    probe(-m.normals[i][0], -m.normals[i][1], -m.normals[i][2]);
-    for (int d = 0; d < 27 && !(in && out); ++d)
-      if (d != 13) probe(d / 9 - 1, (d / 3) % 3 - 1, d % 3 - 1);
-    bad += !(in && out);
-  }
-  EXPECT_EQ(bad, 0u);
+  EXPECT_EQ(mc::verticesFarFromSurface(m.positions, m.normals, 0.49 * voxel,
+                                       [&](const mc::Vec3& p) { return pe.eval(*tape, p.data()); }),
+            0u);
 }
 
 void checkNormals(const Mesh& m, const std::function<mc::Vec3(const mc::Vec3&)>& outward) {
