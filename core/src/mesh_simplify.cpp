@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <memory>
 #include <queue>
 #include <unordered_map>
 
@@ -741,41 +740,46 @@ void firstPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
         }
   }
 
+  // A block writes its own vertices' new state into g at once (no other block reads them) and
+  // keeps its new triangles, appended afterwards in block order.
   struct Result {
-    std::vector<uint32_t> globalOf;  // local vertex -> global
-    std::vector<uint32_t> active;    // the block's triangles (global ids), replaced by its output
-    std::unique_ptr<Simplifier> s;
+    std::vector<Tri> tris;  // global vertex ids
+    std::vector<int8_t> level;
+    std::vector<char> made;
+    SimplifyStats stats;
   };
   std::vector<Result> results(blocks.size());
+  std::vector<char> vAlive(nv, 1), tAlive(nt, 1);
   auto solve = [&](size_t i) {
     const BlockKey& b = blocks[i];
     Result& r = results[i];
-    std::vector<uint32_t>& own = owned[b];
-    for (uint32_t v : own) r.active.insert(r.active.end(), vt[v].begin(), vt[v].end());
-    std::sort(r.active.begin(), r.active.end());
-    r.active.erase(std::unique(r.active.begin(), r.active.end()), r.active.end());
+    const std::vector<uint32_t>& own = owned.at(b);
+    std::vector<uint32_t> active, globalOf;  // the block's triangles; local vertex -> global
+    for (uint32_t v : own) active.insert(active.end(), vt[v].begin(), vt[v].end());
+    std::sort(active.begin(), active.end());
+    active.erase(std::unique(active.begin(), active.end()), active.end());
     V3 lo, hi;
     shrunk(b, lo, hi);
     std::vector<uint32_t> obstacles;
-    for (uint32_t t : near[b]) {
-      if (std::binary_search(r.active.begin(), r.active.end(), t)) continue;
+    for (uint32_t t : near.at(b)) {
+      if (std::binary_search(active.begin(), active.end(), t)) continue;
       V3 tl = g.pos[g.tris[t][0]], th = tl;
       for (uint32_t v : g.tris[t])
         for (int k = 0; k < 3; ++k) tl[k] = std::min(tl[k], g.pos[v][k]), th[k] = std::max(th[k], g.pos[v][k]);
       if (th[0] >= lo[0] && tl[0] <= hi[0] && th[1] >= lo[1] && tl[1] <= hi[1] && th[2] >= lo[2] && tl[2] <= hi[2])
         obstacles.push_back(t);
     }
-    for (uint32_t t : r.active)
-      for (uint32_t v : g.tris[t]) r.globalOf.push_back(v);
+    for (uint32_t t : active)
+      for (uint32_t v : g.tris[t]) globalOf.push_back(v);
     for (uint32_t t : obstacles)
-      for (uint32_t v : g.tris[t]) r.globalOf.push_back(v);
-    std::sort(r.globalOf.begin(), r.globalOf.end());
-    r.globalOf.erase(std::unique(r.globalOf.begin(), r.globalOf.end()), r.globalOf.end());
+      for (uint32_t v : g.tris[t]) globalOf.push_back(v);
+    std::sort(globalOf.begin(), globalOf.end());
+    globalOf.erase(std::unique(globalOf.begin(), globalOf.end()), globalOf.end());
     auto local = [&](uint32_t v) {
-      return uint32_t(std::lower_bound(r.globalOf.begin(), r.globalOf.end(), v) - r.globalOf.begin());
+      return uint32_t(std::lower_bound(globalOf.begin(), globalOf.end(), v) - globalOf.begin());
     };
     Work w;
-    for (uint32_t v : r.globalOf) {
+    for (uint32_t v : globalOf) {
       w.pos.push_back(g.pos[v]);
       w.normal.push_back(g.normal[v]);
       w.key.push_back(g.key[v]);
@@ -783,7 +787,7 @@ void firstPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
       w.moved.push_back(g.moved[v]);
       w.locked.push_back(!std::binary_search(own.begin(), own.end(), v));
     }
-    for (const std::vector<uint32_t>* list : {&r.active, &obstacles})
+    for (const std::vector<uint32_t>* list : {&active, &obstacles})
       for (uint32_t t : *list) {
         w.tris.push_back({local(g.tris[t][0]), local(g.tris[t][1]), local(g.tris[t][2])});
         w.level.push_back(g.level[t]);
@@ -792,37 +796,38 @@ void firstPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     w.confined = true;
     w.regionLo = lo;
     w.regionHi = hi;
-    r.s = std::make_unique<Simplifier>(std::move(w), tape, grid, opt);
-    r.s->run();
+    Simplifier s(std::move(w), tape, grid, opt);
+    r.stats = s.run();
+    const Work& out = s.work();
+    for (uint32_t i = 0; i < globalOf.size(); ++i) {
+      if (out.locked[i]) continue;
+      const uint32_t v = globalOf[i];
+      vAlive[v] = s.vertexAlive(i);
+      g.pos[v] = out.pos[i];
+      g.normal[v] = out.normal[i];
+      g.key[v] = out.key[i];
+      g.quad[v] = out.quad[i];
+      g.moved[v] = out.moved[i];
+    }
+    for (uint32_t t : active) tAlive[t] = 0;
+    for (uint32_t t = 0; t < active.size(); ++t) {  // the active triangles come first
+      if (!s.triangleAlive(t)) continue;
+      const Tri& tr = out.tris[t];
+      r.tris.push_back({globalOf[tr[0]], globalOf[tr[1]], globalOf[tr[2]]});
+      r.level.push_back(out.level[t]);
+      r.made.push_back(out.made[t]);
+    }
   };
   tbb::task_arena arena(opt.threads > 0 ? opt.threads : tbb::task_arena::automatic);
   arena.execute([&] { tbb::parallel_for(size_t(0), blocks.size(), solve); });
 
-  // Write back, block by block: owned vertices' new state, the block's triangles replaced.
-  std::vector<char> vAlive(nv, 1), tAlive(nt, 1);
   for (Result& r : results) {
-    const Work& w = r.s->work();
-    for (uint32_t i = 0; i < r.globalOf.size(); ++i) {
-      if (w.locked[i]) continue;
-      const uint32_t v = r.globalOf[i];
-      vAlive[v] = r.s->vertexAlive(i);
-      g.pos[v] = w.pos[i];
-      g.normal[v] = w.normal[i];
-      g.key[v] = w.key[i];
-      g.quad[v] = w.quad[i];
-      g.moved[v] = w.moved[i];
-    }
-    for (uint32_t t : r.active) tAlive[t] = 0;
-    for (uint32_t t = 0; t < r.active.size(); ++t) {  // the active triangles come first
-      if (!r.s->triangleAlive(t)) continue;
-      const Tri& tr = w.tris[t];
-      g.tris.push_back({r.globalOf[tr[0]], r.globalOf[tr[1]], r.globalOf[tr[2]]});
-      g.level.push_back(w.level[t]);
-      g.made.push_back(w.made[t]);
-      tAlive.push_back(1);
-    }
-    addStats(stats, r.s->stats());
-    r.s.reset();
+    g.tris.insert(g.tris.end(), r.tris.begin(), r.tris.end());
+    g.level.insert(g.level.end(), r.level.begin(), r.level.end());
+    g.made.insert(g.made.end(), r.made.begin(), r.made.end());
+    tAlive.resize(g.tris.size(), 1);
+    addStats(stats, r.stats);
+    r = Result();
   }
   // Compact.
   std::vector<uint32_t> index(nv, UINT32_MAX);
