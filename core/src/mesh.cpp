@@ -10,8 +10,6 @@
 #include "frep/mesh.h"
 
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -22,6 +20,7 @@
 
 #include "frep/eval.h"
 #include "kuhn_tables.h"
+#include "parallel_chunks.h"
 
 namespace frep {
 
@@ -107,28 +106,8 @@ const KuhnCell& kuhnCell(unsigned insideMask) {
 
 namespace {
 
-// Inside: sign bit clear and not NaN (+0 inside, -0 outside), for floats and doubles alike, so
-// the sampler's float values and direct double evaluations classify every point the same way.
-inline bool insideValue(double f) { return !std::isnan(f) && !std::signbit(f); }
 
-template <typename Fn>
-void parallelChunks(size_t n, size_t grain, int threads, Fn&& fn) {
-  auto body = [&](const tbb::blocked_range<size_t>& r) { fn(r.begin(), r.end()); };
-  if (n == 0) return;
-  if (threads == 1) {
-    body(tbb::blocked_range<size_t>(0, n));
-  } else if (threads > 1) {
-    tbb::task_arena arena(threads);
-    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), body); });
-  } else {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), body);
-  }
-}
 
-inline void canonicalRotate(std::array<uint32_t, 3>& t) {
-  if (t[1] < t[0] && t[1] < t[2]) t = {t[1], t[2], t[0]};
-  else if (t[2] < t[0] && t[2] < t[1]) t = {t[2], t[0], t[1]};
-}
 
 // Edge key -> index, open addressing (keys are never ~0: the top bits of a key are unused).
 class KeyIndex {

@@ -5,9 +5,7 @@
 #include "frep/mesh_grid.h"
 
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,31 +13,11 @@
 #include <unordered_map>
 
 #include "kuhn_tables.h"
+#include "parallel_chunks.h"
 
 namespace frep {
 
 namespace {
-
-inline bool insideValue(double f) { return !std::isnan(f) && !std::signbit(f); }
-
-inline void canonicalRotate(std::array<uint32_t, 3>& t) {
-  if (t[1] < t[0] && t[1] < t[2]) t = {t[1], t[2], t[0]};
-  else if (t[2] < t[0] && t[2] < t[1]) t = {t[2], t[0], t[1]};
-}
-
-template <typename Fn>
-void parallelChunks(size_t n, int threads, Fn&& fn) {
-  auto body = [&](const tbb::blocked_range<size_t>& r) { fn(r.begin(), r.end()); };
-  if (n == 0) return;
-  if (threads == 1) {
-    body(tbb::blocked_range<size_t>(0, n));
-  } else if (threads > 1) {
-    tbb::task_arena arena(threads);
-    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4), body); });
-  } else {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4), body);
-  }
-}
 
 constexpr int W = 12;  // window: indices o - 1 .. o + 10 per axis
 
@@ -85,7 +63,7 @@ class SampledMesher {
 
   SampledMesh run() {
     tbb::enumerable_thread_specific<ThreadOutput> outs;
-    parallelChunks(s_.leaves.size(), opt_.threads, [&](size_t b, size_t e) {
+    parallelChunks(s_.leaves.size(), 4, opt_.threads, [&](size_t b, size_t e) {
       ThreadOutput& out = outs.local();
       for (size_t i = b; i < e; ++i) meshLeaf(out, s_.leaves[i]);
     });

@@ -19,11 +19,6 @@
 namespace frep {
 
 namespace {
-inline void canonicalRotate(std::array<uint32_t, 3>& t) {
-  if (t[1] < t[0] && t[1] < t[2]) t = {t[1], t[2], t[0]};
-  else if (t[2] < t[0] && t[2] < t[1]) t = {t[2], t[0], t[1]};
-}
-
 // The merge of both entry points; `consumed(i)`, when given, is called once piece i has been
 // stitched (it is not read again).
 Mesh mergeKeyed(const std::vector<MeshPiece>& pieces, const std::function<void(size_t)>& consumed) {

@@ -10,9 +10,8 @@
 
 #include "frep/eval.h"
 #include "frep/mesh_predicates.h"
+#include "parallel_chunks.h"
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 namespace frep {
 
@@ -161,7 +160,6 @@ class Simplifier {
     return stats_;
   }
   const Work& work() const { return w_; }
-  const SimplifyStats& stats() const { return stats_; }
   bool vertexAlive(uint32_t v) const { return alive_[v] && !vtris_[v].empty(); }
   bool triangleAlive(uint32_t t) const { return tAlive_[t]; }
 
@@ -626,8 +624,8 @@ class Simplifier {
     for (uint32_t t = 0; t < w_.tris.size(); ++t) {
       if (!tAlive_[t]) continue;
       Tri r{index[w_.tris[t][0]], index[w_.tris[t][1]], index[w_.tris[t][2]]};
-      int s = r[0] < r[1] ? (r[0] < r[2] ? 0 : 2) : (r[1] < r[2] ? 1 : 2);
-      out.triangles.push_back({r[s], r[(s + 1) % 3], r[(s + 2) % 3]});
+      canonicalRotate(r);
+      out.triangles.push_back(r);
     }
     std::sort(out.triangles.begin(), out.triangles.end());
     return out;
@@ -818,8 +816,9 @@ void firstPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
       r.made.push_back(out.made[t]);
     }
   };
-  tbb::task_arena arena(opt.threads > 0 ? opt.threads : tbb::task_arena::automatic);
-  arena.execute([&] { tbb::parallel_for(size_t(0), blocks.size(), solve); });
+  parallelChunks(blocks.size(), 1, opt.threads, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) solve(i);
+  });
 
   for (Result& r : results) {
     g.tris.insert(g.tris.end(), r.tris.begin(), r.tris.end());

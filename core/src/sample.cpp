@@ -12,14 +12,13 @@
 #include "frep/sample.h"
 
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include "frep/eval.h"
+#include "parallel_chunks.h"
 
 namespace frep {
 
@@ -82,18 +81,10 @@ class Sampler {
 
     // Level 2 (parallel): each work cube independently down to the voxels.
     tbb::enumerable_thread_specific<Worker> workers;
-    auto body = [&](const tbb::blocked_range<size_t>& r) {
+    parallelChunks(work.size(), 1, opt_.threads, [&](size_t b, size_t e) {
       Worker& w = workers.local();
-      for (size_t i = r.begin(); i != r.end(); ++i) cube(w, work[i].first, kWorkSide, work[i].second);
-    };
-    if (opt_.threads == 1) {
-      body(tbb::blocked_range<size_t>(0, work.size()));
-    } else if (opt_.threads > 1) {
-      tbb::task_arena arena(opt_.threads);
-      arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, work.size(), 1), body); });
-    } else {
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, work.size(), 1), body);
-    }
+      for (size_t i = b; i != e; ++i) cube(w, work[i].first, kWorkSide, work[i].second);
+    });
 
     SampleResult res;
     res.grid = grid_;

@@ -15,15 +15,7 @@ using hf::arrayAtLeast;
 using hf::constArg;
 using hf::scalarArg;
 
-// Runs a core builder, turning its std::invalid_argument into a diagnostic at argument `arg`.
-template <typename F>
-auto guarded(const char* fn, int arg, F&& build) -> decltype(build()) {
-  try {
-    return build();
-  } catch (const std::invalid_argument& e) {
-    throw LibraryError(std::string(fn) + ": " + e.what(), arg);
-  }
-}
+using hf::guarded;
 
 // An axis given as 1, 2 or 3 (x, y, z), constant at compile time.
 Axis axisArg(const char* fn, std::vector<Arg>& a, int i) {

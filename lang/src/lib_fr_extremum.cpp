@@ -27,17 +27,9 @@ namespace frep::lang {
 namespace {
 
 using hf::constArg;
+using hf::guarded;
 
 constexpr double kSearchLimit = 1000.0;
-
-template <typename F>
-auto guarded(const char* fn, int arg, F&& build) -> decltype(build()) {
-  try {
-    return build();
-  } catch (const std::invalid_argument& e) {
-    throw LibraryError(std::string(fn) + ": " + e.what(), arg);
-  }
-}
 
 std::string num(double v) {
   char buf[32];

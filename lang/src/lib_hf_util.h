@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -76,5 +77,15 @@ inline Expr rUnion0(const Expr& a, const Expr& b) { return rUnion(a, b, 0.0); }
 inline Expr rInter0(const Expr& a, const Expr& b) { return rIntersection(a, b, 0.0); }
 
 constexpr double kPi = 3.14159265358979323846;
+
+// Runs a core builder, turning its std::invalid_argument into a diagnostic at argument `arg`.
+template <typename F>
+auto guarded(const char* fn, int arg, F&& build) -> decltype(build()) {
+  try {
+    return build();
+  } catch (const std::invalid_argument& e) {
+    throw LibraryError(std::string(fn) + ": " + e.what(), arg);
+  }
+}
 
 }  // namespace frep::lang::hf

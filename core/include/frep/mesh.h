@@ -16,6 +16,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -35,6 +36,18 @@ inline std::array<int64_t, 4> edgeKeyParts(EdgeKey key) {
   return {int64_t(key >> 41), int64_t((key >> 22) & 0x7ffff), int64_t((key >> 3) & 0x7ffff), int64_t(key & 7)};
 }
 constexpr int64_t kMaxMeshGridPoints = int64_t(1) << 19;
+
+// The sign rule: inside when the sign bit is clear and the value is not NaN (+0 inside, -0
+// outside), for floats and doubles alike, so sampled float values and direct double
+// evaluations classify every point the same way.
+inline bool insideValue(double f) { return !std::isnan(f) && !std::signbit(f); }
+
+// Rotates a triangle (winding kept) to start at its smallest index: the canonical form of the
+// triangles of MeshPiece and Mesh.
+inline void canonicalRotate(std::array<uint32_t, 3>& t) {
+  if (t[1] < t[0] && t[1] < t[2]) t = {t[1], t[2], t[0]};
+  else if (t[2] < t[0] && t[2] < t[1]) t = {t[2], t[0], t[1]};
+}
 
 struct MeshVertex {
   EdgeKey key;

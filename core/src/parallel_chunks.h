@@ -1,0 +1,29 @@
+// Internal to core: one way to run a loop over [0, n) in chunks with a thread-count option
+// (1: serial on the calling thread, > 1: that many threads, 0: TBB's default), shared by the
+// sampler, both meshers and the simplifier.
+#pragma once
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <cstddef>
+
+namespace frep {
+
+// fn(begin, end) for chunks of at least `grain` items.
+template <typename Fn>
+void parallelChunks(size_t n, size_t grain, int threads, Fn&& fn) {
+  auto body = [&](const tbb::blocked_range<size_t>& r) { fn(r.begin(), r.end()); };
+  if (n == 0) return;
+  if (threads == 1) {
+    body(tbb::blocked_range<size_t>(0, n));
+  } else if (threads > 1) {
+    tbb::task_arena arena(threads);
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), body); });
+  } else {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), body);
+  }
+}
+
+}  // namespace frep
