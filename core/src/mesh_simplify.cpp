@@ -334,28 +334,36 @@ class Simplifier {
     int m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
     const V3 u = scale(sub(b, a), 1.0 / m), v = scale(sub(c, a), 1.0 / m);
     // The centroids of the m^2 sub-triangles (not the corners or edges: on a crease of the
-    // model the sign test along the normal is ill-posed), as parameters (s, t) of a + s u + t v.
-    std::vector<std::array<double, 2>>& st = sampleParams_;
-    st.clear();
-    for (int i = 0; i < m; ++i)
-      for (int j = 0; i + j < m; ++j) {
-        st.push_back({i + 1.0 / 3, j + 1.0 / 3});
-        if (i + j <= m - 2) st.push_back({i + 2.0 / 3, j + 2.0 / 3});
-      }
-    // Probes: the samples nearest the centroid and the midpoints between it and the corners.
-    const double probe[kProbes][2] = {{m / 3.0, m / 3.0}, {m / 6.0, m / 6.0}, {2 * m / 3.0, m / 6.0}, {m / 6.0, 2 * m / 3.0}};
-    for (size_t k = 0; k < kProbes && k < st.size(); ++k) {
-      size_t best = k;
-      double bestD = INFINITY;
-      for (size_t i = k; i < st.size(); ++i) {
-        double ds = st[i][0] - probe[k][0], dt = st[i][1] - probe[k][1], dd = ds * ds + dt * dt;
-        if (dd < bestD) bestD = dd, best = i;
-      }
-      std::swap(st[k], st[best]);
+    // model the sign test along the normal is ill-posed): sub-triangle (i, j, up) has its
+    // centroid at a + (i + 1/3) u + (j + 1/3) v, or (i + 2/3, j + 2/3) when upside down.
+    // Probes first: the sub-triangles holding the centroid and the midpoints between it and
+    // the corners.
+    std::array<int, 3> probes[kProbes];
+    size_t nProbes = 0;
+    const double targets[kProbes][2] = {{m / 3.0, m / 3.0}, {m / 6.0, m / 6.0}, {2 * m / 3.0, m / 6.0}, {m / 6.0, 2 * m / 3.0}};
+    for (const auto& tg : targets) {
+      int i = std::min(int(tg[0]), m - 1), j = std::min(int(tg[1]), m - 1 - i);
+      int up = tg[0] - i + tg[1] - j < 1 || i + j > m - 2 ? 1 : 0;
+      std::array<int, 3> id{i, j, up};
+      if (std::find(probes, probes + nProbes, id) == probes + nProbes) probes[nProbes++] = id;
     }
     std::vector<V3>& pts = samplePoints_;
     pts.clear();
-    for (size_t i = from; i < std::min(to, st.size()); ++i) pts.push_back(add(a, add(scale(u, st[i][0]), scale(v, st[i][1]))));
+    size_t index = 0;
+    auto emit = [&](int i, int j, int up) {
+      if (index >= from && index < to) {
+        double o = up ? 1.0 / 3 : 2.0 / 3;
+        pts.push_back(add(a, add(scale(u, i + o), scale(v, j + o))));
+      }
+      ++index;
+    };
+    for (size_t k = 0; k < nProbes; ++k) emit(probes[k][0], probes[k][1], probes[k][2]);
+    for (int i = 0; i < m && index < to; ++i)
+      for (int j = 0; i + j < m; ++j)
+        for (int up = 1; up >= 0; --up) {
+          if (!up && i + j > m - 2) continue;
+          if (std::find(probes, probes + nProbes, std::array<int, 3>{i, j, up}) == probes + nProbes) emit(i, j, up);
+        }
     return crossedAlong(pts, scale(d, e));
   }
 
@@ -674,7 +682,6 @@ class Simplifier {
   double tol_;
   SimplifyStats stats_;
   std::vector<V3> samplePoints_;
-  std::vector<std::array<double, 2>> sampleParams_;
   struct NewTri {  // a triangle as a collapse would leave it
     Tri t;
     std::array<exact::P, 3> q;  // quantised corners

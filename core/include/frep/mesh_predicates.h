@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 namespace frep {
@@ -18,7 +19,27 @@ using P = std::array<int64_t, 3>;
 
 inline int sgn(__int128 v) { return v > 0 ? 1 : (v < 0 ? -1 : 0); }
 
+// Sign of the orientation determinant. A floating-point filter first: the differences are exact
+// in double (< 2^53), and Shewchuk's forward error bound for the products and sums
+// ((7 + 56 eps) eps times the permanent; "Adaptive Precision Floating-Point Arithmetic", 1997)
+// decides nearly every case; the rest in exact 128-bit integers.
 inline int orient3d(const P& a, const P& b, const P& c, const P& d) {
+  {
+    double u[3], v[3], w[3];
+    for (int i = 0; i < 3; ++i) {
+      u[i] = double(b[i] - a[i]);
+      v[i] = double(c[i] - a[i]);
+      w[i] = double(d[i] - a[i]);
+    }
+    const double m0 = v[1] * w[2] - v[2] * w[1], m1 = v[0] * w[2] - v[2] * w[0], m2 = v[0] * w[1] - v[1] * w[0];
+    const double det = u[0] * m0 - u[1] * m1 + u[2] * m2;
+    const double perm = std::abs(u[0]) * (std::abs(v[1] * w[2]) + std::abs(v[2] * w[1])) +
+                        std::abs(u[1]) * (std::abs(v[0] * w[2]) + std::abs(v[2] * w[0])) +
+                        std::abs(u[2]) * (std::abs(v[0] * w[1]) + std::abs(v[1] * w[0]));
+    const double bound = 7.7715611723761027e-16 * perm;
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+  }
   __int128 u[3], v[3], w[3];
   for (int i = 0; i < 3; ++i) {
     u[i] = b[i] - a[i];
@@ -126,6 +147,11 @@ inline bool improperPair(const std::array<uint32_t, 3>& t, const std::array<exac
   if (shared == 1) {
     const exact::P& v = T[ti];
     const exact::P &a = T[(ti + 1) % 3], &b = T[(ti + 2) % 3], &c = U[(ui + 1) % 3], &d = U[(ui + 2) % 3];
+    // One triangle off the other's plane except at v: they meet in v alone (the common case).
+    int oc = exact::orient3d(T[0], T[1], T[2], c), od = exact::orient3d(T[0], T[1], T[2], d);
+    if (oc * od > 0) return false;
+    int oa = exact::orient3d(U[0], U[1], U[2], a), ob = exact::orient3d(U[0], U[1], U[2], b);
+    if (oa * ob > 0) return false;
     return exact::segTri(a, b, U[0], U[1], U[2]) || exact::segTri(c, d, T[0], T[1], T[2]) ||
            exact::rayIntoCorner(v, a, c, d) || exact::rayIntoCorner(v, b, c, d) || exact::rayIntoCorner(v, c, a, b) ||
            exact::rayIntoCorner(v, d, a, b);
