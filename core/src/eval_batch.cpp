@@ -5,6 +5,7 @@
 // bit-identical to the others and to the point evaluator for + - * / sqrt.
 #include <algorithm>
 #include <cmath>
+#include <math.h>  // sincos, sincosf (GNU)
 
 #include "frep/eval.h"
 #include "frep/pow_int.h"
@@ -20,6 +21,43 @@ namespace {
 #else
 #define FREP_CLONES
 #endif
+
+// sin and cos in one call. glibc's sincos/sincosf share the code paths of sin/cos and
+// sinf/cosf, so the bits are the same (checked on doubles over the whole range and on every
+// float); elsewhere, two calls.
+inline void sinCos(double x, double& s, double& c) {
+#ifdef __GLIBC__
+  ::sincos(x, &s, &c);
+#else
+  s = std::sin(x), c = std::cos(x);
+#endif
+}
+inline void sinCos(float x, float& s, float& c) {
+#ifdef __GLIBC__
+  ::sincosf(x, &s, &c);
+#else
+  s = std::sin(x), c = std::cos(x);
+#endif
+}
+
+// A Sin or Cos the tape's sinCosPlan pairs: the first of the pair writes both outputs (the
+// partner's register is free until the partner, see planSinCos), the second has nothing left
+// to do.
+template <typename T>
+void runSinCos(const Instr& ins, uint32_t partnerOut, T* regs, size_t n) {
+  if (partnerOut == Tape::kSinCosDone) return;
+  constexpr size_t B = BatchEvaluator<T>::kBatch;
+  const T* a = regs + size_t(ins.a) * B;
+  T* s = regs + size_t(ins.out) * B;
+  T* c = regs + size_t(partnerOut) * B;
+  if (ins.op == Op::Cos) std::swap(s, c);
+  for (size_t i = 0; i < n; ++i) {
+    T sv, cv;
+    sinCos(a[i], sv, cv);  // a may be the partner's output register: read before writing
+    s[i] = sv;
+    c[i] = cv;
+  }
+}
 
 // Counts the lanes (< count) where an instruction hits a domain error; runs before the
 // instruction writes its output (which may alias an input).
@@ -39,8 +77,8 @@ void countDomainErrors(const Instr& ins, const T* a, const T* b, size_t count, D
 }
 
 template <typename T>
-FREP_CLONES void runTape(const Instr* code, size_t ninstr, T* __restrict regs, size_t n, DomainCounts* dom,
-                         size_t count) {
+FREP_CLONES void runTape(const Instr* code, const uint32_t* sinCos, size_t ninstr, T* __restrict regs, size_t n,
+                         DomainCounts* dom, size_t count) {
   constexpr size_t B = BatchEvaluator<T>::kBatch;
   for (size_t k = 0; k < ninstr; ++k) {
     const Instr& ins = code[k];
@@ -59,8 +97,18 @@ FREP_CLONES void runTape(const Instr* code, size_t ninstr, T* __restrict regs, s
       case Op::Exp: LOOP(std::exp(a[i]));
       case Op::Log: LOOP(T(std::log(double(a[i]) > kLogFloor ? double(a[i]) : kLogFloor)));
       case Op::Log10: LOOP(T(std::log10(double(a[i]) > kLogFloor ? double(a[i]) : kLogFloor)));
-      case Op::Sin: LOOP(std::sin(a[i]));
-      case Op::Cos: LOOP(std::cos(a[i]));
+      case Op::Sin:
+        if (sinCos && sinCos[k] != Tape::kNoSinCos) {
+          runSinCos(ins, sinCos[k], regs, n);
+          break;
+        }
+        LOOP(std::sin(a[i]));
+      case Op::Cos:
+        if (sinCos && sinCos[k] != Tape::kNoSinCos) {
+          runSinCos(ins, sinCos[k], regs, n);
+          break;
+        }
+        LOOP(std::cos(a[i]));
       case Op::Tan: LOOP(std::tan(a[i]));
       case Op::Asin: LOOP(std::asin(a[i] < T(-1) ? T(-1) : (a[i] > T(1) ? T(1) : a[i])));
       case Op::Acos: LOOP(std::acos(a[i] < T(-1) ? T(-1) : (a[i] > T(1) ? T(1) : a[i])));
@@ -159,18 +207,21 @@ const T* BatchEvaluator<T>::eval(const Tape& tape, size_t count) {
   size_t n = (count + 7) & ~size_t(7);
   if (n > kBatch) n = kBatch;
   const auto& code = tape.code();
+  // sinCos[k]: instruction k's entry in the sin/cos pairing plan (nullptr: no pair)
+  const uint32_t* sinCos = tape.sinCosPlan().empty() ? nullptr : tape.sinCosPlan().data();
+  auto at = [&](size_t k) { return sinCos ? sinCos + k : nullptr; };
   if (!tape.hasExtrema()) {
-    runTape<T>(code.data(), code.size(), regs_.data(), n, domain_, count);
+    runTape<T>(code.data(), sinCos, code.size(), regs_.data(), n, domain_, count);
   } else {
     // Straight-line segments between extremum instructions run vectorised as usual.
     size_t start = 0;
     for (size_t k = 0; k < code.size(); ++k) {
       if (code[k].op != Op::Extremum) continue;
-      runTape<T>(code.data() + start, k - start, regs_.data(), n, domain_, count);
+      runTape<T>(code.data() + start, at(start), k - start, regs_.data(), n, domain_, count);
       runExtremum(tape, code[k], count);
       start = k + 1;
     }
-    runTape<T>(code.data() + start, code.size() - start, regs_.data(), n, domain_, count);
+    runTape<T>(code.data() + start, at(start), code.size() - start, regs_.data(), n, domain_, count);
   }
   return regs_.data() + size_t(tape.resultReg()) * kBatch;
 }

@@ -4,6 +4,7 @@
 #include "frep/extremum.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <stdexcept>
 #include <unordered_map>
@@ -13,6 +14,57 @@ namespace frep {
 namespace {
 std::atomic<uint64_t> gNextTapeId{1};
 bool isChoiceOp(Op op) { return op == Op::Min || op == Op::Max || op == Op::Select; }
+
+// Tape::sinCosPlan. A Sin/Cos at k and the complementary Cos/Sin at j > k reading the same
+// register r can both be computed at k when, strictly between k and j, nothing writes r (j
+// would read the same value) and nothing reads or writes out_j (it is written early, at k);
+// k must not overwrite r itself, and the two outputs must differ. Checking each pair against the
+// original tape stays right when pairs overlap: then one pair lies inside the other's window or
+// each has an instruction inside the other's, and those instructions' reads and writes were
+// checked. No pair spans an Extremum (its inputs are not in a/b/c). One forward pass.
+std::vector<uint32_t> planSinCos(const std::vector<Instr>& code, uint32_t numRegs) {
+  std::vector<uint32_t> plan;
+  bool hasSin = false, hasCos = false;
+  for (const Instr& ins : code) {
+    hasSin |= ins.op == Op::Sin;
+    hasCos |= ins.op == Op::Cos;
+  }
+  if (!hasSin || !hasCos) return plan;
+  constexpr uint32_t kNone = UINT32_MAX;
+  // pending[r][op == Cos]: the latest unpaired Sin / Cos reading r since r was last written
+  std::vector<std::array<uint32_t, 2>> pending(numRegs, {kNone, kNone});
+  std::vector<size_t> lastTouch(numRegs, 0);  // 1 + the last instruction reading or writing it
+  size_t barrier = 0;                         // pairs start at or after the last Extremum
+  for (size_t i = 0; i < code.size(); ++i) {
+    const Instr& ins = code[i];
+    if (ins.op == Op::Extremum) {
+      barrier = i + 1;
+      lastTouch[ins.out] = i + 1;
+      continue;
+    }
+    const bool trig = ins.op == Op::Sin || ins.op == Op::Cos;
+    const int slot = ins.op == Op::Cos;
+    bool paired = false;
+    if (trig) {
+      const uint32_t k = pending[ins.a][1 - slot];
+      if (k != kNone && k >= barrier && code[k].out != ins.out && lastTouch[ins.out] <= k + 1) {
+        if (plan.empty()) plan.assign(code.size(), Tape::kNoSinCos);
+        plan[k] = ins.out;
+        plan[i] = Tape::kSinCosDone;
+        pending[ins.a][1 - slot] = kNone;
+        paired = true;
+      }
+    }
+    const int arity = opArity(ins.op);
+    if (arity > 0) lastTouch[ins.a] = i + 1;
+    if (arity > 1) lastTouch[ins.b] = i + 1;
+    if (arity > 2) lastTouch[ins.c] = i + 1;
+    lastTouch[ins.out] = i + 1;
+    pending[ins.out] = {kNone, kNone};
+    if (trig && !paired && ins.out != ins.a) pending[ins.a][slot] = uint32_t(i);
+  }
+  return plan;
+}
 }  // namespace
 
 struct TapeBuilder {
@@ -108,6 +160,7 @@ TapePtr Tape::compile(const Expr& e, uint32_t nvars) {
   t.uniforms_ = uniforms;
   t.extrema_ = extrema;
   t.result_ = regOf(&e.node());
+  t.sinCos_ = planSinCos(t.code_, t.numRegs_);
   t.id_ = gNextTapeId++;
   return tape;
 }
@@ -170,6 +223,7 @@ TapePtr Tape::prune(const std::vector<Choice>& choices, const TapePtr& self) con
   t.code_ = std::move(kept);
   for (auto& ins : t.code_)
     if (isChoiceOp(ins.op)) ++t.numChoices_;
+  t.sinCos_ = planSinCos(t.code_, t.numRegs_);
   t.root_ = root_ ? root_ : self;
   t.id_ = gNextTapeId++;
   return out;

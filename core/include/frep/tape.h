@@ -57,6 +57,14 @@ class Tape {
   const std::vector<ExtremumEntry>& extrema() const { return *extrema_; }
   bool hasExtrema() const { return !extrema_->empty(); }
 
+  // Sin/Cos pairs of the same input value that the batch evaluator computes with one sincos()
+  // call at the first of the two: rotations and gyroids take both of one angle, and glibc's
+  // sincos costs less than sin + cos for the same bits. Per instruction: for the first of a
+  // pair, the output register of the second (written at once); kSinCosDone for the second;
+  // kNoSinCos for the rest. Empty when the tape has no pair. Built by compile and prune.
+  static constexpr uint32_t kNoSinCos = UINT32_MAX, kSinCosDone = UINT32_MAX - 1;
+  const std::vector<uint32_t>& sinCosPlan() const { return sinCos_; }
+
   // A shorter tape, valid wherever the choices hold: decided min/max/select become copies of the
   // kept input, and instructions whose results are no longer read are dropped.
   // choices.size() == size(); returns this tape itself (shared) when nothing changes.
@@ -68,6 +76,7 @@ class Tape {
   std::shared_ptr<const std::vector<double>> uniforms_;
   std::shared_ptr<const std::vector<ExtremumEntry>> extrema_;
   std::vector<Instr> code_;
+  std::vector<uint32_t> sinCos_;
   TapePtr root_;  // the compiled tape this one was pruned from (keeps uniforms alive)
   uint64_t id_ = 0;
   friend struct TapeBuilder;
