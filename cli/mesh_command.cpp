@@ -118,7 +118,19 @@ int runMesh(const MeshRequest& request) {
 
   AtomicOutput out("-O/--out", request.region.out);
   AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
+  // Adaptive simplification: each worker does the blocks inside its brick, the master the rest
+  // (deterministic, so the file still does not depend on the split; docs/mesh.md).
+  // Not by default for models with extremum nodes: every check would run searches.
+  TapePtr tape = Tape::compile(m.field, 3);
+  SimplifyOptions so;
+  so.tolerance = request.tolerance >= 0 ? request.tolerance : tape->hasExtrema() ? 0.0 : 0.1;
+  so.sharpFeatures = !request.noSharp;
+  so.bricksSimplified = so.tolerance > 0 ? options.brickVoxels : 0;
+  if (request.tolerance < 0 && tape->hasExtrema())
+    spdlog::info("the model has extremum nodes: not simplified (each check would run a search); give --tolerance to");
   farm::JobSpec job = makeJob(m, request.model.path, grid, "mesh");
+  job.mutable_mesh()->set_tolerance(so.tolerance);
+  job.mutable_mesh()->set_no_sharp(!so.sharpFeatures);
   spdlog::info("meshing '{}' on {}x{}x{} points of {}", m.model.objectName, grid.dims[0], grid.dims[1], grid.dims[2],
                grid.voxel);
   const auto start = std::chrono::steady_clock::now();
@@ -127,18 +139,9 @@ int runMesh(const MeshRequest& request) {
   requireComplete(reportOut, report);
   Mesh& mesh = outcome.mesh;
   const double meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // Adaptive simplification of the merged mesh, here in the master: deterministic, so the file
-  // still does not depend on the split (docs/mesh.md).
-  // Not by default for models with extremum nodes: every check would run searches.
-  TapePtr tape = Tape::compile(m.field, 3);
-  SimplifyOptions so;
-  so.tolerance = request.tolerance >= 0 ? request.tolerance : tape->hasExtrema() ? 0.0 : 0.1;
-  so.sharpFeatures = !request.noSharp;
-  if (request.tolerance < 0 && tape->hasExtrema())
-    spdlog::info("the model has extremum nodes: not simplified (each check would run a search); give --tolerance to");
   if (so.tolerance > 0)
-    spdlog::info("simplifying {} triangles (tolerance {} voxel, sharp features {}); a signal now ends the run, "
-                 "--resume then redoes only this step",
+    spdlog::info("simplifying across the bricks: {} triangles (tolerance {} voxel, sharp features {}); a signal "
+                 "now ends the run, --resume then redoes only this step",
                  mesh.triangles.size(), so.tolerance, so.sharpFeatures ? "on" : "off");
   SimplifyStats ss = simplifyMesh(mesh, tape, grid, so);
   report.simplifyTolerance = so.tolerance;

@@ -134,9 +134,10 @@ class Master {
     payloadLimit_ = 12 + leaves * (16 + 64 + 2048) + leaves * 8 * 20 + 4096;
     if (op_ == Operation::Mesh) {
       // At most 8 vertices per grid point (7 edges and a feature vertex; a varint key and 6
-      // doubles each) and 12 triangles per cell (3 varints of at most 5 bytes each).
+      // doubles each, and maybe a carried quadric: a varint, 11 doubles and a flag) and 12
+      // triangles per cell (3 varints of at most 5 bytes each and a state byte).
       const size_t b = size_t(opt_.brickVoxels);
-      payloadLimit_ = 4096 + 8 * (b + 1) * (b + 1) * (b + 1) * (10 + 48) + 12 * b * b * b * 15;
+      payloadLimit_ = 4096 + 8 * (b + 1) * (b + 1) * (b + 1) * (10 + 48 + 5 + 88 + 1) + 12 * b * b * b * 16;
     }
   }
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "frep/extremum.h"
+#include "frep/mesh_simplify.h"
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 
@@ -112,8 +113,16 @@ BrickOutput computeBrickOnce(const TapePtr& tape, const JobSpec& job, const std:
     MeshOptions mo;
     mo.threads = threads;
     BrickOutput out;
-    out.piece = meshRegion(tape, gridOf(job), lo, hi, mo);
+    const GridSpec grid = gridOf(job);
+    out.piece = meshRegion(tape, grid, lo, hi, mo);
     out.stats.pointEvals = meshPointEvals(out.piece.stats);
+    if (job.mesh().tolerance() > 0) {
+      SimplifyOptions so;
+      so.tolerance = job.mesh().tolerance();
+      so.sharpFeatures = !job.mesh().no_sharp();
+      so.threads = threads;
+      simplifyRegion(out.piece, tape, grid, so, lo, hi);
+    }
     return out;
   }
   SampleOptions opt;
@@ -300,7 +309,7 @@ constexpr size_t kMinTriangleBytes = 3;
 std::string encodeMeshPiece(const MeshPiece& piece) {
   std::string s;
   s.reserve(kMeshHeader + piece.vertices.size() * 51 + piece.triangles.size() * 5);
-  s.append("FRM2", 4);
+  s.append("FRM3", 4);
   for (int a = 0; a < 3; ++a) put(s, piece.regionLo[a]);
   const MeshStats& st = piece.stats;
   for (uint64_t v : {st.cellsVisited, st.cellsCrossed, st.rootEvals, st.gradientEvals, st.samplePointEvals,
@@ -323,6 +332,20 @@ std::string encodeMeshPiece(const MeshPiece& piece) {
     putVarint(s, zigzag(int64_t(t[2]) - int64_t(t[0])));
     first = t[0];
   }
+  const SimplifyCarry& c = piece.carry;
+  for (uint64_t v : {c.collapses, c.rejectedTopology, c.rejectedShape, c.rejectedError, c.rejectedIntersection, c.modelEvals})
+    put(s, v);
+  put(s, uint32_t(c.vertices.size()));
+  uint32_t prevIndex = 0;
+  for (size_t i = 0; i < c.vertices.size(); ++i) {
+    const SimplifyCarry::Vertex& v = c.vertices[i];
+    putVarint(s, i == 0 ? v.index : v.index - prevIndex);
+    prevIndex = v.index;
+    for (double q : v.quadric) put(s, q);
+    s.push_back(char(v.moved));
+  }
+  s.push_back(char(c.triangles.empty() ? 0 : 1));
+  s.append(reinterpret_cast<const char*>(c.triangles.data()), c.triangles.size());
   return s;
 }
 
@@ -331,7 +354,7 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
     if (error) *error = why;
     return false;
   };
-  if (size < kMeshHeader || std::memcmp(data, "FRM2", 4) != 0) return fail("mesh payload: bad magic or header");
+  if (size < kMeshHeader || std::memcmp(data, "FRM3", 4) != 0) return fail("mesh payload: bad magic or header");
   Reader r{static_cast<const char*>(data) + 4, static_cast<const char*>(data) + size};
   for (int a = 0; a < 3; ++a) r.get(out.regionLo[a]);
   if (((out.regionLo[0] | out.regionLo[1] | out.regionLo[2]) & 7) != 0 || out.regionLo[0] < 0 || out.regionLo[1] < 0 ||
@@ -381,6 +404,39 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
     if (a == b || b == c || a == c) return fail("mesh payload: degenerate triangle");
     t = {uint32_t(a), uint32_t(b), uint32_t(c)};
     first = a;
+  }
+  // The simplifier's carry (simplifyRegion): counters, carried vertices, triangle states.
+  SimplifyCarry& c = out.carry;
+  c = SimplifyCarry();
+  for (uint64_t* v : {&c.collapses, &c.rejectedTopology, &c.rejectedShape, &c.rejectedError, &c.rejectedIntersection,
+                      &c.modelEvals})
+    if (!r.get(*v)) return fail("mesh payload: truncated simplifier counters");
+  uint32_t ncv = 0;
+  if (!r.get(ncv)) return fail("mesh payload: truncated simplifier state");
+  if (uint64_t(ncv) * (1 + 88 + 1) > size_t(r.end - r.p)) return fail("mesh payload: carried vertices exceed its size");
+  c.vertices.resize(ncv);
+  for (uint32_t i = 0; i < ncv; ++i) {
+    SimplifyCarry::Vertex& v = c.vertices[i];
+    uint64_t k = 0;
+    if (!getVarint(r, k)) return fail("mesh payload: truncated carried vertex");
+    if (i > 0 && k == 0) return fail("mesh payload: carried vertices not increasing");
+    const uint64_t index = i == 0 ? k : uint64_t(c.vertices[i - 1].index) + k;
+    if (index >= nv) return fail("mesh payload: carried vertex index out of range");
+    v.index = uint32_t(index);
+    for (double& q : v.quadric)
+      if (!r.get(q) || !std::isfinite(q)) return fail("mesh payload: truncated or non-finite quadric");
+    uint8_t moved = 0;
+    if (!r.get(moved) || moved > 1) return fail("mesh payload: bad carried vertex flag");
+    v.moved = moved;
+  }
+  uint8_t hasStates = 0;
+  if (!r.get(hasStates) || hasStates > 1) return fail("mesh payload: bad triangle-state flag");
+  if (hasStates) {
+    if (size_t(r.end - r.p) < nt) return fail("mesh payload: truncated triangle states");
+    c.triangles.assign(reinterpret_cast<const uint8_t*>(r.p), reinterpret_cast<const uint8_t*>(r.p) + nt);
+    r.p += nt;
+    for (uint8_t st : c.triangles)
+      if ((st & 0x7f) > 16) return fail("mesh payload: triangle error level out of range");
   }
   if (r.p != r.end) return fail("mesh payload: trailing bytes");
   return true;

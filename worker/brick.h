@@ -70,13 +70,17 @@ std::string encodeBrick(const BrickOutput& out);
 // Returns false (with a reason) on a malformed payload; never reads out of bounds.
 bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* error);
 
-// Mesh piece codec (little-endian, version in the magic): "FRM2", regionLo (3 x i32), the
+// Mesh piece codec (little-endian, version in the magic): "FRM3", regionLo (3 x i32), the
 // piece's MeshStats (6 x u64: cells visited, crossed, root evals, gradient evals, sample point
 // evals, fallback edges), u32 vertices, u32 triangles; per vertex: its key as a
 // varint (the first absolute, then the increase over the previous key: keys strictly increase),
 // position and normal (6 x f64, bit-exact); per triangle: the first index as a zigzag varint
 // delta from the previous triangle's first index, the other two as zigzag varint deltas from
-// the first. Varints are LEB128 (7 bits a byte, at most 10 bytes).
+// the first. Then the simplifier's carry (SimplifyCarry, mesh.h; empty for raw pieces): 6 x u64
+// counters (collapses, rejected for topology, shape, error, intersection, model evaluations),
+// u32 carried vertices, each a varint index (the first absolute, then the increase), 11 x f64
+// quadric and a u8 moved flag; a u8 flag, and when 1 one state byte per triangle. Varints are
+// LEB128 (7 bits a byte, at most 10 bytes).
 std::string encodeMeshPiece(const MeshPiece& piece);
 // Returns false (with a reason) on a malformed payload: bad magic, truncation, counts beyond
 // the size, keys not strictly increasing, a varint that overflows, a non-finite coordinate, a

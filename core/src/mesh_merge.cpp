@@ -24,6 +24,7 @@ namespace {
 Mesh mergeKeyed(const std::vector<MeshPiece>& pieces, const std::function<void(size_t)>& consumed) {
   Mesh mesh;
   size_t nv = 0, nt = 0;
+  bool withStates = false;  // some piece carries triangle states: they follow the sort
   for (const MeshPiece& p : pieces) {
     nv += p.vertices.size();
     nt += p.triangles.size();
@@ -34,6 +35,16 @@ Mesh mergeKeyed(const std::vector<MeshPiece>& pieces, const std::function<void(s
     s.gradientEvals += p.stats.gradientEvals;
     s.samplePointEvals += p.stats.samplePointEvals;
     s.fallbackEdges += p.stats.fallbackEdges;
+    const SimplifyCarry& c = p.carry;
+    mesh.carry.collapses += c.collapses;
+    mesh.carry.rejectedTopology += c.rejectedTopology;
+    mesh.carry.rejectedShape += c.rejectedShape;
+    mesh.carry.rejectedError += c.rejectedError;
+    mesh.carry.rejectedIntersection += c.rejectedIntersection;
+    mesh.carry.modelEvals += c.modelEvals;
+    if (!c.triangles.empty() && c.triangles.size() != p.triangles.size())
+      throw std::invalid_argument("mergePieces: a piece's triangle states do not match its triangles");
+    withStates = withStates || !c.triangles.empty();
     for (size_t i = 1; i < p.vertices.size(); ++i)
       if (p.vertices[i].key <= p.vertices[i - 1].key)
         throw std::invalid_argument("mergePieces: piece vertices not sorted by key");
@@ -52,6 +63,14 @@ Mesh mergeKeyed(const std::vector<MeshPiece>& pieces, const std::function<void(s
   mesh.normals.resize(n);
   std::vector<uint8_t> filled(n, 0);
   mesh.triangles.reserve(nt);
+  struct Stated {
+    std::array<uint32_t, 3> t;
+    uint8_t state;
+    bool operator<(const Stated& o) const { return t != o.t ? t < o.t : state < o.state; }
+    bool operator==(const Stated& o) const { return t == o.t; }
+  };
+  std::vector<Stated> stated;
+  if (withStates) stated.reserve(nt);
   std::vector<uint32_t> remap;
   for (size_t pi = 0; pi < pieces.size(); ++pi) {
     const MeshPiece& p = pieces[pi];
@@ -69,17 +88,43 @@ Mesh mergeKeyed(const std::vector<MeshPiece>& pieces, const std::function<void(s
         filled[g] = 1;
       }
     }
-    for (const auto& t : p.triangles) {
+    for (const SimplifyCarry::Vertex& v : p.carry.vertices) {
+      if (v.index >= remap.size()) throw std::invalid_argument("mergePieces: a carried vertex past its piece's vertices");
+      mesh.carry.vertices.push_back(v);
+      mesh.carry.vertices.back().index = remap[v.index];
+    }
+    for (size_t i = 0; i < p.triangles.size(); ++i) {
+      const auto& t = p.triangles[i];
       if (t[0] >= remap.size() || t[1] >= remap.size() || t[2] >= remap.size())
         throw std::invalid_argument("mergePieces: a triangle indexes past its piece's vertices");
       std::array<uint32_t, 3> r{remap[t[0]], remap[t[1]], remap[t[2]]};
       canonicalRotate(r);
-      mesh.triangles.push_back(r);
+      if (withStates)
+        stated.push_back({r, p.carry.triangles.empty() ? uint8_t(0) : p.carry.triangles[i]});
+      else
+        mesh.triangles.push_back(r);
     }
     if (consumed) consumed(pi);
   }
-  tbb::parallel_sort(mesh.triangles.begin(), mesh.triangles.end());
-  mesh.triangles.erase(std::unique(mesh.triangles.begin(), mesh.triangles.end()), mesh.triangles.end());
+  if (withStates) {
+    tbb::parallel_sort(stated.begin(), stated.end());
+    stated.erase(std::unique(stated.begin(), stated.end()), stated.end());
+    mesh.triangles.resize(stated.size());
+    mesh.carry.triangles.resize(stated.size());
+    for (size_t i = 0; i < stated.size(); ++i) mesh.triangles[i] = stated[i].t, mesh.carry.triangles[i] = stated[i].state;
+  } else {
+    tbb::parallel_sort(mesh.triangles.begin(), mesh.triangles.end());
+    mesh.triangles.erase(std::unique(mesh.triangles.begin(), mesh.triangles.end()), mesh.triangles.end());
+  }
+  // A vertex is carried by the one piece whose block simplified it (seam vertices never are);
+  // should two pieces carry it, the smaller record wins, whatever the order of the pieces.
+  auto& cv = mesh.carry.vertices;
+  std::sort(cv.begin(), cv.end(), [](const SimplifyCarry::Vertex& x, const SimplifyCarry::Vertex& y) {
+    return x.index != y.index ? x.index < y.index : (x.quadric != y.quadric ? x.quadric < y.quadric : x.moved < y.moved);
+  });
+  cv.erase(std::unique(cv.begin(), cv.end(), [](const SimplifyCarry::Vertex& x, const SimplifyCarry::Vertex& y) {
+             return x.index == y.index;
+           }), cv.end());
   return mesh;
 }
 
@@ -92,6 +137,7 @@ Mesh mergePiecesReleasing(std::vector<MeshPiece>& pieces) {
   Mesh mesh = mergeKeyed(pieces, [&](size_t i) {
     std::vector<MeshVertex>().swap(pieces[i].vertices);
     std::vector<std::array<uint32_t, 3>>().swap(pieces[i].triangles);
+    pieces[i].carry = SimplifyCarry();
     if (++released % 16 == 0) malloc_trim(0);  // hand the freed pieces back (they are small heap blocks)
   });
   malloc_trim(0);

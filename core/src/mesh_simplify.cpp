@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <functional>
 #include <queue>
 #include <unordered_map>
 
@@ -117,6 +118,8 @@ struct Work {
   V3 regionLo{}, regionHi{};
 };
 
+// The state of a mesh (vertices in key order, triangles canonical) with what earlier passes
+// carried: quadrics beyond a vertex's own tangent plane, error levels, made triangles.
 Work workOf(const Mesh& mesh) {
   Work w;
   w.pos = mesh.positions;
@@ -126,10 +129,40 @@ Work workOf(const Mesh& mesh) {
   for (size_t v = 0; v < w.pos.size(); ++v) w.quad[v].addPlane(w.normal[v], w.pos[v]);
   w.moved.assign(w.pos.size(), 0);
   w.locked.assign(w.pos.size(), 0);
+  for (const SimplifyCarry::Vertex& c : mesh.carry.vertices) {
+    if (c.index >= w.pos.size()) throw std::invalid_argument("simplifyMesh: a carried vertex past the mesh's vertices");
+    Quadric& q = w.quad[c.index];
+    const auto& d = c.quadric;
+    q.A << d[0], d[1], d[2], d[1], d[3], d[4], d[2], d[4], d[5];
+    q.b = Eigen::Vector3d(d[6], d[7], d[8]);
+    q.c = d[9];
+    q.weight = d[10];
+    w.moved[c.index] = c.moved;
+  }
   w.tris = mesh.triangles;
   w.level.assign(w.tris.size(), -1);
   w.made.assign(w.tris.size(), 0);
+  if (!mesh.carry.triangles.empty()) {
+    if (mesh.carry.triangles.size() != w.tris.size())
+      throw std::invalid_argument("simplifyMesh: the carried triangle states do not match the triangles");
+    for (size_t t = 0; t < w.tris.size(); ++t) {
+      w.level[t] = int8_t((mesh.carry.triangles[t] & 0x7f) - 1);
+      w.made[t] = (mesh.carry.triangles[t] & 0x80) != 0;
+    }
+  }
   return w;
+}
+
+// The inverse of workOf for a region's piece: the carry lists what the next passes need.
+void carryOf(const Work& w, SimplifyCarry& carry) {
+  carry.vertices.clear();
+  for (uint32_t v = 0; v < w.pos.size(); ++v) {
+    const Quadric& q = w.quad[v];
+    if (q.weight == 1 && !w.moved[v]) continue;  // its own tangent plane: workOf rebuilds it
+    carry.vertices.push_back({v, {q.A(0, 0), q.A(0, 1), q.A(0, 2), q.A(1, 1), q.A(1, 2), q.A(2, 2), q.b[0], q.b[1], q.b[2], q.c, q.weight}, uint8_t(w.moved[v] ? 1 : 0)});
+  }
+  carry.triangles.resize(w.tris.size());
+  for (size_t t = 0; t < w.tris.size(); ++t) carry.triangles[t] = uint8_t((w.level[t] + 1) | (w.made[t] ? 0x80 : 0));
 }
 
 class Simplifier {
@@ -710,7 +743,50 @@ class Simplifier {
   int maxLevel_ = 0;  // the last error level
 };
 
-constexpr int kBlockVoxels = 32;  // the first pass's blocks (fixed in index space)
+constexpr int kBlockVoxels = 32;  // the block passes' blocks (fixed in index space)
+constexpr int kShift[2] = {0, kBlockVoxels / 2};  // the second pass's blocks straddle the first's faces
+using BlockKey = std::array<int32_t, 3>;
+
+// The cells of block b of pass `pass` along one axis, clipped to the grid's cells.
+std::pair<int64_t, int64_t> blockCells(int32_t b, int pass, int64_t cells) {
+  const int64_t lo = int64_t(b) * kBlockVoxels - kShift[pass];
+  return {std::max<int64_t>(0, lo), std::min(cells, lo + kBlockVoxels)};
+}
+
+// Does the simplification of the region [lo, hi) of cells (simplifyRegion) do block b of
+// `pass`? A first-pass block when its cells lie in the region; a second-pass block when, in
+// addition, every first-pass block it meets does (so it sees the same mesh as it would after
+// the whole first pass).
+bool regionDoes(const BlockKey& b, int pass, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi,
+                const std::array<int64_t, 3>& cells) {
+  for (int k = 0; k < 3; ++k) {
+    auto [c0, c1] = blockCells(b[k], pass, cells[k]);
+    if (c0 >= c1 || c0 < lo[k] || c1 > hi[k]) return false;
+    if (pass == 1)
+      for (int64_t cell : {c0, c1 - 1}) {
+        auto [f0, f1] = blockCells(int32_t(cell / kBlockVoxels), 0, cells[k]);
+        if (f0 < lo[k] || f1 > hi[k]) return false;
+      }
+  }
+  return true;
+}
+
+std::array<int64_t, 3> gridCells(const GridSpec& grid) {
+  return {grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1};
+}
+
+// Did the farm's bricks of `brick` cells (simplifyRegion on each) do block b of `pass`? The
+// brick holding the block's first cell decides.
+bool bricksDid(const BlockKey& b, int pass, int brick, const std::array<int64_t, 3>& cells) {
+  if (brick <= 0) return false;
+  std::array<int64_t, 3> lo, hi;
+  for (int k = 0; k < 3; ++k) {
+    const int64_t c0 = blockCells(b[k], pass, cells[k]).first;
+    lo[k] = c0 / brick * brick;
+    hi[k] = std::min(cells[k], lo[k] + brick);
+  }
+  return regionDoes(b, pass, lo, hi, cells);
+}
 
 void addStats(SimplifyStats& s, const SimplifyStats& b) {
   s.collapses += b.collapses;
@@ -730,12 +806,11 @@ void addStats(SimplifyStats& s, const SimplifyStats& b) {
 // inside its own shrunk box), so the blocks are independent: the result does not depend on the
 // thread count or the order.
 void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt, int shiftVoxels,
-               SimplifyStats& stats) {
+               const std::function<bool(const BlockKey&)>& mine, SimplifyStats& stats) {
   const size_t nv = g.pos.size(), nt = g.tris.size();
   const double side = kBlockVoxels * grid.voxel, margin = grid.voxel;
   V3 origin;
   for (int k = 0; k < 3; ++k) origin[k] = grid.origin[k] - shiftVoxels * grid.voxel;
-  using BlockKey = std::array<int32_t, 3>;
   auto blockOf = [&](const V3& p) {
     BlockKey b;
     for (int k = 0; k < 3; ++k) b[k] = int32_t(std::floor((p[k] - origin[k]) / side));
@@ -765,7 +840,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
       for (uint32_t u : g.tris[t]) ok = ok && inside(g.pos[u], lo, hi);
     if (ok) owned[b].push_back(v);
   }
-  if (owned.empty()) return;
+  for (auto it = owned.begin(); it != owned.end();) it = mine(it->first) ? std::next(it) : owned.erase(it);
   std::vector<BlockKey> blocks;
   for (auto& [b, vs] : owned) blocks.push_back(b);
   // Obstacle candidates: every triangle under each block its box meets.
@@ -873,11 +948,15 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     addStats(stats, r.stats);
     r = Result();
   }
-  // Compact.
-  std::vector<uint32_t> index(nv, UINT32_MAX);
+  // Compact to the canonical form every pass starts from (vertices by key, triangles rotated
+  // to their smallest index and sorted): a pass then sees the same numbering whether the passes
+  // before it ran here or in the workers, region by region.
+  std::vector<uint32_t> alive, index(nv, UINT32_MAX);
+  for (uint32_t v = 0; v < nv; ++v)
+    if (vAlive[v]) alive.push_back(v);
+  std::sort(alive.begin(), alive.end(), [&](uint32_t x, uint32_t y) { return g.key[x] < g.key[y]; });
   Work c;
-  for (uint32_t v = 0; v < nv; ++v) {
-    if (!vAlive[v]) continue;
+  for (uint32_t v : alive) {
     index[v] = uint32_t(c.pos.size());
     c.pos.push_back(g.pos[v]);
     c.normal.push_back(g.normal[v]);
@@ -886,9 +965,16 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     c.moved.push_back(g.moved[v]);
     c.locked.push_back(0);
   }
+  std::vector<std::pair<Tri, uint32_t>> order;  // canonical triangle, old index
   for (uint32_t t = 0; t < g.tris.size(); ++t) {
     if (!tAlive[t]) continue;
-    c.tris.push_back({index[g.tris[t][0]], index[g.tris[t][1]], index[g.tris[t][2]]});
+    Tri r{index[g.tris[t][0]], index[g.tris[t][1]], index[g.tris[t][2]]};
+    canonicalRotate(r);
+    order.push_back({r, t});
+  }
+  std::sort(order.begin(), order.end());
+  for (const auto& [r, t] : order) {
+    c.tris.push_back(r);
     c.level.push_back(g.level[t]);
     c.made.push_back(g.made[t]);
   }
@@ -899,13 +985,23 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
 
 SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options) {
   SimplifyStats stats;
-  stats.trianglesBefore = stats.trianglesAfter = mesh.triangles.size();
+  stats.trianglesBefore = stats.trianglesAfter = mesh.triangles.size() + 2 * mesh.carry.collapses;
   if (!(options.tolerance > 0) || mesh.triangles.empty()) return stats;
   Work w = workOf(mesh);
+  stats.collapses = mesh.carry.collapses;  // the regions' share (simplifyRegion in the workers)
+  stats.rejectedTopology = mesh.carry.rejectedTopology;
+  stats.rejectedShape = mesh.carry.rejectedShape;
+  stats.rejectedError = mesh.carry.rejectedError;
+  stats.rejectedIntersection = mesh.carry.rejectedIntersection;
+  stats.modelEvals = mesh.carry.modelEvals;
+  mesh.carry = SimplifyCarry();
   // Two block passes, the second's blocks shifted by half a block: what the first leaves along
-  // its block faces lies inside the second's blocks; the global pass finishes the rest.
-  blockPass(w, tape, grid, options, 0, stats);
-  blockPass(w, tape, grid, options, kBlockVoxels / 2, stats);
+  // its block faces lies inside the second's blocks; the global pass finishes the rest. Blocks
+  // the bricks' own simplification did are skipped (the result is the same).
+  const std::array<int64_t, 3> cells = gridCells(grid);
+  for (int pass = 0; pass < 2; ++pass)
+    blockPass(w, tape, grid, options, kShift[pass],
+              [&](const BlockKey& b) { return !bricksDid(b, pass, options.bricksSimplified, cells); }, stats);
   Simplifier second(std::move(w), tape, grid, options);
   const SimplifyStats& s2 = second.run();
   addStats(stats, s2);
@@ -913,6 +1009,36 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
   mesh = second.output(mesh.stats);
   stats.trianglesAfter = mesh.triangles.size();
   return stats;
+}
+
+void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options,
+                    const std::array<int32_t, 3>& lo, const std::array<int32_t, 3>& hi) {
+  if (!(options.tolerance > 0) || piece.triangles.empty()) return;
+  Mesh m;  // the piece as a mesh: its vertices are in key order, its triangles canonical
+  for (const MeshVertex& v : piece.vertices) {
+    m.positions.push_back(v.position);
+    m.normals.push_back(v.normal);
+    m.keys.push_back(v.key);
+  }
+  m.triangles = std::move(piece.triangles);
+  m.carry = std::move(piece.carry);
+  Work w = workOf(m);
+  SimplifyStats stats;
+  const std::array<int64_t, 3> cells = gridCells(grid), rlo{lo[0], lo[1], lo[2]}, rhi{hi[0], hi[1], hi[2]};
+  for (int pass = 0; pass < 2; ++pass)
+    blockPass(w, tape, grid, options, kShift[pass], [&](const BlockKey& b) { return regionDoes(b, pass, rlo, rhi, cells); },
+              stats);
+  piece.vertices.clear();
+  for (size_t v = 0; v < w.pos.size(); ++v) piece.vertices.push_back({w.key[v], w.pos[v], w.normal[v]});
+  SimplifyCarry& c = piece.carry;
+  carryOf(w, c);
+  piece.triangles = std::move(w.tris);
+  c.collapses += stats.collapses;
+  c.rejectedTopology += stats.rejectedTopology;
+  c.rejectedShape += stats.rejectedShape;
+  c.rejectedError += stats.rejectedError;
+  c.rejectedIntersection += stats.rejectedIntersection;
+  c.modelEvals += stats.modelEvals;
 }
 
 }  // namespace frep

@@ -235,6 +235,44 @@ TEST(MeshSimplify, SameResultWhateverTheSplit) {
   EXPECT_EQ(a.keys, b.keys);
 }
 
+// The farm's way: each brick's piece simplified on its own (simplifyRegion, in the workers), then
+// merged and finished: the same mesh as simplifying the whole, for bricks that are multiples of
+// the 32-voxel blocks or not.
+TEST(MeshSimplify, BricksSimplifyingTheirOwnBlocksGiveTheSameMesh) {
+  Expr m = max(torusZ(0.55, 0.22), min(blockAt(0.1, 0.1, 0.1, 0.5, 0.3, 0.4), -sphereAt(0.4, 0.3, 0.4, 0.3)));
+  GridSpec g = cubeGrid(1.0, 100);
+  TapePtr tape = Tape::compile(m, 3);
+  SimplifyOptions so;
+  so.tolerance = 0.1;
+  Mesh whole = meshGrid(tape, g);
+  SimplifyStats ws = simplifyMesh(whole, tape, g, so);
+  for (int brick : {32, 64, 72, 96}) {  // 72: some blocks straddle bricks
+    SCOPED_TRACE(brick);
+    std::vector<MeshPiece> pieces;
+    const int32_t cells = int32_t(g.dims[0] - 1);
+    for (int32_t x = 0; x < cells; x += brick)
+      for (int32_t y = 0; y < cells; y += brick)
+        for (int32_t z = 0; z < cells; z += brick) {
+          std::array<int32_t, 3> lo{x, y, z}, hi{std::min(cells, x + brick), std::min(cells, y + brick), std::min(cells, z + brick)};
+          pieces.push_back(meshRegion(tape, g, lo, hi));
+          simplifyRegion(pieces.back(), tape, g, so, lo, hi);
+        }
+    Mesh merged = mergePieces(pieces);
+    EXPECT_GT(merged.carry.collapses, 1000u);  // the bricks did a real share
+    SimplifyOptions finish = so;
+    finish.bricksSimplified = brick;
+    SimplifyStats fs = simplifyMesh(merged, tape, g, finish);
+    EXPECT_EQ(merged.positions, whole.positions);
+    EXPECT_EQ(merged.normals, whole.normals);
+    EXPECT_EQ(merged.triangles, whole.triangles);
+    EXPECT_EQ(merged.keys, whole.keys);
+    EXPECT_EQ(fs.trianglesBefore, ws.trianglesBefore);
+    EXPECT_EQ(fs.collapses, ws.collapses);
+    EXPECT_EQ(fs.modelEvals, ws.modelEvals);
+    EXPECT_EQ(fs.errorBound, ws.errorBound);
+  }
+}
+
 TEST(MeshSimplify, SameResultForAnyThreadCount) {
   // 100 points: 3 x 3 x 3 first-pass blocks of 32 voxels, run by 1 and by 2 threads.
   Expr m = max(torusZ(0.55, 0.22), min(blockAt(0.1, 0.1, 0.1, 0.5, 0.3, 0.4), -sphereAt(0.4, 0.3, 0.4, 0.3)));

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "farm_test_util.h"
+#include "frep/mesh_simplify.h"
 
 using namespace farmtest;
 
@@ -136,6 +137,7 @@ TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
   EXPECT_TRUE(back.vertices.empty() && back.triangles.empty());
 
   EXPECT_FALSE(decodeMeshPiece(s.data(), s.size() - 1, back, &err));  // truncated
+  EXPECT_FALSE(decodeMeshPiece("FRM3", 4, back, &err));
   EXPECT_FALSE(decodeMeshPiece("FRM2", 4, back, &err));
   EXPECT_FALSE(decodeMeshPiece((s + "x").data(), s.size() + 1, back, &err));  // trailing
   std::string bad = s;
@@ -163,17 +165,55 @@ TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
   for (const std::string& m : {twoVertices(9, 9, {0, 1, 2}, 1), twoVertices(5, 9, {0, 1, 3}, 1),
                                twoVertices(5, 9, {0, 1, 1}, 1), twoVertices(5, 9, {0, 1, 2}, NAN)})
     EXPECT_FALSE(decodeMeshPiece(m.data(), m.size(), back, &err));
-  std::string overlong = e + std::string(11, char(0xff)) + std::string(48, '\0');  // one vertex, key > 64 bits
+  const size_t header = 4 + 12 + 48 + 8;  // one vertex, key > 64 bits
+  std::string overlong = e.substr(0, header) + std::string(11, char(0xff)) + std::string(48, '\0') + e.substr(header);
   const uint32_t one = 1;
   std::memcpy(&overlong[4 + 12 + 48], &one, 4);
   EXPECT_FALSE(decodeMeshPiece(overlong.data(), overlong.size(), back, &err));
   EXPECT_NE(err.find("overlong"), std::string::npos) << err;
+  // A simplified piece carries the simplifier's state: it round-trips bit for bit.
+  MeshPiece simplified = piece;
+  SimplifyOptions so;
+  so.tolerance = 0.1;
+  simplifyRegion(simplified, compileJobModel(j), gridOf(j), so, {0, 0, 0}, {32, 32, 32});
+  ASSERT_GT(simplified.carry.collapses, 10u);
+  ASSERT_FALSE(simplified.carry.vertices.empty());
+  ASSERT_EQ(simplified.carry.triangles.size(), simplified.triangles.size());
+  std::string sc = encodeMeshPiece(simplified);
+  ASSERT_TRUE(decodeMeshPiece(sc.data(), sc.size(), back, &err)) << err;
+  EXPECT_EQ(back.triangles, simplified.triangles);
+  EXPECT_EQ(back.carry.triangles, simplified.carry.triangles);
+  EXPECT_EQ(back.carry.collapses, simplified.carry.collapses);
+  EXPECT_EQ(back.carry.modelEvals, simplified.carry.modelEvals);
+  ASSERT_EQ(back.carry.vertices.size(), simplified.carry.vertices.size());
+  for (size_t i = 0; i < back.carry.vertices.size(); ++i) {
+    EXPECT_EQ(back.carry.vertices[i].index, simplified.carry.vertices[i].index);
+    EXPECT_EQ(back.carry.vertices[i].quadric, simplified.carry.vertices[i].quadric);
+    EXPECT_EQ(back.carry.vertices[i].moved, simplified.carry.vertices[i].moved);
+  }
+  // A carried vertex past the piece, a bad flag, an error level out of range: refused.
+  {
+    MeshPiece p = simplified;
+    p.carry.vertices.back().index = uint32_t(p.vertices.size());
+    std::string m = encodeMeshPiece(p);
+    EXPECT_FALSE(decodeMeshPiece(m.data(), m.size(), back, &err));
+    EXPECT_NE(err.find("carried vertex index"), std::string::npos) << err;
+    p = simplified;
+    p.carry.vertices[0].moved = 2;
+    m = encodeMeshPiece(p);
+    EXPECT_FALSE(decodeMeshPiece(m.data(), m.size(), back, &err));
+    p = simplified;
+    p.carry.triangles[0] = 0x7f;
+    m = encodeMeshPiece(p);
+    EXPECT_FALSE(decodeMeshPiece(m.data(), m.size(), back, &err));
+    EXPECT_NE(err.find("level"), std::string::npos) << err;
+  }
   // Random corruption and truncation never crash the decoder (ASan/UBSan builds check the reads)
   // and what it accepts always satisfies mergePieces' preconditions.
   std::mt19937 rng(11);
   std::string small = encodeMeshPiece(meshRegion(compileJobModel(j), gridOf(j), {32, 32, 32}, {40, 40, 40}));
   for (int k = 0; k < 3000; ++k) {
-    std::string m = (k % 2) ? small : s;
+    std::string m = k % 3 == 1 ? small : (k % 3 == 2 ? sc : s);
     for (int c = 0; c < 4; ++c) m[rng() % m.size()] = char(rng());
     if (rng() % 2) m.resize(rng() % (m.size() + 1));
     if (decodeMeshPiece(m.data(), m.size(), back, &err)) {

@@ -64,6 +64,26 @@ struct MeshStats {
   uint64_t fallbackEdges = 0;   // edges whose end values disagreed with their signs (bisection)
 };
 
+// What a region's simplification (simplifyRegion, mesh_simplify.h) leaves for the passes after
+// it; empty for a mesh as the mesher made it. Indices are into the owner's vertices/triangles.
+struct SimplifyCarry {
+  // A vertex's quadric (A: xx xy xz yy yz zz, b: 3, c, weight) and whether it left the mesher's
+  // root; listed (by increasing index) only where that is more than its own tangent plane.
+  struct Vertex {
+    uint32_t index;
+    std::array<double, 11> quadric;
+    uint8_t moved;
+  };
+  std::vector<Vertex> vertices;
+  // Per triangle (all of them, or none): error level + 1 (0: not measured), | 0x80 when a
+  // collapse made it.
+  std::vector<uint8_t> triangles;
+  // Counters of the work done (summed into the final SimplifyStats).
+  uint64_t collapses = 0, rejectedTopology = 0, rejectedShape = 0, rejectedError = 0, rejectedIntersection = 0,
+           modelEvals = 0;
+  bool empty() const { return vertices.empty() && triangles.empty() && collapses == 0 && modelEvals == 0; }
+};
+
 // The triangles of one region: vertices keyed by global edges (sorted by key, unique), triangles
 // as index triples into `vertices` (winding outward; each rotated to start at its smallest index,
 // sorted). Pieces of adjacent regions share the vertices of the edges on their common boundary,
@@ -73,6 +93,7 @@ struct MeshPiece {
   std::vector<MeshVertex> vertices;
   std::vector<std::array<uint32_t, 3>> triangles;
   MeshStats stats;
+  SimplifyCarry carry;  // set by simplifyRegion
 };
 
 // One indexed mesh. Vertex order is the order of their keys, triangle order is the order of
@@ -83,6 +104,7 @@ struct Mesh {
   std::vector<std::array<uint32_t, 3>> triangles;
   std::vector<EdgeKey> keys;  // the global edge of each vertex
   MeshStats stats;            // sums over the pieces
+  SimplifyCarry carry;        // the pieces' (mergePieces keeps it with its vertices and triangles)
 };
 
 struct MeshOptions {

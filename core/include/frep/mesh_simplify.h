@@ -37,7 +37,10 @@ struct SimplifyOptions {
   bool sharpFeatures = true;
   std::vector<double> fixedCoords;  // x[3], x[4], ... for models of dimension > 3
   double minQuality = 0.02;  // 4 sqrt(3) area / sum of squared edges (1: equilateral)
-  int threads = 0;           // the first pass's independent blocks; 0: all cores (same result)
+  int threads = 0;           // the block passes' independent blocks; 0: all cores (same result)
+  // The mesh's bricks of this many cells (from index 0) went through simplifyRegion already:
+  // their blocks are not done again. 0: none.
+  int bricksSimplified = 0;
 };
 
 struct SimplifyStats {
@@ -48,6 +51,15 @@ struct SimplifyStats {
                           // (measured along its normal at the check points)
 };
 
+// Simplifies `mesh` (merged from pieces, maybe with their carry) in place.
 SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options);
+
+// The share of one region [lo, hi) of cells (a farm brick) that needs nothing outside it: the
+// block passes' blocks that lie inside it. The piece stays a valid piece (vertices by key,
+// canonical triangles, the seam vertices untouched) and carries what simplifyMesh needs to
+// finish; merged and finished with options.bricksSimplified = the brick edge, the result is the
+// same mesh as simplifyMesh of the raw merged mesh.
+void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options,
+                    const std::array<int32_t, 3>& lo, const std::array<int32_t, 3>& hi);
 
 }  // namespace frep
