@@ -125,6 +125,7 @@ int runMesh(const MeshRequest& request) {
   SimplifyOptions so;
   so.tolerance = request.tolerance >= 0 ? request.tolerance : tape->hasExtrema() ? 0.0 : 0.1;
   so.sharpFeatures = !request.noSharp;
+  so.threads = request.threads;  // the master's passes (the workers' follow --threads too)
   so.bricksSimplified = so.tolerance > 0 ? options.brickVoxels : 0;
   if (request.tolerance < 0 && tape->hasExtrema())
     spdlog::info("the model has extremum nodes: not simplified (each check would run a search); give --tolerance to");
