@@ -420,14 +420,27 @@ class Simplifier {
     return true;
   }
 
+  // The first level from k up to maxK at which the triangle's probes pass (maxK + 1: none).
+  int probeLevel(const V3& a, const V3& b, const V3& c, int k, int maxK, const V3* primary = nullptr) {
+    while (k <= maxK && !withinLevel(a, b, c, k, primary, 0, kProbes)) ++k;
+    return k;
+  }
+  // The first level from the probes' level `k` up to maxK at which every point passes (maxK + 1:
+  // none). A level is fully checked only once its probes pass (probes failing = the level
+  // fails), so the answer is the same as checking every level in full, for far fewer
+  // evaluations when the triangle's own level is high (small tolerances, crease chords).
+  int fullLevel(const V3& a, const V3& b, const V3& c, int k, int maxK, const V3* primary = nullptr) {
+    while (k <= maxK && !withinLevel(a, b, c, k, primary, kProbes)) k = probeLevel(a, b, c, k + 1, maxK, primary);
+    return k;
+  }
+
   int levelOf(uint32_t t) {
     if (w_.level[t] < 0) {
       const Tri& tr = w_.tris[t];
-      int k = 0;
       const V3 &a = w_.pos[tr[0]], &b = w_.pos[tr[1]], &c = w_.pos[tr[2]];
       V3 along = add(w_.normal[tr[0]], add(w_.normal[tr[1]], w_.normal[tr[2]]));
       const V3* dir = quality(a, b, c) < opt_.minQuality && norm(along) > 0 ? &along : nullptr;
-      while (k <= maxLevel_ && !withinLevel(a, b, c, k, dir)) ++k;
+      const int k = fullLevel(a, b, c, probeLevel(a, b, c, 0, maxLevel_, dir), maxLevel_, dir);
       w_.level[t] = int8_t(std::min(k, maxLevel_));  // beyond the last level: no more allowance
     }
     return w_.level[t];
@@ -515,30 +528,24 @@ class Simplifier {
     int allowed = 0;
     for (uint32_t t : changed) allowed = std::max(allowed, levelOf(t));
     for (uint32_t t : removed) allowed = std::max(allowed, levelOf(t));
+    // The probes of every new triangle first (most failing collapses fail there), then the
+    // full check from each triangle's probe level; the outcome does not depend on this order.
     std::vector<int8_t> newLevel(changed.size());
-    // At the tolerance itself (the common case) the probes of every new triangle first: most
-    // failing collapses fail there. (At a larger allowance a failure at the tolerance proves
-    // nothing: the next level may pass.) The outcome does not depend on this order.
-    size_t probed = 0;
-    if (allowed == 0) {
-      for (uint32_t t : changed) {
-        const Tri& tr = w_.tris[t];
-        if (!withinLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), 0, nullptr, 0, kProbes)) {
-          ++stats_.rejectedError;
-          return;
-        }
-      }
-      probed = kProbes;
-    }
     for (size_t i = 0; i < changed.size(); ++i) {
       const Tri& tr = w_.tris[changed[i]];
-      int k = 0;
-      while (k <= allowed && !withinLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), k, nullptr, k == 0 ? probed : 0)) ++k;
-      if (k > allowed) {
+      newLevel[i] = int8_t(probeLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), 0, allowed));
+      if (newLevel[i] > allowed) {
         ++stats_.rejectedError;
         return;
       }
-      newLevel[i] = int8_t(k);
+    }
+    for (size_t i = 0; i < changed.size(); ++i) {
+      const Tri& tr = w_.tris[changed[i]];
+      newLevel[i] = int8_t(fullLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), newLevel[i], allowed));
+      if (newLevel[i] > allowed) {
+        ++stats_.rejectedError;
+        return;
+      }
     }
     // The removed vertices stay within the allowed error of the new triangles.
     const double e = std::ldexp(tol_, allowed);
