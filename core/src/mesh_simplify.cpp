@@ -450,7 +450,10 @@ class Simplifier {
   void tryCollapse(uint32_t a, uint32_t b) {
     // Link condition: exactly two triangles hold the edge, and a and b have no other common
     // neighbour; neither opposite vertex may drop below valence 3.
-    std::vector<uint32_t> na, nb, opposite;
+    // Scratch lists kept between calls (no allocation per attempt).
+    std::vector<uint32_t>&na = scratch_.na, &nb = scratch_.nb, &opposite = scratch_.opposite, &common = scratch_.common,
+                         &changed = scratch_.changed, &removed = scratch_.removed, &ring = scratch_.ring;
+    for (auto* l : {&na, &nb, &opposite, &common, &changed, &removed, &ring}) l->clear();
     for (uint32_t t : vtris_[a])
       for (uint32_t v : w_.tris[t])
         if (v != a) na.push_back(v);
@@ -467,7 +470,6 @@ class Simplifier {
     na.erase(std::unique(na.begin(), na.end()), na.end());
     std::sort(nb.begin(), nb.end());
     nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-    std::vector<uint32_t> common;
     std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
     std::sort(opposite.begin(), opposite.end());
     if (opposite.size() != 2 || opposite[0] == opposite[1] || common != opposite || vtris_[opposite[0]].size() <= 3 ||
@@ -478,7 +480,7 @@ class Simplifier {
 
     double cost;
     V3 p = placement(a, b, &cost);
-    std::vector<uint32_t> changed, removed;  // triangles kept with a new corner; the two dropped
+    // changed: triangles kept with a new corner; removed: the two dropped
     for (uint32_t v : {a, b})
       for (uint32_t t : vtris_[v]) {
         const Tri& tr = w_.tris[t];
@@ -530,7 +532,8 @@ class Simplifier {
     for (uint32_t t : removed) allowed = std::max(allowed, levelOf(t));
     // The probes of every new triangle first (most failing collapses fail there), then the
     // full check from each triangle's probe level; the outcome does not depend on this order.
-    std::vector<int8_t> newLevel(changed.size());
+    std::vector<int8_t>& newLevel = scratch_.newLevel;
+    newLevel.assign(changed.size(), 0);
     for (size_t i = 0; i < changed.size(); ++i) {
       const Tri& tr = w_.tris[changed[i]];
       newLevel[i] = int8_t(probeLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), 0, allowed));
@@ -654,7 +657,6 @@ class Simplifier {
       insertBuckets(changed[i]);
     }
     ++stats_.collapses;
-    std::vector<uint32_t> ring;
     for (uint32_t t : vtris_[a])
       for (uint32_t v : w_.tris[t])
         if (v != a) ring.push_back(v);
@@ -722,6 +724,10 @@ class Simplifier {
   double tol_;
   SimplifyStats stats_;
   std::vector<V3> samplePoints_;
+  struct Scratch {
+    std::vector<uint32_t> na, nb, opposite, common, changed, removed, ring;
+    std::vector<int8_t> newLevel;
+  } scratch_;
   struct NewTri {  // a triangle as a collapse would leave it
     Tri t;
     std::array<exact::P, 3> q;  // quantised corners
