@@ -333,7 +333,8 @@ std::string encodeMeshPiece(const MeshPiece& piece) {
     first = t[0];
   }
   const SimplifyCarry& c = piece.carry;
-  for (uint64_t v : {c.collapses, c.rejectedTopology, c.rejectedShape, c.rejectedError, c.rejectedIntersection, c.modelEvals})
+  const SimplifyCounters& n = c.counters;
+  for (uint64_t v : {n.collapses, n.rejectedTopology, n.rejectedShape, n.rejectedError, n.rejectedIntersection, n.modelEvals})
     put(s, v);
   put(s, uint32_t(c.vertices.size()));
   uint32_t prevIndex = 0;
@@ -408,8 +409,9 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
   // The simplifier's carry (simplifyRegion): counters, carried vertices, triangle states.
   SimplifyCarry& c = out.carry;
   c = SimplifyCarry();
-  for (uint64_t* v : {&c.collapses, &c.rejectedTopology, &c.rejectedShape, &c.rejectedError, &c.rejectedIntersection,
-                      &c.modelEvals})
+  SimplifyCounters& n = c.counters;
+  for (uint64_t* v : {&n.collapses, &n.rejectedTopology, &n.rejectedShape, &n.rejectedError, &n.rejectedIntersection,
+                      &n.modelEvals})
     if (!r.get(*v)) return fail("mesh payload: truncated simplifier counters");
   uint32_t ncv = 0;
   if (!r.get(ncv)) return fail("mesh payload: truncated simplifier state");

@@ -36,12 +36,7 @@ Mesh mergeKeyed(const std::vector<MeshPiece>& pieces, const std::function<void(s
     s.samplePointEvals += p.stats.samplePointEvals;
     s.fallbackEdges += p.stats.fallbackEdges;
     const SimplifyCarry& c = p.carry;
-    mesh.carry.collapses += c.collapses;
-    mesh.carry.rejectedTopology += c.rejectedTopology;
-    mesh.carry.rejectedShape += c.rejectedShape;
-    mesh.carry.rejectedError += c.rejectedError;
-    mesh.carry.rejectedIntersection += c.rejectedIntersection;
-    mesh.carry.modelEvals += c.modelEvals;
+    mesh.carry.counters += c.counters;
     if (!c.triangles.empty() && c.triangles.size() != p.triangles.size())
       throw std::invalid_argument("mergePieces: a piece's triangle states do not match its triangles");
     withStates = withStates || !c.triangles.empty();

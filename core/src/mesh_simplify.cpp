@@ -801,14 +801,6 @@ bool bricksDid(const BlockKey& b, int pass, int brick, const std::array<int64_t,
   return regionDoes(b, pass, lo, hi, cells);
 }
 
-void addStats(SimplifyStats& s, const SimplifyStats& b) {
-  s.collapses += b.collapses;
-  s.rejectedTopology += b.rejectedTopology;
-  s.rejectedShape += b.rejectedShape;
-  s.rejectedError += b.rejectedError;
-  s.rejectedIntersection += b.rejectedIntersection;
-  s.modelEvals += b.modelEvals;
-}
 
 // A block pass, in parallel: the grid's index space, shifted by `shiftVoxels`, is cut into
 // fixed blocks of kBlockVoxels (so the cut does not depend on the farm's bricks). A vertex
@@ -958,7 +950,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     g.level.insert(g.level.end(), r.level.begin(), r.level.end());
     g.made.insert(g.made.end(), r.made.begin(), r.made.end());
     tAlive.resize(g.tris.size(), 1);
-    addStats(stats, r.stats);
+    stats += r.stats;
     r = Result();
   }
   // Compact to the canonical form every pass starts from (vertices by key, triangles rotated
@@ -998,15 +990,10 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
 
 SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options) {
   SimplifyStats stats;
-  stats.trianglesBefore = stats.trianglesAfter = mesh.triangles.size() + 2 * mesh.carry.collapses;
+  stats.trianglesBefore = stats.trianglesAfter = mesh.triangles.size() + 2 * mesh.carry.counters.collapses;
   if (!(options.tolerance > 0) || mesh.triangles.empty()) return stats;
   Work w = workOf(mesh);
-  stats.collapses = mesh.carry.collapses;  // the regions' share (simplifyRegion in the workers)
-  stats.rejectedTopology = mesh.carry.rejectedTopology;
-  stats.rejectedShape = mesh.carry.rejectedShape;
-  stats.rejectedError = mesh.carry.rejectedError;
-  stats.rejectedIntersection = mesh.carry.rejectedIntersection;
-  stats.modelEvals = mesh.carry.modelEvals;
+  stats += mesh.carry.counters;  // the regions' share (simplifyRegion in the workers)
   mesh.carry = SimplifyCarry();
   // Two block passes, the second's blocks shifted by half a block: what the first leaves along
   // its block faces lies inside the second's blocks; the global pass finishes the rest. Blocks
@@ -1017,7 +1004,7 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
               [&](const BlockKey& b) { return !bricksDid(b, pass, options.bricksSimplified, cells); }, stats);
   Simplifier second(std::move(w), tape, grid, options);
   const SimplifyStats& s2 = second.run();
-  addStats(stats, s2);
+  stats += s2;
   stats.errorBound = s2.errorBound;  // over every triangle a collapse made, in either pass
   mesh = second.output(mesh.stats);
   stats.trianglesAfter = mesh.triangles.size();
@@ -1046,12 +1033,7 @@ void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid,
   SimplifyCarry& c = piece.carry;
   carryOf(w, c);
   piece.triangles = std::move(w.tris);
-  c.collapses += stats.collapses;
-  c.rejectedTopology += stats.rejectedTopology;
-  c.rejectedShape += stats.rejectedShape;
-  c.rejectedError += stats.rejectedError;
-  c.rejectedIntersection += stats.rejectedIntersection;
-  c.modelEvals += stats.modelEvals;
+  c.counters += stats;
 }
 
 }  // namespace frep

@@ -258,7 +258,7 @@ TEST(MeshSimplify, BricksSimplifyingTheirOwnBlocksGiveTheSameMesh) {
           simplifyRegion(pieces.back(), tape, g, so, lo, hi);
         }
     Mesh merged = mergePieces(pieces);
-    EXPECT_GT(merged.carry.collapses, 1000u);  // the bricks did a real share
+    EXPECT_GT(merged.carry.counters.collapses, 1000u);  // the bricks did a real share
     SimplifyOptions finish = so;
     finish.bricksSimplified = brick;
     SimplifyStats fs = simplifyMesh(merged, tape, g, finish);

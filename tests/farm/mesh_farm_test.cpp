@@ -176,15 +176,15 @@ TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
   SimplifyOptions so;
   so.tolerance = 0.1;
   simplifyRegion(simplified, compileJobModel(j), gridOf(j), so, {0, 0, 0}, {32, 32, 32});
-  ASSERT_GT(simplified.carry.collapses, 10u);
+  ASSERT_GT(simplified.carry.counters.collapses, 10u);
   ASSERT_FALSE(simplified.carry.vertices.empty());
   ASSERT_EQ(simplified.carry.triangles.size(), simplified.triangles.size());
   std::string sc = encodeMeshPiece(simplified);
   ASSERT_TRUE(decodeMeshPiece(sc.data(), sc.size(), back, &err)) << err;
   EXPECT_EQ(back.triangles, simplified.triangles);
   EXPECT_EQ(back.carry.triangles, simplified.carry.triangles);
-  EXPECT_EQ(back.carry.collapses, simplified.carry.collapses);
-  EXPECT_EQ(back.carry.modelEvals, simplified.carry.modelEvals);
+  EXPECT_EQ(back.carry.counters.collapses, simplified.carry.counters.collapses);
+  EXPECT_EQ(back.carry.counters.modelEvals, simplified.carry.counters.modelEvals);
   ASSERT_EQ(back.carry.vertices.size(), simplified.carry.vertices.size());
   for (size_t i = 0; i < back.carry.vertices.size(); ++i) {
     EXPECT_EQ(back.carry.vertices[i].index, simplified.carry.vertices[i].index);

@@ -64,6 +64,17 @@ struct MeshStats {
   uint64_t fallbackEdges = 0;   // edges whose end values disagreed with their signs (bisection)
 };
 
+// The simplifier's work counters (mesh_simplify.h), summed over passes, blocks and bricks.
+struct SimplifyCounters {
+  uint64_t collapses = 0, rejectedTopology = 0, rejectedShape = 0, rejectedError = 0, rejectedIntersection = 0;
+  uint64_t modelEvals = 0;
+  SimplifyCounters& operator+=(const SimplifyCounters& o) {
+    collapses += o.collapses, rejectedTopology += o.rejectedTopology, rejectedShape += o.rejectedShape;
+    rejectedError += o.rejectedError, rejectedIntersection += o.rejectedIntersection, modelEvals += o.modelEvals;
+    return *this;
+  }
+};
+
 // What a region's simplification (simplifyRegion, mesh_simplify.h) leaves for the passes after
 // it; empty for a mesh as the mesher made it. Indices are into the owner's vertices/triangles.
 struct SimplifyCarry {
@@ -78,10 +89,7 @@ struct SimplifyCarry {
   // Per triangle (all of them, or none): error level + 1 (0: not measured), | 0x80 when a
   // collapse made it.
   std::vector<uint8_t> triangles;
-  // Counters of the work done (summed into the final SimplifyStats).
-  uint64_t collapses = 0, rejectedTopology = 0, rejectedShape = 0, rejectedError = 0, rejectedIntersection = 0,
-           modelEvals = 0;
-  bool empty() const { return vertices.empty() && triangles.empty() && collapses == 0 && modelEvals == 0; }
+  SimplifyCounters counters;  // the work done (summed into the final SimplifyStats)
 };
 
 // The triangles of one region: vertices keyed by global edges (sorted by key, unique), triangles

@@ -43,10 +43,8 @@ struct SimplifyOptions {
   int bricksSimplified = 0;
 };
 
-struct SimplifyStats {
-  uint64_t trianglesBefore = 0, trianglesAfter = 0, collapses = 0;
-  uint64_t rejectedTopology = 0, rejectedShape = 0, rejectedError = 0, rejectedIntersection = 0;
-  uint64_t modelEvals = 0;
+struct SimplifyStats : SimplifyCounters {
+  uint64_t trianglesBefore = 0, trianglesAfter = 0;
   double errorBound = 0;  // in world units: no output triangle is further from the surface
                           // (measured along its normal at the check points)
 };
