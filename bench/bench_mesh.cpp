@@ -560,8 +560,9 @@ int main(int argc, char** argv) {
 
   // libfive's published figure: sphere ∩ gyroid, 10^3 region at 0.025 (400^3 equivalent) in
   // about 3 s after its thread-pool rewrite, i.e. ~21 M voxel-eq/s on a multi-core machine.
-  std::printf("\nlibfive (published, not run here): ~21 M voxel-eq/s on sphere ∩ gyroid, multi-core; per core "
-              "%.1f M/s if 4 cores, %.1f M/s if 8 (its core count is not stated)\n",
+  std::printf("\nlibfive (published): ~21 M voxel-eq/s on sphere ∩ gyroid, multi-core; per core "
+              "%.1f M/s if 4 cores, %.1f M/s if 8 (its core count is not stated). Measured on this machine\n"
+              "against frep mesh by bench/bench_mesh_libfive.py (needs a libfive build; docs/mesh.md).\n",
               21.0 / 4, 21.0 / 8);
 
   if (farm) {
