@@ -522,7 +522,18 @@ class Master {
     }
     *t->mutable_job() = job_;
     if (!send(router, rid, e)) {
-      dropPeer(rid, false);
+      // No route to the peer: its connection closed without a bye (it crashed or reconnected)
+      // and its liveness window has not run out yet. dispatch() already took a pending brick
+      // off pending_: put it back, or no one would lease it again and the job would never end
+      // (the loop keeps waiting while the other workers heartbeat). A reissued or backup copy
+      // stays leased to its other holders and goes back to the reissue queue (it was due).
+      if (b.phase == BrickPhase::Pending) pending_.push_front(b.id);
+      else reissue_.push_back(b.id);
+      // A dead peer, as if silent past its liveness window: its bricks count a failure, so a
+      // brick that kills its workers is poisoned whichever way the death is noticed first.
+      ++report_.deadWorkers;
+      spdlog::warn("worker {} unreachable: dead, its bricks go back to the queue", p.workerId);
+      dropPeer(rid, true);
       return;
     }
     if (b.phase != BrickPhase::Leased) b.firstLease = now;

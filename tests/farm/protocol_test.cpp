@@ -120,6 +120,83 @@ TEST(Protocol, WorkerOfAnotherProtocolMajorIsRefusedWithAReason) {
   EXPECT_EQ(out.report.refused, 1u);
 }
 
+// A peer whose connection is gone while it is still registered (it crashed or reconnected and
+// its liveness window has not run out) must not swallow the brick the master tries to lease to
+// it: that brick goes back to the queue. It was lost once, and the master then waited forever
+// for it while other workers heartbeated (frep mesh/sample with a crashing brick hung).
+TEST(Protocol, BrickForAPeerThatVanishedGoesBackToTheQueue) {
+  JobSpec j = sphereJob();
+  setGrid(j, GridSpec::fromBounds({-1, -1, -1}, {1, 0, 0}, 64));  // 64x32x32: two bricks of 32
+  FarmOptions inProcess = clusterOptions();
+  inProcess.workers = 0;
+  FarmOutcome ref = runJob(j, inProcess);
+  ASSERT_EQ(ref.report.bricks, 2u);
+  FarmOptions o = clusterOptions();
+  o.heartbeatMs = 400;  // liveness window 2.4 s: the vanished peer stays registered meanwhile
+  o.noWorkerTimeoutSec = 5;
+  MasterThread master(j, o);
+  const std::string ep = master.endpoint();
+
+  zmq::context_t ctx(1);
+  auto peer = [&](const char* id) {
+    zmq::socket_t s(ctx, zmq::socket_type::dealer);
+    s.set(zmq::sockopt::linger, 1000);
+    s.set(zmq::sockopt::routing_id, id);
+    s.connect(ep);
+    Envelope hello;
+    hello.mutable_hello()->set_worker_id(id);
+    send(s, "", hello);
+    return s;
+  };
+  // The envelopes of one kind received within `ms`, or until `count` of them arrived.
+  auto collect = [](zmq::socket_t& s, Envelope::BodyCase kind, size_t count, int ms = 10000) {
+    std::vector<Envelope> got;
+    auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+    while (got.size() < count && std::chrono::steady_clock::now() < deadline) {
+      zmq::pollitem_t item{static_cast<void*>(s), 0, ZMQ_POLLIN, 0};
+      zmq::poll(&item, 1, std::chrono::milliseconds(20));
+      Incoming in;
+      std::string err;
+      while (got.size() < count && receive(s, false, in, &err))
+        if (err.empty() && in.envelope.body_case() == kind) got.push_back(in.envelope);
+    }
+    return got;
+  };
+  // "y" leases both bricks (two in flight per worker): nothing is pending.
+  zmq::socket_t y = peer("y");
+  std::vector<Envelope> held = collect(y, Envelope::kTask, 2);
+  ASSERT_EQ(held.size(), 2u);
+  // "x" joins with room for two bricks and vanishes without a bye.
+  {
+    zmq::socket_t x = peer("x");
+    ASSERT_EQ(collect(x, Envelope::kWelcome, 1).size(), 1u);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));  // the master sees the disconnect
+  // "y" hands both bricks back and leaves: the master offers them to "x" first (it is idle).
+  for (const Envelope& t : held) {
+    Envelope f;
+    f.set_job_id(jobIdOf(j));
+    f.mutable_failed()->set_brick_id(t.task().brick_id());
+    f.mutable_failed()->set_attempt(t.task().attempt());
+    f.mutable_failed()->set_error("handed back by the test");
+    f.mutable_failed()->set_handed_back(true);
+    send(y, "", f);
+  }
+  Envelope bye;
+  bye.mutable_bye()->set_reason("test");
+  send(y, "", bye);
+  // A real worker computes whatever is queued; a lost brick would leave the master waiting.
+  EXPECT_EQ(runWorker(ep), 0);
+  master.join();
+  const FarmOutcome& out = master.outcome;
+  ASSERT_EQ(master.error, "");
+  EXPECT_FALSE(out.report.interrupted);
+  EXPECT_TRUE(out.report.poisoned.empty());
+  EXPECT_EQ(out.report.bricksComputed, 2u);
+  ASSERT_EQ(out.result.leaves.size(), ref.result.leaves.size());
+  for (size_t i = 0; i < ref.result.leaves.size(); ++i) ASSERT_EQ(out.result.leaves[i].values, ref.result.leaves[i].values);
+}
+
 TEST(Protocol, CurveMasterRefusesWorkersWithoutTheKeys) {
   namespace fs = std::filesystem;
   fs::path dir = fs::temp_directory_path() / ("frep-curve-" + std::to_string(getpid()));
