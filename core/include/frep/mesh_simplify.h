@@ -13,14 +13,16 @@
 //    gets thinner than a quality bound (unless it was already);
 //  - no self-intersection: the new triangles against every triangle near them, with the exact
 //    predicates of frep/mesh_predicates.h on positions quantised to 2^-16 voxel;
-//  - error against the model itself: at points spread over each new triangle (at most one
+//  - error against the model itself: at points spread over each new triangle (at most half a
 //    voxel apart, up to 64x64 points per triangle) the surface must be crossed within distance
 //    e along the triangle's normal: f(p - e n) inside and f(p + e n) outside. e is the
 //    tolerance, or the error the replaced triangles already had if larger (the mesher's chords
 //    across a crease), so the result is never further from the surface than the tolerance or
 //    the input mesh. The removed vertices must also stay within e of the new triangles.
-// Single-threaded and deterministic (ties broken by vertex index): the output depends only on
-// the input mesh, so the farm's split-invariance carries over.
+// Passes: two of independent 32^3 blocks (fixed in index space; in parallel, and in the workers
+// for the blocks inside their bricks: simplifyRegion), then one over the whole mesh. Each is
+// deterministic (ties broken by vertex index) and starts from the canonical mesh, so the output
+// depends only on the input mesh: the farm's split-invariance carries over.
 #pragma once
 
 #include <cstdint>
