@@ -147,7 +147,7 @@ int main(int argc, char** argv) {
   addModelOptions(meshCmd, mesh.model, true);
   addRegionOptions(meshCmd, mesh.region, "Output mesh: .ply (binary), .obj or .stl (binary)", 128);
   meshCmd->add_option("--threads", mesh.threads,
-                      "Threads of the in-process run, --workers 0 (default 0: all cores; same output)");
+                      "Threads of the in-process run (--workers 0) and of the master's simplification (default 0: all cores; same output)");
   addFarmOptions(meshCmd, mesh.farm);
   meshCmd->add_option("--tolerance", mesh.tolerance,
                       "Adaptive simplification: the largest distance from the surface it may add, in voxels "
