@@ -44,6 +44,18 @@ struct Quadric {
     c += d * d;
     weight += 1;
   }
+  // The 11 numbers SimplifyCarry::Vertex holds (A: xx xy xz yy yz zz, b, c, weight), and back.
+  std::array<double, 11> packed() const {
+    return {A(0, 0), A(0, 1), A(0, 2), A(1, 1), A(1, 2), A(2, 2), b[0], b[1], b[2], c, weight};
+  }
+  static Quadric unpacked(const std::array<double, 11>& d) {
+    Quadric q;
+    q.A << d[0], d[1], d[2], d[1], d[3], d[4], d[2], d[4], d[5];
+    q.b = Eigen::Vector3d(d[6], d[7], d[8]);
+    q.c = d[9];
+    q.weight = d[10];
+    return q;
+  }
   Quadric& operator+=(const Quadric& o) {
     A += o.A, b += o.b, c += o.c, weight += o.weight;
     return *this;
@@ -131,12 +143,7 @@ Work workOf(const Mesh& mesh) {
   w.locked.assign(w.pos.size(), 0);
   for (const SimplifyCarry::Vertex& c : mesh.carry.vertices) {
     if (c.index >= w.pos.size()) throw std::invalid_argument("simplifyMesh: a carried vertex past the mesh's vertices");
-    Quadric& q = w.quad[c.index];
-    const auto& d = c.quadric;
-    q.A << d[0], d[1], d[2], d[1], d[3], d[4], d[2], d[4], d[5];
-    q.b = Eigen::Vector3d(d[6], d[7], d[8]);
-    q.c = d[9];
-    q.weight = d[10];
+    w.quad[c.index] = Quadric::unpacked(c.quadric);
     w.moved[c.index] = c.moved;
   }
   w.tris = mesh.triangles;
@@ -159,7 +166,7 @@ void carryOf(const Work& w, SimplifyCarry& carry) {
   for (uint32_t v = 0; v < w.pos.size(); ++v) {
     const Quadric& q = w.quad[v];
     if (q.weight == 1 && !w.moved[v]) continue;  // its own tangent plane: workOf rebuilds it
-    carry.vertices.push_back({v, {q.A(0, 0), q.A(0, 1), q.A(0, 2), q.A(1, 1), q.A(1, 2), q.A(2, 2), q.b[0], q.b[1], q.b[2], q.c, q.weight}, uint8_t(w.moved[v] ? 1 : 0)});
+    carry.vertices.push_back({v, q.packed(), uint8_t(w.moved[v] ? 1 : 0)});
   }
   carry.triangles.resize(w.tris.size());
   for (size_t t = 0; t < w.tris.size(); ++t) carry.triangles[t] = uint8_t((w.level[t] + 1) | (w.made[t] ? 0x80 : 0));
@@ -801,8 +808,7 @@ bool bricksDid(const BlockKey& b, int pass, int brick, const std::array<int64_t,
   return regionDoes(b, pass, lo, hi, cells);
 }
 
-
-// A block pass, in parallel: the grid's index space, shifted by `shiftVoxels`, is cut into
+// A block pass, in parallel: the grid's index space, shifted by kShift[pass], is cut into
 // fixed blocks of kBlockVoxels (so the cut does not depend on the farm's bricks). A vertex
 // belongs to its block if it and every neighbour lie inside the block shrunk by a voxel; each
 // block simplifies the triangles around its own vertices, with the other vertices locked,
@@ -810,12 +816,13 @@ bool bricksDid(const BlockKey& b, int pass, int brick, const std::array<int64_t,
 // obstacle. Those triangles are never changed by another block (each block's triangles stay
 // inside its own shrunk box), so the blocks are independent: the result does not depend on the
 // thread count or the order.
-void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt, int shiftVoxels,
+// Only the blocks `mine` accepts are done.
+void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt, int pass,
                const std::function<bool(const BlockKey&)>& mine, SimplifyStats& stats) {
   const size_t nv = g.pos.size(), nt = g.tris.size();
   const double side = kBlockVoxels * grid.voxel, margin = grid.voxel;
   V3 origin;
-  for (int k = 0; k < 3; ++k) origin[k] = grid.origin[k] - shiftVoxels * grid.voxel;
+  for (int k = 0; k < 3; ++k) origin[k] = grid.origin[k] - kShift[pass] * grid.voxel;
   auto blockOf = [&](const V3& p) {
     BlockKey b;
     for (int k = 0; k < 3; ++k) b[k] = int32_t(std::floor((p[k] - origin[k]) / side));
@@ -1000,7 +1007,7 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
   // the bricks' own simplification did are skipped (the result is the same).
   const std::array<int64_t, 3> cells = gridCells(grid);
   for (int pass = 0; pass < 2; ++pass)
-    blockPass(w, tape, grid, options, kShift[pass],
+    blockPass(w, tape, grid, options, pass,
               [&](const BlockKey& b) { return !bricksDid(b, pass, options.bricksSimplified, cells); }, stats);
   Simplifier second(std::move(w), tape, grid, options);
   const SimplifyStats& s2 = second.run();
@@ -1026,8 +1033,7 @@ void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid,
   SimplifyStats stats;
   const std::array<int64_t, 3> cells = gridCells(grid), rlo{lo[0], lo[1], lo[2]}, rhi{hi[0], hi[1], hi[2]};
   for (int pass = 0; pass < 2; ++pass)
-    blockPass(w, tape, grid, options, kShift[pass], [&](const BlockKey& b) { return regionDoes(b, pass, rlo, rhi, cells); },
-              stats);
+    blockPass(w, tape, grid, options, pass, [&](const BlockKey& b) { return regionDoes(b, pass, rlo, rhi, cells); }, stats);
   piece.vertices.clear();
   for (size_t v = 0; v < w.pos.size(); ++v) piece.vertices.push_back({w.key[v], w.pos[v], w.normal[v]});
   SimplifyCarry& c = piece.carry;

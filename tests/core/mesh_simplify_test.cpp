@@ -220,8 +220,25 @@ TEST(MeshSimplify, BlendedUnionKeepsItsVolume) {
   EXPECT_NEAR(r.volume, v0, r.stats.errorBound * a0);
 }
 
+namespace {
+
+// A torus and a block with a ball taken out (creases, corners, curved faces): the split tests'
+// model.
+Expr torusAndNotchedBlock() {
+  return max(torusZ(0.55, 0.22), min(blockAt(0.1, 0.1, 0.1, 0.5, 0.3, 0.4), -sphereAt(0.4, 0.3, 0.4, 0.3)));
+}
+
+void expectSameMesh(const Mesh& a, const Mesh& b) {
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.normals, b.normals);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.keys, b.keys);
+}
+
+}  // namespace
+
 TEST(MeshSimplify, SameResultWhateverTheSplit) {
-  Expr m = max(torusZ(0.55, 0.22), min(blockAt(0.1, 0.1, 0.1, 0.5, 0.3, 0.4), -sphereAt(0.4, 0.3, 0.4, 0.3)));
+  Expr m = torusAndNotchedBlock();
   GridSpec g = cubeGrid(1.0, 61);
   TapePtr tape = Tape::compile(m, 3);
   SimplifyOptions so;
@@ -229,17 +246,14 @@ TEST(MeshSimplify, SameResultWhateverTheSplit) {
   Mesh a = meshGrid(tape, g, {}, 0), b = meshGrid(tape, g, {}, 16);
   simplifyMesh(a, tape, g, so);
   simplifyMesh(b, tape, g, so);
-  EXPECT_EQ(a.positions, b.positions);
-  EXPECT_EQ(a.normals, b.normals);
-  EXPECT_EQ(a.triangles, b.triangles);
-  EXPECT_EQ(a.keys, b.keys);
+  expectSameMesh(a, b);
 }
 
 // The farm's way: each brick's piece simplified on its own (simplifyRegion, in the workers), then
 // merged and finished: the same mesh as simplifying the whole, for bricks that are multiples of
 // the 32-voxel blocks or not.
 TEST(MeshSimplify, BricksSimplifyingTheirOwnBlocksGiveTheSameMesh) {
-  Expr m = max(torusZ(0.55, 0.22), min(blockAt(0.1, 0.1, 0.1, 0.5, 0.3, 0.4), -sphereAt(0.4, 0.3, 0.4, 0.3)));
+  Expr m = torusAndNotchedBlock();
   GridSpec g = cubeGrid(1.0, 100);
   TapePtr tape = Tape::compile(m, 3);
   SimplifyOptions so;
@@ -262,10 +276,7 @@ TEST(MeshSimplify, BricksSimplifyingTheirOwnBlocksGiveTheSameMesh) {
     SimplifyOptions finish = so;
     finish.bricksSimplified = brick;
     SimplifyStats fs = simplifyMesh(merged, tape, g, finish);
-    EXPECT_EQ(merged.positions, whole.positions);
-    EXPECT_EQ(merged.normals, whole.normals);
-    EXPECT_EQ(merged.triangles, whole.triangles);
-    EXPECT_EQ(merged.keys, whole.keys);
+    expectSameMesh(merged, whole);
     EXPECT_EQ(fs.trianglesBefore, ws.trianglesBefore);
     EXPECT_EQ(fs.collapses, ws.collapses);
     EXPECT_EQ(fs.modelEvals, ws.modelEvals);
@@ -275,7 +286,7 @@ TEST(MeshSimplify, BricksSimplifyingTheirOwnBlocksGiveTheSameMesh) {
 
 TEST(MeshSimplify, SameResultForAnyThreadCount) {
   // 100 points: 3 x 3 x 3 first-pass blocks of 32 voxels, run by 1 and by 2 threads.
-  Expr m = max(torusZ(0.55, 0.22), min(blockAt(0.1, 0.1, 0.1, 0.5, 0.3, 0.4), -sphereAt(0.4, 0.3, 0.4, 0.3)));
+  Expr m = torusAndNotchedBlock();
   GridSpec g = cubeGrid(1.0, 100);
   TapePtr tape = Tape::compile(m, 3);
   Mesh a = meshGrid(tape, g), b = a;
