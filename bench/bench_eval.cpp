@@ -13,8 +13,8 @@
 
 #include <unistd.h>
 
-#include "frep/eval.h"
-#include "frep/expr.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/expr.h"
 #include "bench_models.h"
 #include "tree_walker.h"
 

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <random>
 
-#include "frep/eval.h"
+#include "frep/evaluators/eval.h"
 #include "frep/lang/hyperfun.h"
 #include "frep/lang/interpret.h"
 

@@ -41,12 +41,12 @@
 #include <thread>
 #include <vector>
 
-#include "frep/eval.h"
-#include "frep/expr.h"
-#include "frep/mesh.h"
-#include "frep/mesh_simplify.h"
-#include "frep/sample.h"
-#include "frep/tape.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/expr.h"
+#include "frep/meshing/mesh.h"
+#include "frep/meshing/mesh_simplify.h"
+#include "frep/sampling/sample.h"
+#include "frep/expressions/tape.h"
 #include "vdb_grid.h"
 
 using namespace frep;

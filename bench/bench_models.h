@@ -3,8 +3,8 @@
 
 #include <array>
 
-#include "frep/expr.h"
-#include "frep/ops.h"
+#include "frep/expressions/expr.h"
+#include "frep/primitives/ops.h"
 
 namespace frep::bench {
 

@@ -7,8 +7,8 @@
 #include <cstdio>
 
 #include "bench_models.h"
-#include "frep/eval.h"
-#include "frep/sample.h"
+#include "frep/evaluators/eval.h"
+#include "frep/sampling/sample.h"
 
 using namespace frep;
 

@@ -22,10 +22,10 @@
 #include <cstdio>
 #include <cstring>
 
-#include "frep/eval.h"
-#include "frep/extremum.h"
-#include "frep/ops.h"
-#include "frep/sample.h"
+#include "frep/evaluators/eval.h"
+#include "frep/extremum/extremum.h"
+#include "frep/primitives/ops.h"
+#include "frep/sampling/sample.h"
 
 #include "bench_timing.h"
 

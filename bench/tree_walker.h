@@ -7,7 +7,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "frep/expr.h"
+#include "frep/expressions/expr.h"
 
 namespace frep::bench {
 

@@ -5,8 +5,8 @@
 #include "arg_parse.h"
 #include "commands.h"
 #include "exit_codes.h"
-#include "frep/eval.h"
-#include "frep/tape.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/tape.h"
 
 namespace frep::cli {
 

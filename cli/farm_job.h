@@ -8,7 +8,7 @@
 #include "atomic_output.h"
 #include "commands.h"
 #include "farm_master.h"
-#include "frep/sample.h"
+#include "frep/sampling/sample.h"
 #include "model_loader.h"
 
 namespace frep::cli {

@@ -15,10 +15,10 @@
 #include "commands.h"
 #include "exit_codes.h"
 #include "farm_job.h"
-#include "frep/mesh.h"
-#include "frep/mesh_simplify.h"
+#include "frep/meshing/mesh.h"
+#include "frep/meshing/mesh_simplify.h"
 #include "mesh_writer.h"
-#include "frep/mesh_grid.h"
+#include "frep/meshing/mesh_grid.h"
 #include "sampling_grid.h"
 #include "vdb_reader.h"
 

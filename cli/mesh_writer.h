@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "frep/mesh.h"
+#include "frep/meshing/mesh.h"
 
 namespace frep::cli {
 

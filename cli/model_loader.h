@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "frep/expr.h"
+#include "frep/expressions/expr.h"
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "arg_parse.h"
-#include "frep/sample.h"
+#include "frep/sampling/sample.h"
 
 namespace frep::cli {
 

@@ -9,8 +9,8 @@
 #include "atomic_output.h"
 #include "commands.h"
 #include "exit_codes.h"
-#include "frep/eval.h"
-#include "frep/tape.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/tape.h"
 #include "heatmap.h"
 #include "sampling_grid.h"
 

@@ -5,7 +5,7 @@
 
 #include <openvdb/openvdb.h>
 
-#include "frep/sample.h"
+#include "frep/sampling/sample.h"
 
 namespace frep::cli {
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "frep/mesh.h"
-#include "frep/sample.h"
+#include "frep/meshing/mesh.h"
+#include "frep/sampling/sample.h"
 
 namespace frep::cli {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "frep/sample.h"
+#include "frep/sampling/sample.h"
 
 namespace frep::cli {
 

@@ -18,7 +18,7 @@
 
 #include "brick.h"
 #include "curve.h"
-#include "frep/mesh_merge.h"
+#include "frep/meshing/mesh_merge.h"
 #include "journal.h"
 #include "local_workers.h"
 #include "progress.h"

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "farm.pb.h"
-#include "frep/mesh.h"
-#include "frep/mesh_simplify.h"
-#include "frep/sample.h"
+#include "frep/meshing/mesh.h"
+#include "frep/meshing/mesh_simplify.h"
+#include "frep/sampling/sample.h"
 
 namespace frep::farm {
 
@@ -63,7 +63,7 @@ struct FarmReport {
   DomainCounts domainErrors;
   uint64_t leaves = 0, tiles = 0;        // "sample": merged output
   uint64_t vertices = 0, triangles = 0;  // "mesh": merged output (after simplification)
-  // "mesh": the simplification of the merged mesh (frep/mesh_simplify.h; run by the caller).
+  // "mesh": the simplification of the merged mesh (frep/meshing/mesh_simplify.h; run by the caller).
   double simplifyTolerance = 0;  // voxels; 0: not simplified
   bool sharpFeatures = false;
   SimplifyStats simplify;

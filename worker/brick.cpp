@@ -7,8 +7,8 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "frep/extremum.h"
-#include "frep/mesh_simplify.h"
+#include "frep/extremum/extremum.h"
+#include "frep/meshing/mesh_simplify.h"
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "farm.pb.h"
-#include "frep/mesh.h"
-#include "frep/sample.h"
+#include "frep/meshing/mesh.h"
+#include "frep/sampling/sample.h"
 
 namespace frep::farm {
 

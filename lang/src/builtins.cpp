@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "frep/ops.h"
+#include "frep/primitives/ops.h"
 
 namespace frep::lang {
 

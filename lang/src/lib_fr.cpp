@@ -1,11 +1,11 @@
-// frepfarm's fr* extensions to the HyperFun library: the core operation library (frep/ops.h)
+// frepfarm's fr* extensions to the HyperFun library: the core operation library (frep/primitives/ops.h)
 // exposed to models. Set operations take the survey's R-function parameter a (HyperFun fixes
 // a = 0); transformations rewrite their coordinate array in place and return 1, like hf*.
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "frep/ops.h"
+#include "frep/primitives/ops.h"
 #include "lib_hf_util.h"
 
 namespace frep::lang {

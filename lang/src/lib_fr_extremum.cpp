@@ -1,6 +1,6 @@
 // frepfarm's fr* extremum extensions (issue 6, docs/extremum.md "The language side"): Minkowski
 // sum and difference, projection, sweep, constant-radius offset and Minkowski metamorphosis of
-// OBJECTS defined earlier in the file. Each lowers to one extremum node (frep/extremum.h) over
+// OBJECTS defined earlier in the file. Each lowers to one extremum node (frep/extremum/extremum.h) over
 // the callee's compiled field, read through the caller's coordinate array. Sweeps also take
 // keyframe motions (frSweepKeys; frKeyframe is the interpolant alone, for motion objects).
 //
@@ -17,10 +17,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "frep/eval.h"
-#include "frep/extremum.h"
-#include "frep/interval.h"
-#include "frep/tape.h"
+#include "frep/evaluators/eval.h"
+#include "frep/extremum/extremum.h"
+#include "frep/evaluators/interval.h"
+#include "frep/expressions/tape.h"
 #include "lib_hf_util.h"
 
 namespace frep::lang {

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "frep/expr.h"
-#include "frep/ops.h"
+#include "frep/expressions/expr.h"
+#include "frep/primitives/ops.h"
 #include "frep/lang/library.h"
 
 namespace frep::lang::hf {

@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "frep/eval.h"
-#include "frep/expr.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/expr.h"
 
 using namespace frep;
 

@@ -1,4 +1,4 @@
-// The branch-and-bound's term form (core/src/extremum_terms.h): the min-of-terms rewrite, the
+// The branch-and-bound's term form (core/src/extremum/extremum_terms.h): the min-of-terms rewrite, the
 // soundness of constraint propagation against a cut (random boxes: no sampled point that
 // reaches the cut is ever cut off, and the interval bounds hold every sampled value), the local
 // ascent, end-to-end certification of B&B results against dense sampling, and identical sampled
@@ -10,11 +10,11 @@
 #include <map>
 #include <random>
 
-#include "../../core/src/extremum_terms.h"
-#include "frep/eval.h"
-#include "frep/extremum.h"
-#include "frep/ops.h"
-#include "frep/sample.h"
+#include "../../core/src/extremum/extremum_terms.h"
+#include "frep/evaluators/eval.h"
+#include "frep/extremum/extremum.h"
+#include "frep/primitives/ops.h"
+#include "frep/sampling/sample.h"
 
 using namespace frep;
 

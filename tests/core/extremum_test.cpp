@@ -10,10 +10,10 @@
 #include <random>
 #include <stdexcept>
 
-#include "frep/eval.h"
-#include "frep/extremum.h"
-#include "frep/ops.h"
-#include "frep/sample.h"
+#include "frep/evaluators/eval.h"
+#include "frep/extremum/extremum.h"
+#include "frep/primitives/ops.h"
+#include "frep/sampling/sample.h"
 
 using namespace frep;
 

@@ -6,8 +6,8 @@
 #include <random>
 #include <vector>
 
-#include "frep/eval.h"
-#include "frep/expr.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/expr.h"
 
 using namespace frep;
 

@@ -7,9 +7,9 @@
 #include <random>
 #include <vector>
 
-#include "frep/eval.h"
-#include "frep/expr.h"
-#include "frep/interval.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/expr.h"
+#include "frep/evaluators/interval.h"
 
 using namespace frep;
 

@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "frep/mesh_predicates.h"
+#include "frep/meshing/mesh_predicates.h"
 
 namespace mesh_checks {
 
@@ -125,7 +125,7 @@ size_t verticesFarFromSurface(const std::vector<Vec3>& pos, const std::vector<Ve
 // quantised mesh (a displacement of at most 2^-25 of the box, far below the mesher's smallest
 // features). A pair of triangles is improper when it meets anywhere but in a shared vertex or
 // a shared edge: no shared vertex and any contact; one shared vertex and contact beyond it; a
-// shared edge and the two triangles folded onto each other in one plane (frep/mesh_predicates.h).
+// shared edge and the two triangles folded onto each other in one plane (frep/meshing/mesh_predicates.h).
 
 // Number of improper triangle pairs (0 for an embedded surface).
 inline size_t selfIntersections(const std::vector<Vec3>& pos, const std::vector<Tri>& tris) {

@@ -1,9 +1,9 @@
 // Analytic test models of the mesher and simplifier tests (inside: f >= 0) and their grids.
 #pragma once
 
-#include "frep/expr.h"
-#include "frep/ops.h"
-#include "frep/sample.h"
+#include "frep/expressions/expr.h"
+#include "frep/primitives/ops.h"
+#include "frep/sampling/sample.h"
 
 namespace mesh_models {
 

@@ -1,11 +1,11 @@
-// The exact predicates of frep/mesh_predicates.h: the floating-point filter of orient3d agrees
+// The exact predicates of frep/meshing/mesh_predicates.h: the floating-point filter of orient3d agrees
 // with plain 128-bit arithmetic on nearly degenerate inputs, and improperPair judges the cases
 // the simplifier meets (shared vertex, shared edge, crossing, touching).
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "frep/mesh_predicates.h"
+#include "frep/meshing/mesh_predicates.h"
 
 namespace {
 

@@ -11,11 +11,11 @@
 
 #include "core/mesh_checks.h"
 #include "core/mesh_models.h"
-#include "frep/eval.h"
-#include "frep/extremum.h"
-#include "frep/mesh.h"
-#include "frep/mesh_simplify.h"
-#include "frep/ops.h"
+#include "frep/evaluators/eval.h"
+#include "frep/extremum/extremum.h"
+#include "frep/meshing/mesh.h"
+#include "frep/meshing/mesh_simplify.h"
+#include "frep/primitives/ops.h"
 
 using namespace frep;
 namespace mc = mesh_checks;

@@ -7,9 +7,9 @@
 #include <stdexcept>
 #include <vector>
 
-#include "frep/eval.h"
-#include "frep/ops.h"
-#include "frep/primitives.h"
+#include "frep/evaluators/eval.h"
+#include "frep/primitives/ops.h"
+#include "frep/primitives/primitives.h"
 
 using namespace frep;
 

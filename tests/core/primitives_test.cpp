@@ -7,8 +7,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "frep/eval.h"
-#include "frep/primitives.h"
+#include "frep/evaluators/eval.h"
+#include "frep/primitives/primitives.h"
 
 using namespace frep;
 

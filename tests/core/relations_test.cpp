@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "frep/relations.h"
+#include "frep/relations/relations.h"
 
 using namespace frep;
 

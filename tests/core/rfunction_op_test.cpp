@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "frep/eval.h"
-#include "frep/ops.h"
+#include "frep/evaluators/eval.h"
+#include "frep/primitives/ops.h"
 
 using namespace frep;
 

@@ -3,8 +3,8 @@
 
 #include <map>
 
-#include "frep/eval.h"
-#include "frep/sample.h"
+#include "frep/evaluators/eval.h"
+#include "frep/sampling/sample.h"
 
 using namespace frep;
 

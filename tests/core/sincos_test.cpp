@@ -12,9 +12,9 @@
 #include <set>
 #include <vector>
 
-#include "frep/eval.h"
-#include "frep/expr.h"
-#include "frep/extremum.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/expr.h"
+#include "frep/extremum/extremum.h"
 
 using namespace frep;
 

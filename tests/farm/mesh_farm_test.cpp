@@ -10,7 +10,7 @@
 #include <random>
 
 #include "farm_test_util.h"
-#include "frep/mesh_simplify.h"
+#include "frep/meshing/mesh_simplify.h"
 
 using namespace farmtest;
 

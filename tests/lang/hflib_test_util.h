@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "frep/eval.h"
-#include "frep/expr.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/expr.h"
 #include "frep/lang/library.h"
-#include "frep/tape.h"
+#include "frep/expressions/tape.h"
 
 namespace hftest {
 

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "frep/eval.h"
+#include "frep/evaluators/eval.h"
 #include "frep/lang/hyperfun.h"
-#include "frep/tape.h"
+#include "frep/expressions/tape.h"
 
 namespace frep::lang::testing {
 

@@ -1,6 +1,6 @@
 // The core pieces behind `frep mesh input.vdb` and the master's lean merge, without a binary:
-// meshSamples (core/include/frep/mesh_grid.h) against meshGrid on the same signs, and
-// mergePiecesReleasing (core/include/frep/mesh_merge.h) against mergePieces.
+// meshSamples (core/include/frep/meshing/mesh_grid.h) against meshGrid on the same signs, and
+// mergePiecesReleasing (core/include/frep/meshing/mesh_merge.h) against mergePieces.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,13 +8,13 @@
 #include <random>
 
 #include "core/mesh_checks.h"
-#include "frep/eval.h"
-#include "frep/expr.h"
-#include "frep/mesh.h"
-#include "frep/mesh_grid.h"
-#include "frep/mesh_merge.h"
-#include "frep/ops.h"
-#include "frep/sample.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/expr.h"
+#include "frep/meshing/mesh.h"
+#include "frep/meshing/mesh_grid.h"
+#include "frep/meshing/mesh_merge.h"
+#include "frep/primitives/ops.h"
+#include "frep/sampling/sample.h"
 
 using namespace frep;
 namespace mc = mesh_checks;

@@ -1,11 +1,11 @@
 // HyperFun's operators and builtin functions as core expressions (semantics in
-// docs/language.md; domain errors follow the core's conventions in frep/expr.h).
+// docs/language.md; domain errors follow the core's conventions in frep/expressions/expr.h).
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "frep/expr.h"
+#include "frep/expressions/expr.h"
 
 namespace frep::lang {
 

@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "frep/expr.h"
+#include "frep/expressions/expr.h"
 #include "frep/lang/hyperfun.h"
 
 namespace frep::lang {

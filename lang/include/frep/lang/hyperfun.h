@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "frep/expr.h"
+#include "frep/expressions/expr.h"
 
 namespace frep::lang {
 

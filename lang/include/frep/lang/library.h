@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "frep/expr.h"
+#include "frep/expressions/expr.h"
 
 namespace frep::lang {
 

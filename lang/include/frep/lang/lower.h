@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "frep/expr.h"
+#include "frep/expressions/expr.h"
 #include "frep/lang/ast.h"
 #include "frep/lang/diagnostics.h"
 #include "frep/lang/hyperfun.h"

@@ -1,0 +1,111 @@
+// The four evaluators that walk a compiled Tape. Each owns its register file, so use one
+// evaluator per thread. All agree with applyOp (expr.h) on every op.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "frep/evaluators/interval.h"
+#include "frep/expressions/tape.h"
+
+namespace frep {
+
+class ExtremumSolver;  // extremum.h
+
+// The search engines an evaluator needs for a tape's Op::Extremum instructions, one per entry
+// of the tape's extremum table, created on first use and rebuilt when the evaluator moves to
+// another root tape. Copies start empty (a solver holds its own evaluators).
+class ExtremumSlots {
+ public:
+  ExtremumSlots();
+  ~ExtremumSlots();
+  ExtremumSlots(const ExtremumSlots&);
+  ExtremumSlots& operator=(const ExtremumSlots&);
+  ExtremumSolver& get(const Tape& tape, uint32_t entry);
+
+ private:
+  uint64_t rootId_ = 0;
+  std::vector<std::unique_ptr<ExtremumSolver>> solvers_;
+};
+
+// 1. Point evaluation in double precision: the reference.
+class PointEvaluator {
+ public:
+  double eval(const Tape& tape, const double* x);
+  // Adds every domain error of later evals to *counts (nullptr: stop counting).
+  void countDomainErrors(DomainCounts* counts) { domain_ = counts; }
+
+ private:
+  DomainCounts* domain_ = nullptr;
+  std::vector<double> regs_;
+  uint64_t boundId_ = 0;
+  ExtremumSlots extrema_;
+  std::vector<double> xbuf_;
+};
+
+// 2. Batch evaluation over up to kBatch points in structure-of-arrays form.
+//    Usage: fill in(i)[k] for var i and point k < count, call eval, read out()[k].
+//    Extremum instructions run one search per lane, each lane warm-started from the previous
+//    lane's arg-extremum within the same eval call (neighbouring voxels); nothing carries over
+//    between calls, so results do not depend on the order of calls (determinism).
+template <typename T>
+class BatchEvaluator {
+ public:
+  static constexpr size_t kBatch = 256;
+  T* in(uint32_t var);  // valid after reserve(tape) or a previous eval with that tape
+  void reserve(const Tape& tape);
+  const T* eval(const Tape& tape, size_t count);
+  // Adds the domain errors of later evals (lanes < count) to *counts (nullptr: stop).
+  void countDomainErrors(DomainCounts* counts) { domain_ = counts; }
+
+ private:
+  DomainCounts* domain_ = nullptr;
+  void bind(const Tape& tape);
+  void runExtremum(const Tape& tape, const Instr& ins, size_t count);
+  std::vector<T> regs_;  // numRegs * kBatch, register-major
+  uint64_t boundId_ = 0;
+  uint32_t numUniformsBound_ = 0;
+  ExtremumSlots extrema_;
+  std::vector<double> xbuf_, warm_, res_;
+};
+extern template class BatchEvaluator<float>;
+extern template class BatchEvaluator<double>;
+
+// 3. Interval evaluation over boxes, recording which side each min/max/select takes.
+class IntervalEvaluator {
+ public:
+  Interval eval(const Tape& tape, const Interval* box);
+  // Choices made by the last eval (one per instruction of that tape).
+  const std::vector<Choice>& choices() const { return choices_; }
+  // Shortened tape valid inside the last evaluated box (self: the tape last evaluated).
+  TapePtr pruned(const TapePtr& self) const { return self->prune(choices_, self); }
+  // Extremum nodes: by default their bound stops refining as soon as its sign is decided (all
+  // that inside/outside classification needs). An outer search needs tight upper bounds
+  // instead: signOnly = false (the extremum solver sets it for its body).
+  void setExtremumSignOnly(bool signOnly) { extremumSignOnly_ = signOnly; }
+
+ private:
+  std::vector<Interval> regs_;
+  std::vector<Choice> choices_;
+  uint64_t boundId_ = 0;
+  ExtremumSlots extrema_;
+  std::vector<Interval> xbuf_;
+  bool extremumSignOnly_ = true;
+};
+
+// 4. Forward-mode gradient: value and d/dx[i] for every coordinate of the tape. An extremum
+//    node's derivative follows Danskin's theorem: d/dX max_u g = dg/dX at the maximiser.
+class GradientEvaluator {
+ public:
+  // grad must hold tape.numVars() doubles.
+  double eval(const Tape& tape, const double* x, double* grad);
+
+ private:
+  std::vector<double> val_, der_;  // der_: numRegs * numVars
+  uint64_t boundId_ = 0;
+  ExtremumSlots extrema_;
+  std::vector<double> xbuf_, gbuf_, row_;
+};
+
+}  // namespace frep

@@ -1,0 +1,65 @@
+// Adaptive, feature-preserving simplification of a mesh of a model (docs/mesh.md, "Adaptivity
+// and sharp features").
+//
+// Greedy edge collapses ordered by a quadric error built from the model's TANGENT PLANES at the
+// mesher's vertices (points on the surface with the gradient's normal), not from the mesh's own
+// triangles: where a crease or a corner of the model crosses the mesh, the quadric of the merged
+// vertices holds the planes of the faces that meet there, so the merged vertex lands on the
+// edge or the corner (the estimate of dual contouring's QEF), and flat regions merge freely.
+//
+// Every collapse is checked before it is made:
+//  - topology: the link condition (the surface stays a closed 2-manifold, same genus);
+//  - no fold, no degenerate triangle: no changed triangle turns by more than ~80 degrees or
+//    gets thinner than a quality bound (unless it was already);
+//  - no self-intersection: the new triangles against every triangle near them, with the exact
+//    predicates of frep/meshing/mesh_predicates.h on positions quantised to 2^-16 voxel;
+//  - error against the model itself: at points spread over each new triangle (at most half a
+//    voxel apart, up to 64x64 points per triangle) the surface must be crossed within distance
+//    e along the triangle's normal: f(p - e n) inside and f(p + e n) outside. e is the
+//    tolerance, or the error the replaced triangles already had if larger (the mesher's chords
+//    across a crease), so the result is never further from the surface than the tolerance or
+//    the input mesh. The removed vertices must also stay within e of the new triangles.
+// Passes: two of independent 32^3 blocks (fixed in index space; in parallel, and in the workers
+// for the blocks inside their bricks: simplifyRegion), then one over the whole mesh. Each is
+// deterministic (ties broken by vertex index) and starts from the canonical mesh, so the output
+// depends only on the input mesh: the farm's split-invariance carries over.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "frep/meshing/mesh.h"
+
+namespace frep {
+
+struct SimplifyOptions {
+  double tolerance = 0;  // in voxels (grid.voxel); <= 0: the mesh is left as it is
+  // true: a merged vertex goes where its quadric is least (on edges and corners of the model);
+  // false: it stays at one of the two vertices (every vertex remains a root on a grid edge).
+  bool sharpFeatures = true;
+  std::vector<double> fixedCoords;  // x[3], x[4], ... for models of dimension > 3
+  double minQuality = 0.02;  // 4 sqrt(3) area / sum of squared edges (1: equilateral)
+  int threads = 0;           // the block passes' independent blocks; 0: all cores (same result)
+  // The mesh's bricks of this many cells (from index 0) went through simplifyRegion already:
+  // their blocks are not done again. 0: none.
+  int bricksSimplified = 0;
+};
+
+struct SimplifyStats : SimplifyCounters {
+  uint64_t trianglesBefore = 0, trianglesAfter = 0;
+  double errorBound = 0;  // in world units: no output triangle is further from the surface
+                          // (measured along its normal at the check points)
+};
+
+// Simplifies `mesh` (merged from pieces, maybe with their carry) in place.
+SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options);
+
+// The share of one region [lo, hi) of cells (a farm brick) that needs nothing outside it: the
+// block passes' blocks that lie inside it. The piece stays a valid piece (vertices by key,
+// canonical triangles, the seam vertices untouched) and carries what simplifyMesh needs to
+// finish; merged and finished with options.bricksSimplified = the brick edge, the result is the
+// same mesh as simplifyMesh of the raw merged mesh.
+void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options,
+                    const std::array<int32_t, 3>& lo, const std::array<int32_t, 3>& hi);
+
+}  // namespace frep

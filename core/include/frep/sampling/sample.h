@@ -1,0 +1,89 @@
+// Sparse sampling of a model on a regular grid: values only in 8^3 leaf blocks near the
+// surface, inside/outside tiles elsewhere, found by recursive interval subdivision with tape
+// pruning, so the cost follows the surface, not the volume. This is the in-process reference
+// that the farm distributes brick by brick.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "frep/expressions/tape.h"
+
+namespace frep {
+
+// Voxel (i, j, k) sits at world point origin + (i, j, k) * voxel; 0 <= i < dims[0], ...
+struct GridSpec {
+  std::array<double, 3> origin{0, 0, 0};
+  double voxel = 1.0;
+  std::array<int32_t, 3> dims{0, 0, 0};
+  std::array<double, 3> world(int64_t i, int64_t j, int64_t k) const {
+    return {origin[0] + double(i) * voxel, origin[1] + double(j) * voxel, origin[2] + double(k) * voxel};
+  }
+  // The grid that spans [lo, hi] with n voxels along the longest axis (n >= 2), others in step.
+  static GridSpec fromBounds(const std::array<double, 3>& lo, const std::array<double, 3>& hi, int n);
+};
+
+constexpr int kLeafDim = 8;  // OpenVDB leaf nodes are 8^3
+constexpr int kLeafVoxels = kLeafDim * kLeafDim * kLeafDim;
+
+// Index of voxel (x, y, z) inside a leaf, as OpenVDB orders it: x major, z minor.
+inline int leafOffset(int x, int y, int z) { return (x << 6) | (y << 3) | z; }
+
+struct LeafBlock {
+  std::array<int32_t, 3> origin;  // multiple of 8 (index space)
+  // f at each voxel (F-rep sign: >= 0 inside). Voxels outside the band, or outside the grid,
+  // are inactive and hold +band (inside) or -band (outside), in world units: band * voxel.
+  std::array<float, kLeafVoxels> values;
+  std::array<uint64_t, kLeafVoxels / 64> active;  // bit per voxel, same order as values
+  bool isActive(int offset) const { return (active[offset >> 6] >> (offset & 63)) & 1u; }
+};
+
+struct Tile {
+  std::array<int32_t, 3> origin;  // multiple of 8
+  int32_t size;                    // edge length in voxels (power of two >= 8)
+  bool inside;                     // the whole cube is inside (f > 0) or outside (f < 0)
+};
+
+struct SampleOptions {
+  int bandVoxels = 3;  // voxels within this many voxels (Chebyshev) of a possible zero are sampled
+  // Index-space region to sample, [lo, hi) per axis; lo must be a multiple of 8. Default: all.
+  std::array<int32_t, 3> regionLo{0, 0, 0};
+  std::array<int32_t, 3> regionHi{-1, -1, -1};
+  std::vector<double> fixedCoords;  // values of x[3], x[4], ... for models of dimension > 3
+  int threads = 0;                  // 0: TBB's default; 1: serial (deterministic either way)
+};
+
+struct SampleStats {
+  uint64_t pointEvals = 0;     // model evaluations at grid points
+  uint64_t intervalEvals = 0;  // interval evaluations over boxes
+  uint64_t denseEvals = 0;     // what a dense evaluation of the region would cost
+  uint64_t nanValues = 0;      // samples whose value was NaN (domain errors), stored as outside
+  DomainCounts domainErrors;   // evaluations that used a documented domain-error value
+  uint64_t tapeInstrs = 0;     // sum of pruned tape lengths used for point batches ...
+  uint64_t tapeBatches = 0;    // ... over this many batches (average = tapeInstrs / tapeBatches)
+};
+
+struct SampleResult {
+  GridSpec grid;
+  int bandVoxels = 3;
+  std::vector<LeafBlock> leaves;  // sorted by origin (x, then y, then z)
+  std::vector<Tile> tiles;        // sorted by origin
+  SampleStats stats;
+};
+
+SampleResult sample(const TapePtr& tape, const GridSpec& grid, const SampleOptions& options = {});
+
+// Puts leaves and tiles in the canonical order (by origin: x, then y, then z). Leaves are 2 KiB
+// each, so they are ordered through an index and moved once.
+void sortByOrigin(std::vector<LeafBlock>& leaves, std::vector<Tile>& tiles);
+
+// Volume of the inside of a sampled model as counted on its lattice: the grid points with
+// f >= 0 (voxels of inside tiles and leaf values >= 0, within the grid) times the voxel volume.
+double insideVolume(const SampleResult& r);
+// The same count for a shape given by a predicate on world points: the grid points p of g with
+// inside(p), times the voxel volume.
+double latticeVolume(const GridSpec& g, const std::function<bool(const std::array<double, 3>&)>& inside);
+
+}  // namespace frep

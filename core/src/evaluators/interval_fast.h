@@ -1,0 +1,102 @@
+// Internal to the core (interval.cpp, eval_interval.cpp, extremum_terms.cpp): outward rounding
+// by one ulp, and the inlined fast path of the common interval ops on finite operands. The fast
+// path is bit-identical to applyOp (interval.cpp): the same IEEE operations and the same
+// one-ulp outward steps.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+
+#include "frep/evaluators/interval.h"
+
+namespace frep {
+namespace detail {
+
+// One step to the next double above x: std::nextafter(x, inf) without the libm call (this runs
+// for every bound of every op). +inf and NaN stay as they are.
+inline double nextUp(double x) {
+  if (!(x < std::numeric_limits<double>::infinity())) return x;
+  if (x == 0.0) return std::numeric_limits<double>::denorm_min();
+  uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  bits = x > 0.0 ? bits + 1 : bits - 1;
+  std::memcpy(&x, &bits, sizeof bits);
+  return x;
+}
+inline double up1(double x) { return nextUp(x); }
+inline double down1(double x) { return -nextUp(-x); }
+inline bool finiteIv(const Interval& a) {
+  return std::fabs(a.lo) < std::numeric_limits<double>::infinity() &&
+         std::fabs(a.hi) < std::numeric_limits<double>::infinity();
+}
+
+// r = op(a, b) for Copy, Neg, Abs, Sqrt, x^2, +, -, *, min and max on finite operands. Returns
+// false when the op or its operands are not handled here (the caller then uses applyOp).
+inline bool fastOp(Op op, const Interval& a, const Interval& b, double imm, Interval& r) {
+  switch (op) {
+    case Op::Copy:
+      if (!finiteIv(a)) return false;
+      r = a;
+      return true;
+    case Op::Neg:
+      if (!finiteIv(a)) return false;
+      r = Interval(-a.hi, -a.lo);
+      return true;
+    case Op::Abs:
+      if (!finiteIv(a)) return false;
+      if (a.lo >= 0.0) r = a;
+      else if (a.hi <= 0.0) r = Interval(-a.hi, -a.lo);
+      else r = Interval(0.0, std::max(-a.lo, a.hi));
+      return true;
+    case Op::Sqrt:
+      if (!finiteIv(a)) return false;
+      if (a.hi <= 0.0) r = Interval(0.0, 0.0);
+      else r = Interval(a.lo > 0.0 ? std::max(0.0, down1(std::sqrt(a.lo))) : 0.0, up1(std::sqrt(a.hi)));
+      return true;
+    case Op::PowI: {
+      if (imm != 2.0 || !finiteIv(a)) return false;
+      // powInt(x, 2) == x * x; even power, 1 ulp (interval.cpp powIInterval).
+      const double minAbs = (a.lo <= 0.0 && a.hi >= 0.0) ? 0.0 : std::min(std::fabs(a.lo), std::fabs(a.hi));
+      const double maxAbs = std::max(std::fabs(a.lo), std::fabs(a.hi));
+      r = Interval(std::max(down1(minAbs * minAbs), 0.0), up1(maxAbs * maxAbs));
+      return true;
+    }
+    case Op::Add:
+      if (!finiteIv(a) || !finiteIv(b)) return false;
+      r = Interval(down1(a.lo + b.lo), up1(a.hi + b.hi));
+      return true;
+    case Op::Sub:
+      if (!finiteIv(a) || !finiteIv(b)) return false;
+      r = Interval(down1(a.lo - b.hi), up1(a.hi - b.lo));
+      return true;
+    case Op::Mul: {
+      if (!finiteIv(a) || !finiteIv(b)) return false;
+      const double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
+      r = Interval(down1(*std::min_element(p, p + 4)), up1(*std::max_element(p, p + 4)));
+      return true;
+    }
+    case Op::Min:
+      if (!finiteIv(a) || !finiteIv(b)) return false;
+      r = Interval(std::min(a.lo, b.lo), std::min(a.hi, b.hi));
+      return true;
+    case Op::Max:
+      if (!finiteIv(a) || !finiteIv(b)) return false;
+      r = Interval(std::max(a.lo, b.lo), std::max(a.hi, b.hi));
+      return true;
+    default:
+      return false;
+  }
+}
+
+// op(a, b): the fast path, else applyOp.
+inline Interval applyOpFast(Op op, const Interval& a, const Interval& b) {
+  Interval r;
+  if (fastOp(op, a, b, 0.0, r)) return r;
+  return applyOp(op, a, b);
+}
+
+}  // namespace detail
+}  // namespace frep

@@ -1,0 +1,1045 @@
+// Adaptive, feature-preserving edge collapses checked against the model (mesh_simplify.h).
+#include "frep/meshing/mesh_simplify.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <functional>
+#include <queue>
+#include <unordered_map>
+
+#include "frep/evaluators/eval.h"
+#include "frep/meshing/mesh_predicates.h"
+#include "sampling/parallel_chunks.h"
+
+
+namespace frep {
+
+namespace {
+
+using V3 = std::array<double, 3>;
+using Tri = std::array<uint32_t, 3>;
+
+V3 add(const V3& a, const V3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+V3 scale(const V3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+V3 cross(const V3& a, const V3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double norm(const V3& a) { return std::sqrt(dot(a, a)); }
+
+// Sum of squared distances to planes n.x = n.p (Garland & Heckbert's quadric), here the model's
+// tangent planes at surface points.
+struct Quadric {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  double c = 0, weight = 0;
+  void addPlane(const V3& n, const V3& p) {
+    Eigen::Vector3d nn(n[0], n[1], n[2]);
+    double d = -dot(n, p);
+    A += nn * nn.transpose();
+    b += d * nn;
+    c += d * d;
+    weight += 1;
+  }
+  // The 11 numbers SimplifyCarry::Vertex holds (A: xx xy xz yy yz zz, b, c, weight), and back.
+  std::array<double, 11> packed() const {
+    return {A(0, 0), A(0, 1), A(0, 2), A(1, 1), A(1, 2), A(2, 2), b[0], b[1], b[2], c, weight};
+  }
+  static Quadric unpacked(const std::array<double, 11>& d) {
+    Quadric q;
+    q.A << d[0], d[1], d[2], d[1], d[3], d[4], d[2], d[4], d[5];
+    q.b = Eigen::Vector3d(d[6], d[7], d[8]);
+    q.c = d[9];
+    q.weight = d[10];
+    return q;
+  }
+  Quadric& operator+=(const Quadric& o) {
+    A += o.A, b += o.b, c += o.c, weight += o.weight;
+    return *this;
+  }
+  double operator()(const V3& x) const {
+    Eigen::Vector3d v(x[0], x[1], x[2]);
+    return std::max(0.0, v.dot(A * v) + 2 * b.dot(v) + c);
+  }
+  // The least-squares point nearest to `ref`. Directions with less support than half a plane
+  // (eigenvalue < 0.5; each unit-normal plane adds 1 to the trace) stay at ref: nearly parallel
+  // planes do not define a crease. An absolute threshold, not one relative to the largest
+  // eigenvalue: a vertex that has absorbed a whole face holds thousands of that face's planes
+  // and still only a few dozen of the face across the crease.
+  V3 minimiser(const V3& ref) const {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(A);  // closed form for 3x3: several times faster than the iterative solver
+    Eigen::Vector3d r(ref[0], ref[1], ref[2]), g = -(A * r + b), x = r;
+    double top = es.eigenvalues().maxCoeff();
+    for (int i = 0; i < 3; ++i) {
+      double l = es.eigenvalues()[i];
+      if (l > 0.5 && l > 1e-9 * top) {
+        x += es.eigenvectors().col(i) * (es.eigenvectors().col(i).dot(g) / l);
+      }
+    }
+    return {x[0], x[1], x[2]};
+  }
+};
+
+// Closest distance from p to triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
+double pointTriangleDistance(const V3& p, const V3& a, const V3& b, const V3& c) {
+  V3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return norm(ap);
+  V3 bp = sub(p, b);
+  double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return norm(bp);
+  double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return norm(sub(p, add(a, scale(ab, d1 / (d1 - d3)))));
+  V3 cp = sub(p, c);
+  double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return norm(cp);
+  double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return norm(sub(p, add(a, scale(ac, d2 / (d2 - d6)))));
+  double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return norm(sub(p, add(b, scale(sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))))));
+  double denom = 1 / (va + vb + vc);
+  return norm(sub(p, add(a, add(scale(ab, vb * denom), scale(ac, vc * denom)))));
+}
+
+double quality(const V3& a, const V3& b, const V3& c) {
+  double s = dot(sub(b, a), sub(b, a)) + dot(sub(c, b), sub(c, b)) + dot(sub(a, c), sub(a, c));
+  return s > 0 ? 2 * std::sqrt(3.0) * norm(cross(sub(b, a), sub(c, a))) / s : 0;
+}
+
+constexpr int kMaxSamplesPerSide = 64;  // error samples per triangle <= 64^2
+constexpr double kQuantum = 65536;      // exact predicates: 2^16 steps per voxel
+constexpr double kBucketVoxels = 2;     // spatial hash cell
+constexpr size_t kProbes = 4;           // error samples tried first on every new triangle
+
+// The state a simplification works on: the whole mesh, or one block of it (locked vertices and
+// the triangles around the block held fixed, placements confined to the block).
+struct Work {
+  std::vector<V3> pos, normal;
+  std::vector<EdgeKey> key;
+  std::vector<Quadric> quad;
+  std::vector<char> moved, locked;  // per vertex
+  std::vector<Tri> tris;
+  std::vector<int8_t> level;  // per triangle: error level (-1: not measured yet)
+  std::vector<char> made;     // per triangle: made by a collapse
+  bool confined = false;      // placements stay inside [regionLo, regionHi]
+  V3 regionLo{}, regionHi{};
+};
+
+// The state of a mesh (vertices in key order, triangles canonical) with what earlier passes
+// carried: quadrics beyond a vertex's own tangent plane, error levels, made triangles.
+Work workOf(const Mesh& mesh) {
+  Work w;
+  w.pos = mesh.positions;
+  w.normal = mesh.normals;
+  w.key = mesh.keys;
+  w.quad.resize(mesh.positions.size());
+  for (size_t v = 0; v < w.pos.size(); ++v) w.quad[v].addPlane(w.normal[v], w.pos[v]);
+  w.moved.assign(w.pos.size(), 0);
+  w.locked.assign(w.pos.size(), 0);
+  for (const SimplifyCarry::Vertex& c : mesh.carry.vertices) {
+    if (c.index >= w.pos.size()) throw std::invalid_argument("simplifyMesh: a carried vertex past the mesh's vertices");
+    w.quad[c.index] = Quadric::unpacked(c.quadric);
+    w.moved[c.index] = c.moved;
+  }
+  w.tris = mesh.triangles;
+  w.level.assign(w.tris.size(), -1);
+  w.made.assign(w.tris.size(), 0);
+  if (!mesh.carry.triangles.empty()) {
+    if (mesh.carry.triangles.size() != w.tris.size())
+      throw std::invalid_argument("simplifyMesh: the carried triangle states do not match the triangles");
+    for (size_t t = 0; t < w.tris.size(); ++t) {
+      w.level[t] = int8_t((mesh.carry.triangles[t] & 0x7f) - 1);
+      w.made[t] = (mesh.carry.triangles[t] & 0x80) != 0;
+    }
+  }
+  return w;
+}
+
+// The inverse of workOf for a region's piece: the carry lists what the next passes need.
+void carryOf(const Work& w, SimplifyCarry& carry) {
+  carry.vertices.clear();
+  for (uint32_t v = 0; v < w.pos.size(); ++v) {
+    const Quadric& q = w.quad[v];
+    if (q.weight == 1 && !w.moved[v]) continue;  // its own tangent plane: workOf rebuilds it
+    carry.vertices.push_back({v, q.packed(), uint8_t(w.moved[v] ? 1 : 0)});
+  }
+  carry.triangles.resize(w.tris.size());
+  for (size_t t = 0; t < w.tris.size(); ++t) carry.triangles[t] = uint8_t((w.level[t] + 1) | (w.made[t] ? 0x80 : 0));
+}
+
+class Simplifier {
+ public:
+  Simplifier(Work&& work, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt)
+      : w_(std::move(work)), tape_(tape), grid_(grid), opt_(opt), tol_(opt.tolerance * grid.voxel) {
+    // Error levels e_k = tol * 2^k up to two voxels (or the tolerance if larger): a replaced
+    // triangle allows its new ones at most that much error, however far its own chord was (the
+    // mesher's chords across a crease can be most of a voxel deep).
+    while (std::ldexp(tol_, maxLevel_ + 1) <= std::max(tol_, grid_.voxel) * (1 + 1e-12)) ++maxLevel_;
+    if (tape_->numVars() > 3 && opt_.fixedCoords.size() < tape_->numVars() - 3)
+      throw std::invalid_argument("simplifyMesh: the model has " + std::to_string(tape_->numVars()) +
+                                  " coordinates; give values for x[4..] (fixedCoords)");
+  }
+
+  // Collapses until no candidate is left; then work(), vertexAlive() and triangleAlive() hold
+  // the result.
+  const SimplifyStats& run() {
+    setUp();
+    while (!queue_.empty()) {
+      Candidate c = queue_.top();
+      queue_.pop();
+      if (!alive_[c.a] || !alive_[c.b] || version_[c.a] != c.va || version_[c.b] != c.vb) continue;
+      tryCollapse(c.a, c.b);
+    }
+    int worst = -1;  // over the triangles that collapses made
+    for (uint32_t t = 0; t < w_.tris.size(); ++t)
+      if (tAlive_[t] && w_.made[t]) worst = std::max<int>(worst, w_.level[t]);
+    stats_.errorBound = worst < 0 ? 0 : std::ldexp(tol_, worst);
+    return stats_;
+  }
+  const Work& work() const { return w_; }
+  bool vertexAlive(uint32_t v) const { return alive_[v] && !vtris_[v].empty(); }
+  bool triangleAlive(uint32_t t) const { return tAlive_[t]; }
+
+ private:
+  struct Candidate {
+    double cost, length2;
+    uint32_t a, b, va, vb;
+    bool operator>(const Candidate& o) const {
+      if (cost != o.cost) return cost > o.cost;
+      if (length2 != o.length2) return length2 > o.length2;
+      return a != o.a ? a > o.a : b > o.b;
+    }
+  };
+
+  void setUp() {
+    const size_t nv = w_.pos.size();
+    alive_.assign(nv, 1);
+    version_.assign(nv, 0);
+    vtris_.assign(nv, {});
+    qpos_.resize(nv);
+    for (size_t v = 0; v < nv; ++v) qpos_[v] = quantise(w_.pos[v]);
+    tAlive_.assign(w_.tris.size(), 1);
+    probe_.resize(w_.tris.size());
+    for (uint32_t t = 0; t < w_.tris.size(); ++t) {
+      for (uint32_t v : w_.tris[t]) vtris_[v].push_back(t);
+      insertBuckets(t);
+    }
+    for (uint32_t t = 0; t < w_.tris.size(); ++t)
+      for (int c = 0; c < 3; ++c) {
+        uint32_t a = w_.tris[t][c], b = w_.tris[t][(c + 1) % 3];
+        // Each undirected edge once (in a closed mesh; a block's open rim is locked anyway).
+        if (a < b || !std::count(vtris_[b].begin(), vtris_[b].end(), t)) pushCandidate(a, b);
+      }
+  }
+
+  // ---- positions ------------------------------------------------------------------------
+  exact::P quantise(const V3& p) const {
+    exact::P q;
+    for (int k = 0; k < 3; ++k) q[k] = std::llround((p[k] - grid_.origin[k]) / grid_.voxel * kQuantum);
+    return q;
+  }
+
+  V3 placement(uint32_t a, uint32_t b, double* cost) const {
+    Quadric q = w_.quad[a];
+    q += w_.quad[b];
+    const V3 &pa = w_.pos[a], &pb = w_.pos[b];
+    double ca = q(pa), cb = q(pb);
+    V3 best = ca <= cb ? pa : pb;
+    *cost = std::min(ca, cb);
+    if (opt_.sharpFeatures) {
+      V3 mid = scale(add(pa, pb), 0.5);
+      V3 p = q.minimiser(mid);
+      double reach = std::max(norm(sub(pa, pb)), grid_.voxel);
+      double cp = q(p);
+      bool inside = true;
+      for (int k = 0; k < 3 && w_.confined; ++k) inside = inside && p[k] >= w_.regionLo[k] && p[k] <= w_.regionHi[k];
+      if (inside && norm(sub(p, mid)) <= reach && std::isfinite(cp) && cp <= *cost) {
+        *cost = cp;
+        best = p;
+      }
+    }
+    return best;
+  }
+
+  void pushCandidate(uint32_t a, uint32_t b) {
+    if (w_.locked[a] || w_.locked[b]) return;
+    if (a > b) std::swap(a, b);
+    double cost;
+    placement(a, b, &cost);
+    // Mean squared distance to the tangent planes above tol^2: the merged vertex cannot sit on
+    // all of them within the tolerance; not worth the model evaluations.
+    if (cost > tol_ * tol_ * (w_.quad[a].weight + w_.quad[b].weight)) return;
+    // Costs below 1e-6 tol^2 count as equal: then shorter edges first (even coarsening).
+    double key = std::floor(cost / (1e-6 * tol_ * tol_));
+    queue_.push({key, dot(sub(w_.pos[a], w_.pos[b]), sub(w_.pos[a], w_.pos[b])), a, b, version_[a], version_[b]});
+  }
+
+  // ---- spatial hash of triangles (for the self-intersection check) ------------------------
+  std::array<int32_t, 6> cellRange(const V3& a, const V3& b, const V3& c) const {
+    std::array<int32_t, 6> r;
+    const double s = kBucketVoxels * grid_.voxel;
+    for (int k = 0; k < 3; ++k) {
+      double lo = std::min({a[k], b[k], c[k]}) - grid_.origin[k], hi = std::max({a[k], b[k], c[k]}) - grid_.origin[k];
+      const double margin = 1e-3 * grid_.voxel;  // far above the quantisation step
+      r[k] = int32_t(std::floor((lo - margin) / s));
+      r[k + 3] = int32_t(std::floor((hi + margin) / s));
+    }
+    return r;
+  }
+  static uint64_t cellKey(int32_t x, int32_t y, int32_t z) {
+    return (uint64_t(uint32_t(x + (1 << 20)) & 0x1fffff) << 42) | (uint64_t(uint32_t(y + (1 << 20)) & 0x1fffff) << 21) |
+           uint64_t(uint32_t(z + (1 << 20)) & 0x1fffff);
+  }
+  // Calls f(key) for the cells of the range that the triangle abc may touch: all of them for a
+  // small range, else those passing a conservative separating-axis test (the triangle's plane
+  // and the nine edge x axis directions, the cell grown by a margin), so a large tilted
+  // triangle is filed under the cells along its surface, not every cell of its box.
+  template <typename F>
+  void forTriangleCells(const V3& a, const V3& b, const V3& c, F&& f) const {
+    const std::array<int32_t, 6> r = cellRange(a, b, c);
+    const int64_t count = int64_t(r[3] - r[0] + 1) * (r[4] - r[1] + 1) * (r[5] - r[2] + 1);
+    const double s = kBucketVoxels * grid_.voxel, h = 0.5 * s + 1e-3 * grid_.voxel;
+    const V3 e[3] = {sub(b, a), sub(c, b), sub(a, c)};
+    const V3 n = cross(e[0], e[2]);
+    for (int32_t x = r[0]; x <= r[3]; ++x)
+      for (int32_t y = r[1]; y <= r[4]; ++y)
+        for (int32_t z = r[2]; z <= r[5]; ++z) {
+          if (count > 8) {
+            const V3 cc{grid_.origin[0] + (x + 0.5) * s, grid_.origin[1] + (y + 0.5) * s, grid_.origin[2] + (z + 0.5) * s};
+            const V3 v[3] = {sub(a, cc), sub(b, cc), sub(c, cc)};
+            auto separated = [&](const V3& axis) {
+              double p0 = dot(axis, v[0]), p1 = dot(axis, v[1]), p2 = dot(axis, v[2]);
+              double rad = h * (std::abs(axis[0]) + std::abs(axis[1]) + std::abs(axis[2]));
+              return std::min({p0, p1, p2}) > rad * (1 + 1e-9) || std::max({p0, p1, p2}) < -rad * (1 + 1e-9);
+            };
+            bool apart = separated(n);
+            for (int i = 0; i < 3 && !apart; ++i)
+              apart = separated({0, -e[i][2], e[i][1]}) || separated({e[i][2], 0, -e[i][0]}) ||
+                      separated({-e[i][1], e[i][0], 0});
+            if (apart) continue;
+          }
+          f(cellKey(x, y, z));
+        }
+  }
+  void insertBuckets(uint32_t t) {
+    const Tri& tr = w_.tris[t];
+    const V3 &a = w_.pos[tr[0]], &b = w_.pos[tr[1]], &c = w_.pos[tr[2]];
+    // The entry carries the triangle's box (float, rounded outwards past a 1e-3 voxel margin), so
+    // a query scans its cells' entries in order and touches a triangle only if the boxes meet.
+    Entry e{t, {}, {}};
+    const double margin = 1e-3 * grid_.voxel;
+    for (int k = 0; k < 3; ++k) {
+      e.lo[k] = std::nextafter(float(std::min({a[k], b[k], c[k]}) - margin), -INFINITY);
+      e.hi[k] = std::nextafter(float(std::max({a[k], b[k], c[k]}) + margin), INFINITY);
+    }
+    forTriangleCells(a, b, c, [&](uint64_t k) { buckets_[k].push_back(e); });
+  }
+  // Before any corner of t moves (the same cells as its insertion).
+  void eraseBuckets(uint32_t t) {
+    const Tri& tr = w_.tris[t];
+    forTriangleCells(w_.pos[tr[0]], w_.pos[tr[1]], w_.pos[tr[2]], [&](uint64_t k) {
+      auto it = buckets_.find(k);
+      auto& v = it->second;
+      v.erase(std::find_if(v.begin(), v.end(), [t](const Entry& e) { return e.tri == t; }));
+      if (v.empty()) buckets_.erase(it);
+    });
+  }
+
+  // ---- error against the model --------------------------------------------------------------
+  // Is every sample point p of triangle abc within e = tolerance * 2^level of the surface,
+  // along the normal? Certified when the model changes sign along [p - e d, p + e d] (inside at
+  // the start, outside at the end): the surface crosses it. d is the triangle's normal, or
+  // `primary` (for the mesher's slivers, whose own normal is noise). Measuring along the normal
+  // (not towards the nearest surface point) also keeps chords across a crease out: they are
+  // deeper along their normal than to the nearer face.
+  //
+  // The points come probes first (kProbes points spread over the triangle, where a chord is
+  // deepest), so a caller can test the probes of several triangles before any full check:
+  // [from, to) selects a range of that order.
+  bool withinLevel(const V3& a, const V3& b, const V3& c, int level, const V3* primary = nullptr, size_t from = 0,
+                   size_t to = SIZE_MAX) {
+    const double e = 0.8 * std::ldexp(tol_, level);  // 0.8: a margin for the gaps between samples
+    auto unit = [](V3 d) {
+      double l = norm(d);
+      return l > 0 && std::isfinite(l) ? scale(d, 1 / l) : V3{0, 0, 0};
+    };
+    const V3 d = primary ? unit(*primary) : unit(cross(sub(b, a), sub(c, a)));
+    if (d == V3{0, 0, 0}) return false;
+    double longest = std::max({norm(sub(b, a)), norm(sub(c, b)), norm(sub(a, c))});
+    int m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
+    const V3 u = scale(sub(b, a), 1.0 / m), v = scale(sub(c, a), 1.0 / m);
+    // The centroids of the m^2 sub-triangles (not the corners or edges: on a crease of the
+    // model the sign test along the normal is ill-posed): sub-triangle (i, j, up) has its
+    // centroid at a + (i + 1/3) u + (j + 1/3) v, or (i + 2/3, j + 2/3) when upside down.
+    // Probes first: the sub-triangles holding the centroid and the midpoints between it and
+    // the corners.
+    std::array<int, 3> probes[kProbes];
+    size_t nProbes = 0;
+    const double targets[kProbes][2] = {{m / 3.0, m / 3.0}, {m / 6.0, m / 6.0}, {2 * m / 3.0, m / 6.0}, {m / 6.0, 2 * m / 3.0}};
+    for (const auto& tg : targets) {
+      int i = std::min(int(tg[0]), m - 1), j = std::min(int(tg[1]), m - 1 - i);
+      int up = tg[0] - i + tg[1] - j < 1 || i + j > m - 2 ? 1 : 0;
+      std::array<int, 3> id{i, j, up};
+      if (std::find(probes, probes + nProbes, id) == probes + nProbes) probes[nProbes++] = id;
+    }
+    std::vector<V3>& pts = samplePoints_;
+    pts.clear();
+    size_t index = 0;
+    auto emit = [&](int i, int j, int up) {
+      if (index >= from && index < to) {
+        double o = up ? 1.0 / 3 : 2.0 / 3;
+        pts.push_back(add(a, add(scale(u, i + o), scale(v, j + o))));
+      }
+      ++index;
+    };
+    for (size_t k = 0; k < nProbes; ++k) emit(probes[k][0], probes[k][1], probes[k][2]);
+    for (int i = 0; i < m && index < to; ++i)
+      for (int j = 0; i + j < m; ++j)
+        for (int up = 1; up >= 0; --up) {
+          if (!up && i + j > m - 2) continue;
+          if (std::find(probes, probes + nProbes, std::array<int, 3>{i, j, up}) == probes + nProbes) emit(i, j, up);
+        }
+    return crossedAlong(pts, scale(d, e));
+  }
+
+  // Is f(p - d) inside and f(p + d) outside at every point p of `pts`?
+  bool crossedAlong(const std::vector<V3>& pts, const V3& d) {
+    const uint32_t nvars = tape_->numVars();
+    batch_.reserve(*tape_);
+    const size_t perCall = BatchEvaluator<double>::kBatch / 2;
+    for (size_t s = 0; s < pts.size(); s += perCall) {
+      size_t n = std::min(perCall, pts.size() - s);
+      for (size_t i = 0; i < n; ++i)
+        for (int side = 0; side < 2; ++side) {
+          V3 q = side == 0 ? sub(pts[s + i], d) : add(pts[s + i], d);
+          for (uint32_t k = 0; k < nvars; ++k) batch_.in(k)[2 * i + side] = k < 3 ? q[k] : opt_.fixedCoords[k - 3];
+        }
+      const double* f = batch_.eval(*tape_, 2 * n);
+      stats_.modelEvals += 2 * n;
+      for (size_t i = 0; i < n; ++i)
+        if (std::signbit(f[2 * i]) || !std::signbit(f[2 * i + 1])) return false;
+    }
+    return true;
+  }
+
+  // The first level from k up to maxK at which the triangle's probes pass (maxK + 1: none).
+  int probeLevel(const V3& a, const V3& b, const V3& c, int k, int maxK, const V3* primary = nullptr) {
+    while (k <= maxK && !withinLevel(a, b, c, k, primary, 0, kProbes)) ++k;
+    return k;
+  }
+  // The first level from the probes' level `k` up to maxK at which every point passes (maxK + 1:
+  // none). A level is fully checked only once its probes pass (probes failing = the level
+  // fails), so the answer is the same as checking every level in full, for far fewer
+  // evaluations when the triangle's own level is high (small tolerances, crease chords).
+  int fullLevel(const V3& a, const V3& b, const V3& c, int k, int maxK, const V3* primary = nullptr) {
+    while (k <= maxK && !withinLevel(a, b, c, k, primary, kProbes)) k = probeLevel(a, b, c, k + 1, maxK, primary);
+    return k;
+  }
+
+  int levelOf(uint32_t t) {
+    if (w_.level[t] < 0) {
+      const Tri& tr = w_.tris[t];
+      const V3 &a = w_.pos[tr[0]], &b = w_.pos[tr[1]], &c = w_.pos[tr[2]];
+      V3 along = add(w_.normal[tr[0]], add(w_.normal[tr[1]], w_.normal[tr[2]]));
+      const V3* dir = quality(a, b, c) < opt_.minQuality && norm(along) > 0 ? &along : nullptr;
+      const int k = fullLevel(a, b, c, probeLevel(a, b, c, 0, maxLevel_, dir), maxLevel_, dir);
+      w_.level[t] = int8_t(std::min(k, maxLevel_));  // beyond the last level: no more allowance
+    }
+    return w_.level[t];
+  }
+
+  // ---- one collapse ---------------------------------------------------------------------------
+  void tryCollapse(uint32_t a, uint32_t b) {
+    // Link condition: exactly two triangles hold the edge, and a and b have no other common
+    // neighbour; neither opposite vertex may drop below valence 3.
+    // Scratch lists kept between calls (no allocation per attempt).
+    std::vector<uint32_t>&na = scratch_.na, &nb = scratch_.nb, &opposite = scratch_.opposite, &common = scratch_.common,
+                         &changed = scratch_.changed, &removed = scratch_.removed, &ring = scratch_.ring;
+    for (auto* l : {&na, &nb, &opposite, &common, &changed, &removed, &ring}) l->clear();
+    for (uint32_t t : vtris_[a])
+      for (uint32_t v : w_.tris[t])
+        if (v != a) na.push_back(v);
+    for (uint32_t t : vtris_[b]) {
+      bool hasA = false;
+      for (uint32_t v : w_.tris[t]) hasA |= v == a;
+      for (uint32_t v : w_.tris[t])
+        if (v != b) {
+          nb.push_back(v);
+          if (hasA && v != a) opposite.push_back(v);
+        }
+    }
+    std::sort(na.begin(), na.end());
+    na.erase(std::unique(na.begin(), na.end()), na.end());
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
+    std::sort(opposite.begin(), opposite.end());
+    if (opposite.size() != 2 || opposite[0] == opposite[1] || common != opposite || vtris_[opposite[0]].size() <= 3 ||
+        vtris_[opposite[1]].size() <= 3) {
+      ++stats_.rejectedTopology;
+      return;
+    }
+
+    double cost;
+    V3 p = placement(a, b, &cost);
+    // changed: triangles kept with a new corner; removed: the two dropped
+    for (uint32_t v : {a, b})
+      for (uint32_t t : vtris_[v]) {
+        const Tri& tr = w_.tris[t];
+        bool both = (tr[0] == a || tr[1] == a || tr[2] == a) && (tr[0] == b || tr[1] == b || tr[2] == b);
+        if (both) {
+          if (v == a) removed.push_back(t);
+        } else {
+          changed.push_back(t);
+        }
+      }
+    auto corner = [&](uint32_t v) { return v == a || v == b ? p : w_.pos[v]; };
+    auto renamed = [&](const Tri& tr) {
+      Tri r = tr;
+      for (uint32_t& v : r)
+        if (v == b) v = a;
+      return r;
+    };
+
+    // Shape: no flip or fold; below the quality bound, the worst triangle may not get more than
+    // 10% worse (the mesher leaves slivers where the surface grazes grid points; they go first).
+    double worstBefore = 1, worstAfter = 1;
+    for (uint32_t t : removed) worstBefore = std::min(worstBefore, quality(w_.pos[w_.tris[t][0]], w_.pos[w_.tris[t][1]], w_.pos[w_.tris[t][2]]));
+    for (uint32_t t : changed) {
+      const Tri& tr = w_.tris[t];
+      V3 o0 = w_.pos[tr[0]], o1 = w_.pos[tr[1]], o2 = w_.pos[tr[2]];
+      double q0 = quality(o0, o1, o2);
+      worstBefore = std::min(worstBefore, q0);
+      // The direction the triangle must keep facing: its own normal, or for a sliver (whose
+      // normal is noise: the mesher's triangles where the surface grazes a grid point) the
+      // model's normals at its corners.
+      V3 n0 = q0 < opt_.minQuality ? add(w_.normal[tr[0]], add(w_.normal[tr[1]], w_.normal[tr[2]])) : cross(sub(o1, o0), sub(o2, o0));
+      V3 c0 = corner(tr[0]), c1 = corner(tr[1]), c2 = corner(tr[2]);
+      V3 n1 = cross(sub(c1, c0), sub(c2, c0));
+      double l1 = norm(n1);
+      worstAfter = std::min(worstAfter, quality(c0, c1, c2));
+      if (!(l1 > 1e-12 * grid_.voxel * grid_.voxel) || dot(n0, n1) <= 0.2 * norm(n0) * l1) {
+        ++stats_.rejectedShape;
+        return;
+      }
+    }
+    if (worstAfter < opt_.minQuality && worstAfter < 0.9 * worstBefore) {
+      ++stats_.rejectedShape;
+      return;
+    }
+
+    // Error: allowed level = the worst of the replaced triangles (at least the tolerance).
+    int allowed = 0;
+    for (uint32_t t : changed) allowed = std::max(allowed, levelOf(t));
+    for (uint32_t t : removed) allowed = std::max(allowed, levelOf(t));
+    // The probes of every new triangle first (most failing collapses fail there), then the
+    // full check from each triangle's probe level; the outcome does not depend on this order.
+    std::vector<int8_t>& newLevel = scratch_.newLevel;
+    newLevel.assign(changed.size(), 0);
+    for (size_t i = 0; i < changed.size(); ++i) {
+      const Tri& tr = w_.tris[changed[i]];
+      newLevel[i] = int8_t(probeLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), 0, allowed));
+      if (newLevel[i] > allowed) {
+        ++stats_.rejectedError;
+        return;
+      }
+    }
+    for (size_t i = 0; i < changed.size(); ++i) {
+      const Tri& tr = w_.tris[changed[i]];
+      newLevel[i] = int8_t(fullLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), newLevel[i], allowed));
+      if (newLevel[i] > allowed) {
+        ++stats_.rejectedError;
+        return;
+      }
+    }
+    // The removed vertices stay within the allowed error of the new triangles.
+    const double e = std::ldexp(tol_, allowed);
+    for (uint32_t v : {a, b}) {
+      double d = INFINITY;
+      for (uint32_t t : changed) {
+        const Tri& tr = w_.tris[t];
+        d = std::min(d, pointTriangleDistance(w_.pos[v], corner(tr[0]), corner(tr[1]), corner(tr[2])));
+      }
+      if (d > e) {
+        ++stats_.rejectedError;
+        return;
+      }
+    }
+
+    // Self-intersection: the new triangles against each other, then against every other
+    // triangle whose box meets theirs (one pass over the cells of the ring's box).
+    const exact::P qp = quantise(p);
+    auto qcorner = [&](uint32_t v) { return v == a || v == b ? qp : qpos_[v]; };
+    ++stampNow_;
+    for (uint32_t t : changed) probe_[t].skip = stampNow_;
+    for (uint32_t t : removed) probe_[t].skip = stampNow_;
+    std::vector<NewTri>& fresh = freshTris_;
+    fresh.clear();
+    V3 ringLo{INFINITY, INFINITY, INFINITY}, ringHi{-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t t : changed) {
+      const Tri& tr = w_.tris[t];
+      NewTri n{renamed(tr), {qcorner(tr[0]), qcorner(tr[1]), qcorner(tr[2])}, corner(tr[0]), corner(tr[0])};
+      for (int c = 1; c < 3; ++c)
+        for (int k = 0; k < 3; ++k) n.lo[k] = std::min(n.lo[k], corner(tr[c])[k]), n.hi[k] = std::max(n.hi[k], corner(tr[c])[k]);
+      for (int k = 0; k < 3; ++k) ringLo[k] = std::min(ringLo[k], n.lo[k]), ringHi[k] = std::max(ringHi[k], n.hi[k]);
+      fresh.push_back(n);
+    }
+    for (size_t i = 0; i < fresh.size(); ++i)
+      for (size_t j = i + 1; j < fresh.size(); ++j)
+        if (improperPair(fresh[i].t, fresh[i].q, fresh[j].t, fresh[j].q)) {
+          ++stats_.rejectedIntersection;
+          return;
+        }
+    bool bad = false;
+    ++probeNow_;
+    const std::array<int32_t, 6> range = cellRange(ringLo, ringHi, ringHi);
+    for (int32_t x = range[0]; x <= range[3] && !bad; ++x)
+      for (int32_t y = range[1]; y <= range[4] && !bad; ++y)
+        for (int32_t z = range[2]; z <= range[5] && !bad; ++z) {
+          auto it = buckets_.find(cellKey(x, y, z));
+          if (it == buckets_.end()) continue;
+          for (const Entry& e : it->second) {
+            // Disjoint boxes: no contact, not even a shared vertex.
+            if (e.hi[0] < ringLo[0] || e.lo[0] > ringHi[0] || e.hi[1] < ringLo[1] || e.lo[1] > ringHi[1] ||
+                e.hi[2] < ringLo[2] || e.lo[2] > ringHi[2])
+              continue;
+            Probe& pr = probe_[e.tri];
+            if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
+            pr.seen = probeNow_;
+            const Tri& tu = w_.tris[e.tri];
+            const std::array<exact::P, 3> qu{qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]};
+            for (const NewTri& n : fresh) {
+              if (e.hi[0] < n.lo[0] || e.lo[0] > n.hi[0] || e.hi[1] < n.lo[1] || e.lo[1] > n.hi[1] || e.hi[2] < n.lo[2] ||
+                  e.lo[2] > n.hi[2])
+                continue;
+              if (improperPair(n.t, n.q, tu, qu)) {
+                bad = true;
+                break;
+              }
+            }
+            if (bad) break;
+          }
+        }
+    if (bad) {
+      ++stats_.rejectedIntersection;
+      return;
+    }
+
+    // Apply.
+    for (uint32_t t : removed) {
+      eraseBuckets(t);
+      tAlive_[t] = 0;
+      for (uint32_t v : w_.tris[t]) {
+        auto& l = vtris_[v];
+        l.erase(std::find(l.begin(), l.end(), t));
+      }
+    }
+    for (uint32_t t : changed) eraseBuckets(t);
+    for (uint32_t t : vtris_[b]) {
+      for (uint32_t& v : w_.tris[t])
+        if (v == b) v = a;
+      vtris_[a].push_back(t);
+    }
+    vtris_[b].clear();
+    alive_[b] = 0;
+    if (p == w_.pos[b]) {  // stayed at b: a takes b's identity (its key and normal)
+      w_.key[a] = w_.key[b];
+      w_.normal[a] = w_.normal[b];
+      w_.moved[a] = w_.moved[b];
+    } else if (p != w_.pos[a]) {
+      w_.moved[a] = 1;
+    }
+    w_.pos[a] = p;
+    qpos_[a] = qp;
+    w_.quad[a] += w_.quad[b];
+    ++version_[a];
+    for (size_t i = 0; i < changed.size(); ++i) {
+      w_.level[changed[i]] = newLevel[i];
+      w_.made[changed[i]] = 1;
+      insertBuckets(changed[i]);
+    }
+    ++stats_.collapses;
+    for (uint32_t t : vtris_[a])
+      for (uint32_t v : w_.tris[t])
+        if (v != a) ring.push_back(v);
+    std::sort(ring.begin(), ring.end());
+    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+    for (uint32_t v : ring) pushCandidate(a, v);
+  }
+
+  // ---- output -------------------------------------------------------------------------------
+ public:
+  // The mesh: vertices in the order of their keys (as the mesher orders them), triangles by
+  // index triple rotated to start at the smallest.
+  Mesh output(const MeshStats& stats) {
+    const size_t nv = w_.pos.size();
+    std::vector<uint32_t> order;
+    for (uint32_t v = 0; v < nv; ++v)
+      if (alive_[v] && !vtris_[v].empty()) order.push_back(v);
+    std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return w_.key[x] != w_.key[y] ? w_.key[x] < w_.key[y] : x < y; });
+    std::vector<uint32_t> index(nv, UINT32_MAX);
+    Mesh out;
+    out.stats = stats;
+    GradientEvaluator grad;
+    std::vector<double> x(std::max<uint32_t>(tape_->numVars(), 3)), g(x.size());
+    for (uint32_t v : order) {
+      index[v] = uint32_t(out.positions.size());
+      out.positions.push_back(w_.pos[v]);
+      out.keys.push_back(w_.key[v]);
+      V3 n = w_.normal[v];
+      V3 fan{0, 0, 0};  // area-weighted normal of the triangles around the vertex
+      for (uint32_t t : vtris_[v]) {
+        const Tri& tr = w_.tris[t];
+        fan = add(fan, cross(sub(w_.pos[tr[1]], w_.pos[tr[0]]), sub(w_.pos[tr[2]], w_.pos[tr[0]])));
+      }
+      if (w_.moved[v] || dot(n, fan) <= 0) {
+        // Outward = -grad f; at an edge or a corner of the model the gradient is one face's (or
+        // undefined), and a kept vertex near a corner may now carry triangles of several faces:
+        // then the fan's normal.
+        for (uint32_t k = 0; k < x.size(); ++k) x[k] = k < 3 ? w_.pos[v][k] : opt_.fixedCoords[k - 3];
+        grad.eval(*tape_, x.data(), g.data());
+        V3 gn{-g[0], -g[1], -g[2]};
+        double lg = norm(gn), lf = norm(fan);
+        if (lg > 0 && std::isfinite(lg) && lf > 0 && dot(gn, fan) > 0.9 * lg * lf)
+          n = scale(gn, 1 / lg);
+        else if (lf > 0)
+          n = scale(fan, 1 / lf);
+      }
+      out.normals.push_back(n);
+    }
+    for (uint32_t t = 0; t < w_.tris.size(); ++t) {
+      if (!tAlive_[t]) continue;
+      Tri r{index[w_.tris[t][0]], index[w_.tris[t][1]], index[w_.tris[t][2]]};
+      canonicalRotate(r);
+      out.triangles.push_back(r);
+    }
+    std::sort(out.triangles.begin(), out.triangles.end());
+    return out;
+  }
+
+ private:
+
+  Work w_;
+  TapePtr tape_;
+  GridSpec grid_;
+  SimplifyOptions opt_;
+  double tol_;
+  SimplifyStats stats_;
+  std::vector<V3> samplePoints_;
+  struct Scratch {
+    std::vector<uint32_t> na, nb, opposite, common, changed, removed, ring;
+    std::vector<int8_t> newLevel;
+  } scratch_;
+  struct NewTri {  // a triangle as a collapse would leave it
+    Tri t;
+    std::array<exact::P, 3> q;  // quantised corners
+    V3 lo, hi;                  // box
+  };
+  std::vector<NewTri> freshTris_;
+  std::vector<exact::P> qpos_;
+  std::vector<char> alive_;
+  std::vector<uint32_t> version_;
+  std::vector<std::vector<uint32_t>> vtris_;
+  std::vector<char> tAlive_;
+  // Per-triangle marks of the self-intersection queries.
+  struct Probe {
+    uint32_t skip = 0;  // == stampNow_: part of the collapse being checked
+    uint32_t seen = 0;  // == probeNow_: already tested in this query
+  };
+  std::vector<Probe> probe_;
+  uint32_t stampNow_ = 0, probeNow_ = 0;
+  struct Entry {
+    uint32_t tri;
+    float lo[3], hi[3];
+  };
+  std::unordered_map<uint64_t, std::vector<Entry>> buckets_;
+  std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue_;
+  BatchEvaluator<double> batch_;
+  int maxLevel_ = 0;  // the last error level
+};
+
+constexpr int kBlockVoxels = 32;  // the block passes' blocks (fixed in index space)
+constexpr int kShift[2] = {0, kBlockVoxels / 2};  // the second pass's blocks straddle the first's faces
+using BlockKey = std::array<int32_t, 3>;
+
+// The cells of block b of pass `pass` along one axis, clipped to the grid's cells.
+std::pair<int64_t, int64_t> blockCells(int32_t b, int pass, int64_t cells) {
+  const int64_t lo = int64_t(b) * kBlockVoxels - kShift[pass];
+  return {std::max<int64_t>(0, lo), std::min(cells, lo + kBlockVoxels)};
+}
+
+// Does the simplification of the region [lo, hi) of cells (simplifyRegion) do block b of
+// `pass`? A first-pass block when its cells lie in the region; a second-pass block when, in
+// addition, every first-pass block it meets does (so it sees the same mesh as it would after
+// the whole first pass).
+bool regionDoes(const BlockKey& b, int pass, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi,
+                const std::array<int64_t, 3>& cells) {
+  for (int k = 0; k < 3; ++k) {
+    auto [c0, c1] = blockCells(b[k], pass, cells[k]);
+    if (c0 >= c1 || c0 < lo[k] || c1 > hi[k]) return false;
+    if (pass == 1)
+      for (int64_t cell : {c0, c1 - 1}) {
+        auto [f0, f1] = blockCells(int32_t(cell / kBlockVoxels), 0, cells[k]);
+        if (f0 < lo[k] || f1 > hi[k]) return false;
+      }
+  }
+  return true;
+}
+
+std::array<int64_t, 3> gridCells(const GridSpec& grid) {
+  return {grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1};
+}
+
+// Did the farm's bricks of `brick` cells (simplifyRegion on each) do block b of `pass`? The
+// brick holding the block's first cell decides.
+bool bricksDid(const BlockKey& b, int pass, int brick, const std::array<int64_t, 3>& cells) {
+  if (brick <= 0) return false;
+  std::array<int64_t, 3> lo, hi;
+  for (int k = 0; k < 3; ++k) {
+    const int64_t c0 = blockCells(b[k], pass, cells[k]).first;
+    lo[k] = c0 / brick * brick;
+    hi[k] = std::min(cells[k], lo[k] + brick);
+  }
+  return regionDoes(b, pass, lo, hi, cells);
+}
+
+// A block pass, in parallel: the grid's index space, shifted by kShift[pass], is cut into
+// fixed blocks of kBlockVoxels (so the cut does not depend on the farm's bricks). A vertex
+// belongs to its block if it and every neighbour lie inside the block shrunk by a voxel; each
+// block simplifies the triangles around its own vertices, with the other vertices locked,
+// placements confined to the shrunk block, and every other triangle meeting it as a fixed
+// obstacle. Those triangles are never changed by another block (each block's triangles stay
+// inside its own shrunk box), so the blocks are independent: the result does not depend on the
+// thread count or the order.
+// Only the blocks `mine` accepts are done.
+void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt, int pass,
+               const std::function<bool(const BlockKey&)>& mine, SimplifyStats& stats) {
+  const size_t nv = g.pos.size(), nt = g.tris.size();
+  const double side = kBlockVoxels * grid.voxel, margin = grid.voxel;
+  V3 origin;
+  for (int k = 0; k < 3; ++k) origin[k] = grid.origin[k] - kShift[pass] * grid.voxel;
+  auto blockOf = [&](const V3& p) {
+    BlockKey b;
+    for (int k = 0; k < 3; ++k) b[k] = int32_t(std::floor((p[k] - origin[k]) / side));
+    return b;
+  };
+  auto shrunk = [&](const BlockKey& b, V3& lo, V3& hi) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = origin[k] + b[k] * side + margin;
+      hi[k] = origin[k] + (b[k] + 1) * side - margin;
+    }
+  };
+  auto inside = [](const V3& p, const V3& lo, const V3& hi) {
+    return p[0] > lo[0] && p[0] < hi[0] && p[1] > lo[1] && p[1] < hi[1] && p[2] > lo[2] && p[2] < hi[2];
+  };
+  std::vector<std::vector<uint32_t>> vt(nv);
+  for (uint32_t t = 0; t < nt; ++t)
+    for (uint32_t v : g.tris[t]) vt[v].push_back(t);
+  // Owned vertices by block (ordered: the write-back order is fixed).
+  std::map<BlockKey, std::vector<uint32_t>> owned;
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (vt[v].empty()) continue;
+    BlockKey b = blockOf(g.pos[v]);
+    V3 lo, hi;
+    shrunk(b, lo, hi);
+    bool ok = true;
+    for (uint32_t t : vt[v])
+      for (uint32_t u : g.tris[t]) ok = ok && inside(g.pos[u], lo, hi);
+    if (ok) owned[b].push_back(v);
+  }
+  for (auto it = owned.begin(); it != owned.end();) it = mine(it->first) ? std::next(it) : owned.erase(it);
+  std::vector<BlockKey> blocks;
+  for (auto& [b, vs] : owned) blocks.push_back(b);
+  // Obstacle candidates: every triangle under each block its box meets.
+  std::map<BlockKey, std::vector<uint32_t>> near;
+  for (uint32_t t = 0; t < nt; ++t) {
+    V3 lo = g.pos[g.tris[t][0]], hi = lo;
+    for (uint32_t v : g.tris[t])
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], g.pos[v][k]), hi[k] = std::max(hi[k], g.pos[v][k]);
+    BlockKey a = blockOf(lo), b = blockOf(hi);
+    for (int32_t x = a[0]; x <= b[0]; ++x)
+      for (int32_t y = a[1]; y <= b[1]; ++y)
+        for (int32_t z = a[2]; z <= b[2]; ++z) {
+          auto it = owned.find({x, y, z});
+          if (it != owned.end()) near[{x, y, z}].push_back(t);
+        }
+  }
+
+  // A block writes its own vertices' new state into g at once (no other block reads them) and
+  // keeps its new triangles, appended afterwards in block order.
+  struct Result {
+    std::vector<Tri> tris;  // global vertex ids
+    std::vector<int8_t> level;
+    std::vector<char> made;
+    SimplifyStats stats;
+  };
+  std::vector<Result> results(blocks.size());
+  std::vector<char> vAlive(nv, 1), tAlive(nt, 1);
+  auto solve = [&](size_t i) {
+    const BlockKey& b = blocks[i];
+    Result& r = results[i];
+    const std::vector<uint32_t>& own = owned.at(b);
+    std::vector<uint32_t> active, globalOf;  // the block's triangles; local vertex -> global
+    for (uint32_t v : own) active.insert(active.end(), vt[v].begin(), vt[v].end());
+    std::sort(active.begin(), active.end());
+    active.erase(std::unique(active.begin(), active.end()), active.end());
+    V3 lo, hi;
+    shrunk(b, lo, hi);
+    std::vector<uint32_t> obstacles;
+    for (uint32_t t : near.at(b)) {
+      if (std::binary_search(active.begin(), active.end(), t)) continue;
+      V3 tl = g.pos[g.tris[t][0]], th = tl;
+      for (uint32_t v : g.tris[t])
+        for (int k = 0; k < 3; ++k) tl[k] = std::min(tl[k], g.pos[v][k]), th[k] = std::max(th[k], g.pos[v][k]);
+      if (th[0] >= lo[0] && tl[0] <= hi[0] && th[1] >= lo[1] && tl[1] <= hi[1] && th[2] >= lo[2] && tl[2] <= hi[2])
+        obstacles.push_back(t);
+    }
+    for (uint32_t t : active)
+      for (uint32_t v : g.tris[t]) globalOf.push_back(v);
+    for (uint32_t t : obstacles)
+      for (uint32_t v : g.tris[t]) globalOf.push_back(v);
+    std::sort(globalOf.begin(), globalOf.end());
+    globalOf.erase(std::unique(globalOf.begin(), globalOf.end()), globalOf.end());
+    auto local = [&](uint32_t v) {
+      return uint32_t(std::lower_bound(globalOf.begin(), globalOf.end(), v) - globalOf.begin());
+    };
+    Work w;
+    for (uint32_t v : globalOf) {
+      w.pos.push_back(g.pos[v]);
+      w.normal.push_back(g.normal[v]);
+      w.key.push_back(g.key[v]);
+      w.quad.push_back(g.quad[v]);
+      w.moved.push_back(g.moved[v]);
+      w.locked.push_back(!std::binary_search(own.begin(), own.end(), v));
+    }
+    for (const std::vector<uint32_t>* list : {&active, &obstacles})
+      for (uint32_t t : *list) {
+        w.tris.push_back({local(g.tris[t][0]), local(g.tris[t][1]), local(g.tris[t][2])});
+        w.level.push_back(g.level[t]);
+        w.made.push_back(g.made[t]);
+      }
+    w.confined = true;
+    w.regionLo = lo;
+    w.regionHi = hi;
+    Simplifier s(std::move(w), tape, grid, opt);
+    r.stats = s.run();
+    const Work& out = s.work();
+    for (uint32_t i = 0; i < globalOf.size(); ++i) {
+      if (out.locked[i]) continue;
+      const uint32_t v = globalOf[i];
+      vAlive[v] = s.vertexAlive(i);
+      g.pos[v] = out.pos[i];
+      g.normal[v] = out.normal[i];
+      g.key[v] = out.key[i];
+      g.quad[v] = out.quad[i];
+      g.moved[v] = out.moved[i];
+    }
+    for (uint32_t t : active) tAlive[t] = 0;
+    for (uint32_t t = 0; t < active.size(); ++t) {  // the active triangles come first
+      if (!s.triangleAlive(t)) continue;
+      const Tri& tr = out.tris[t];
+      r.tris.push_back({globalOf[tr[0]], globalOf[tr[1]], globalOf[tr[2]]});
+      r.level.push_back(out.level[t]);
+      r.made.push_back(out.made[t]);
+    }
+  };
+  parallelChunks(blocks.size(), 1, opt.threads, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) solve(i);
+  });
+
+  for (Result& r : results) {
+    g.tris.insert(g.tris.end(), r.tris.begin(), r.tris.end());
+    g.level.insert(g.level.end(), r.level.begin(), r.level.end());
+    g.made.insert(g.made.end(), r.made.begin(), r.made.end());
+    tAlive.resize(g.tris.size(), 1);
+    stats += r.stats;
+    r = Result();
+  }
+  // Compact to the canonical form every pass starts from (vertices by key, triangles rotated
+  // to their smallest index and sorted): a pass then sees the same numbering whether the passes
+  // before it ran here or in the workers, region by region.
+  std::vector<uint32_t> alive, index(nv, UINT32_MAX);
+  for (uint32_t v = 0; v < nv; ++v)
+    if (vAlive[v]) alive.push_back(v);
+  std::sort(alive.begin(), alive.end(), [&](uint32_t x, uint32_t y) { return g.key[x] < g.key[y]; });
+  Work c;
+  for (uint32_t v : alive) {
+    index[v] = uint32_t(c.pos.size());
+    c.pos.push_back(g.pos[v]);
+    c.normal.push_back(g.normal[v]);
+    c.key.push_back(g.key[v]);
+    c.quad.push_back(g.quad[v]);
+    c.moved.push_back(g.moved[v]);
+    c.locked.push_back(0);
+  }
+  std::vector<std::pair<Tri, uint32_t>> order;  // canonical triangle, old index
+  for (uint32_t t = 0; t < g.tris.size(); ++t) {
+    if (!tAlive[t]) continue;
+    Tri r{index[g.tris[t][0]], index[g.tris[t][1]], index[g.tris[t][2]]};
+    canonicalRotate(r);
+    order.push_back({r, t});
+  }
+  std::sort(order.begin(), order.end());
+  for (const auto& [r, t] : order) {
+    c.tris.push_back(r);
+    c.level.push_back(g.level[t]);
+    c.made.push_back(g.made[t]);
+  }
+  g = std::move(c);
+}
+
+}  // namespace
+
+SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options) {
+  SimplifyStats stats;
+  stats.trianglesBefore = stats.trianglesAfter = mesh.triangles.size() + 2 * mesh.carry.counters.collapses;
+  if (!(options.tolerance > 0) || mesh.triangles.empty()) return stats;
+  Work w = workOf(mesh);
+  stats += mesh.carry.counters;  // the regions' share (simplifyRegion in the workers)
+  mesh.carry = SimplifyCarry();
+  // Two block passes, the second's blocks shifted by half a block: what the first leaves along
+  // its block faces lies inside the second's blocks; the global pass finishes the rest. Blocks
+  // the bricks' own simplification did are skipped (the result is the same).
+  const std::array<int64_t, 3> cells = gridCells(grid);
+  for (int pass = 0; pass < 2; ++pass)
+    blockPass(w, tape, grid, options, pass,
+              [&](const BlockKey& b) { return !bricksDid(b, pass, options.bricksSimplified, cells); }, stats);
+  Simplifier second(std::move(w), tape, grid, options);
+  const SimplifyStats& s2 = second.run();
+  stats += s2;
+  stats.errorBound = s2.errorBound;  // over every triangle a collapse made, in either pass
+  mesh = second.output(mesh.stats);
+  stats.trianglesAfter = mesh.triangles.size();
+  return stats;
+}
+
+void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options,
+                    const std::array<int32_t, 3>& lo, const std::array<int32_t, 3>& hi) {
+  if (!(options.tolerance > 0) || piece.triangles.empty()) return;
+  Mesh m;  // the piece as a mesh: its vertices are in key order, its triangles canonical
+  for (const MeshVertex& v : piece.vertices) {
+    m.positions.push_back(v.position);
+    m.normals.push_back(v.normal);
+    m.keys.push_back(v.key);
+  }
+  m.triangles = std::move(piece.triangles);
+  m.carry = std::move(piece.carry);
+  Work w = workOf(m);
+  SimplifyStats stats;
+  const std::array<int64_t, 3> cells = gridCells(grid), rlo{lo[0], lo[1], lo[2]}, rhi{hi[0], hi[1], hi[2]};
+  for (int pass = 0; pass < 2; ++pass)
+    blockPass(w, tape, grid, options, pass, [&](const BlockKey& b) { return regionDoes(b, pass, rlo, rhi, cells); }, stats);
+  piece.vertices.clear();
+  for (size_t v = 0; v < w.pos.size(); ++v) piece.vertices.push_back({w.key[v], w.pos[v], w.normal[v]});
+  SimplifyCarry& c = piece.carry;
+  carryOf(w, c);
+  piece.triangles = std::move(w.tris);
+  c.counters += stats;
+}
+
+}  // namespace frep
