@@ -31,6 +31,7 @@ struct SliceRequest {
   RegionRequest region;
   std::string axis;  // "" = z (3D objects); ignored for 2D objects
   double at = 0.0;   // position of the slicing plane on that axis
+  bool mask = false; // inside/outside only (white/black): tiles an interval decides are not evaluated
 };
 int runSlice(const SliceRequest& request);
 

@@ -70,4 +70,14 @@ RgbImage renderHeatmap(const std::vector<double>& values, int width, int height)
   return image;
 }
 
+RgbImage renderMask(const std::vector<double>& values, int width, int height) {
+  RgbImage img(width, height);
+  for (size_t p = 0; p < values.size(); ++p) {
+    const double v = values[p];
+    const uint8_t g = std::isnan(v) ? 128 : v >= 0.0 ? 255 : 0;
+    img.rgb[3 * p] = img.rgb[3 * p + 1] = img.rgb[3 * p + 2] = g;
+  }
+  return img;
+}
+
 }  // namespace frep::cli

@@ -22,4 +22,8 @@ std::array<uint8_t, 3> rampColour(bool inside, double t);
 // has the smaller |f| of the two (so the line is one pixel wide and hugs the true zero).
 RgbImage renderHeatmap(const std::vector<double>& values, int width, int height);
 
+// Inside (f >= 0) white, outside black, NaN grey: the picture of the solid alone (frep slice
+// --mask), for which pixels in tiles whose sign an interval decided need no evaluation.
+RgbImage renderMask(const std::vector<double>& values, int width, int height);
+
 }  // namespace frep::cli
