@@ -72,6 +72,28 @@ struct MeshRequest {
 };
 int runMesh(const MeshRequest& request);
 
+// frep render: a shaded PNG of the solid by certified interval ray casting (frep/render), in
+// process on threads; turntable (--frames) and x[4] sweep (--t-frames) write numbered frames.
+struct RenderRequest {
+  ModelRequest model;
+  std::string bounds;      // -b: the region drawn (hfp's default ±10); the view fits the solid in it
+  std::string out;         // -O: PNG path (frames: NAME_0000.png, ...)
+  std::string size = "512x512";
+  double azimuth = -60, elevation = 25;  // degrees
+  double distance = 0;     // 0: fit the solid
+  double zoom = 1;         // > 1 magnifies
+  std::string eye, target, up;  // look-at camera (eye given: azimuth/elevation ignored)
+  bool perspective = false;
+  double fov = 30;         // perspective: horizontal field of view, degrees
+  std::string background = "255,255,255", colour = "204,158,97";
+  int frames = 0;          // turntable: N frames over 360 degrees of azimuth
+  int tFrames = 0;         // N frames sweeping x[4] over --t-range
+  std::string tRange = "0,1";
+  int threads = 0;
+  bool noFootprint = false;
+};
+int runRender(const RenderRequest& request);
+
 int runKeygen(const std::string& dir);
 
 }  // namespace frep::cli

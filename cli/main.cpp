@@ -156,11 +156,35 @@ int main(int argc, char** argv) {
   meshCmd->add_flag("--no-sharp", mesh.noSharp,
                     "Keep merged vertices on the mesher's vertices instead of the model's edges and corners");
 
+  RenderRequest render;
+  CLI::App* renderCmd = app.add_subcommand("render", "Shaded PNG of a model by certified interval ray casting");
+  addModelOptions(renderCmd, render.model, true);
+  renderCmd->add_option("-b,--bounds", render.bounds, "Region drawn: B | min,max | bx,by,bz | xmin,ymin,zmin,xmax,ymax,zmax (default 10)");
+  renderCmd->add_option("-O,--out", render.out, "Output PNG file (required); frames add _0000, _0001, ...");
+  renderCmd->add_option("--size", render.size, "Image size WxH in pixels (default 512x512)");
+  renderCmd->add_option("--azimuth", render.azimuth, "Camera azimuth in degrees, from +x towards +y (default -60)");
+  renderCmd->add_option("--elevation", render.elevation, "Camera elevation in degrees above the xy plane (default 25)");
+  renderCmd->add_option("--distance", render.distance, "Camera distance from the target (default: fit the solid)");
+  renderCmd->add_option("--zoom", render.zoom, "Magnification of the fitted view (default 1)");
+  renderCmd->add_option("--eye", render.eye, "Look-at camera: eye position x,y,z (instead of azimuth/elevation)");
+  renderCmd->add_option("--target", render.target, "Point looked at, x,y,z (default: the centre of the solid's box)");
+  renderCmd->add_option("--up", render.up, "Up direction of the image, x,y,z (default 0,0,1)");
+  renderCmd->add_flag("--perspective", render.perspective, "Perspective projection (default orthographic)");
+  renderCmd->add_option("--fov", render.fov, "Perspective: horizontal field of view in degrees (default 30)");
+  renderCmd->add_option("--background", render.background, "Background r,g,b (0-255) or #rrggbb (default white)");
+  renderCmd->add_option("--colour,--color", render.colour, "Surface colour r,g,b (0-255) or #rrggbb");
+  renderCmd->add_option("--frames", render.frames, "Turntable: N frames turning the azimuth through 360 degrees");
+  renderCmd->add_option("--t-frames", render.tFrames, "N frames sweeping x[4] over --t-range (geometric type t: animation)");
+  renderCmd->add_option("--t-range", render.tRange, "first,last value of x[4] for --t-frames (default 0,1)");
+  renderCmd->add_option("--threads", render.threads, "Threads (default 0: all cores; same output)");
+  renderCmd->add_flag("--no-footprint", render.noFootprint,
+                      "Cast centre rays only (sub-pixel features between pixel centres are then not drawn)");
+
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
   keygenCmd->add_option("dir", keygenDir, "Directory for the keys")->required();
 
-  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd}) sub->fallthrough();
+  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, renderCmd}) sub->fallthrough();
 
   try {
     app.parse(argc, argv);
@@ -168,7 +192,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh and keygen";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, render and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
@@ -188,6 +212,10 @@ int main(int argc, char** argv) {
       return runSlice(slice);
     }
     if (keygenCmd->parsed()) return runKeygen(keygenDir);
+    if (renderCmd->parsed()) {
+      checkObjectIsNotAFile(render.model);
+      return runRender(render);
+    }
     if (meshCmd->parsed()) {
       checkObjectIsNotAFile(mesh.model);
       mesh.logLevel = logLevel;
