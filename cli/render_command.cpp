@@ -172,6 +172,12 @@ int runRender(const RenderRequest& r) {
   double totalMs = 0;
   uint64_t intervals = 0, points = 0;
   size_t hitPixels = 0;
+  double pixelStep = 0;  // of the last frame
+  // Every frame's field and the box of the solid over all frames: the view stays put while
+  // the t-sweep's solid changes (and a turntable's box does not depend on the azimuth).
+  std::vector<Expr> fields;
+  std::vector<bool> found;
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (int k = 0; k < frames; ++k) {
     Expr field = first.field;
     if (r.tFrames > 0) {
@@ -179,15 +185,16 @@ int runRender(const RenderRequest& r) {
       m.mapping = "X,Y,Z," + formatNumber(tValues[size_t(k)]);
       field = loadModel(m, true).field;
     }
-    Vec3 lo, hi;
-    const bool found = solidBounds(field, box.lo, box.hi, kBoundsLevels, lo, hi);
-    if (!found) {
-      spdlog::warn("frame {}: the solid has no point in the box; the picture is empty", k);
-      lo = box.lo, hi = box.hi;
-    }
-    for (int i = 0; i < 3; ++i) lo[size_t(i)] = std::max(lo[size_t(i)], box.lo[size_t(i)]), hi[size_t(i)] = std::min(hi[size_t(i)], box.hi[size_t(i)]);
+    Vec3 flo, fhi;
+    found.push_back(solidBounds(field, box.lo, box.hi, kBoundsLevels, flo, fhi));
+    if (!found.back()) spdlog::warn("frame {}: the solid has no point in the box; the picture is empty", k);
+    for (size_t i = 0; i < 3 && found.back(); ++i) lo[i] = std::min(lo[i], flo[i]), hi[i] = std::max(hi[i], fhi[i]);
+    fields.push_back(field);
+  }
+  if (!(lo[0] <= hi[0])) lo = box.lo, hi = box.hi;
+  for (size_t i = 0; i < 3; ++i) lo[i] = std::max(lo[i], box.lo[i]), hi[i] = std::min(hi[i], box.hi[i]);
+  for (int k = 0; k < frames; ++k) {
     const double azimuth = r.azimuth + (r.frames > 0 ? 360.0 * k / r.frames : 0.0);
-    // A turntable fits the solid of all frames: its box does not depend on the azimuth.
     const View view = makeView(r, lo, hi, azimuth, w, h, r.frames > 1);
     RenderOptions opt;
     opt.width = w, opt.height = h, opt.threads = r.threads, opt.footprint = !r.noFootprint;
@@ -196,19 +203,21 @@ int runRender(const RenderRequest& r) {
     AtomicOutput out("-O/--out", path);
     RenderStats stats;
     const auto t0 = std::chrono::steady_clock::now();
-    DepthImage depth = found ? castRays(clipToBox(field, box), view.camera, opt, {}, &stats) : DepthImage{};
-    if (!found) depth.width = w, depth.height = h, depth.hits.assign(size_t(w) * size_t(h), RayHit{});
+    DepthImage depth = found[size_t(k)] ? castRays(clipToBox(fields[size_t(k)], box), view.camera, opt, {}, &stats) : DepthImage{};
+    if (!found[size_t(k)]) depth.width = w, depth.height = h, depth.hits.assign(size_t(w) * size_t(h), RayHit{});
     RgbImage img(w, h);
     img.rgb = shadeImage(depth, view.camera, shade);
     totalMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     writePng(out.tempPath(), img);
     out.commit();
+    pixelStep = 2 * view.camera.halfWidth / w;
     intervals += stats.intervalEvals, points += stats.pointEvals;
     for (const RayHit& hit : depth.hits) hitPixels += hit.kind != RayHit::kNone;
   }
   std::cout << "wrote " << (frames > 1 ? framePath(r.out, 0, frames) + " .. " + framePath(r.out, frames - 1, frames) : r.out)
             << ": " << w << "x" << h << " pixels" << (frames > 1 ? ", " + std::to_string(frames) + " frames" : "")
-            << ", " << hitPixels << " on the solid; " << intervals << " interval and " << points
+            << ", pixel " << formatNumber(pixelStep) << (r.perspective ? " (tangent units)" : "") << ", "
+            << hitPixels << " on the solid; " << intervals << " interval and " << points
             << " point evaluations in " << formatNumber(std::round(totalMs * 10) / 10) << " ms\n";
   return kExitOk;
 }
