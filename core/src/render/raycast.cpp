@@ -25,7 +25,8 @@ constexpr int kTopTile = 32;  // the parallel grain; fixed, so results do not de
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Depth search widths, in pixel footprints at the far end of the range: point checks start at
 // kLeaf; intervals keep splitting to kMinWidth before a box they cannot exclude counts as a hit.
-constexpr double kLeaf = 0.25, kMinWidth = 1.0 / 64, kRootWidth = 1e-4;
+constexpr double kLeaf = 0.25, kMinWidth = 1.0 / 64, kRootWidth = 1e-4, kConfirm = 1.0 / 16;
+constexpr int kConfirmBudget = 256;  // confirming evaluations per pixel
 
 Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -62,7 +63,8 @@ class Caster {
  public:
   Caster(const Camera& cam, const RenderOptions& opt, TapePtr view, TapePtr model, DepthImage& img,
          const std::vector<double>& fixed)
-      : cam_(cam), opt_(opt), view_(std::move(view)), model_(std::move(model)), img_(img), fixed_(fixed) {}
+      : cam_(cam), opt_(opt), view_(std::move(view)), model_(std::move(model)), img_(img), fixed_(fixed),
+        budget_(img.hits.size(), kConfirmBudget) {}
 
   void topTile(Worker& w, int c0, int c1, int r0, int r1) {
     cell(w, c0, c1, r0, r1, opt_.nearDepth, opt_.farDepth, view_);
@@ -123,7 +125,7 @@ class Caster {
       return;
     }
     if (!opt_.footprint || h.kind == RayHit::kFootprint) return;
-    d = footprintSearch(w, *tape, pu, pv, a, b, fp);
+    d = footprintSearch(w, tape, pu, pv, a, b, fp, budget_[size_t(r) * size_t(img_.width) + size_t(c)]);
     if (d < kInf) finish(w, h, RayHit::kFootprint, pu, pv, d);
   }
 
@@ -155,15 +157,40 @@ class Caster {
   }
 
   // First depth slab of width <= kLeaf footprints in which the pixel's footprint may hold a
-  // point of the solid.
-  double footprintSearch(Worker& w, const Tape& tape, double pu, double pv, double a, double b, double fp) {
+  // point of the solid, confirmed by `confirm`.
+  double footprintSearch(Worker& w, const TapePtr& tape, double pu, double pv, double a, double b, double fp,
+                         int& budget) {
     const double half = 0.5 * img_.pixelStep;
-    const Interval iv = evalBox(w, tape, Interval(pu - half, pu + half), Interval(pv - half, pv + half), Interval(a, b));
+    const Interval iv = evalBox(w, *tape, Interval(pu - half, pu + half), Interval(pv - half, pv + half), Interval(a, b));
     if (iv.hi < 0) return kInf;
-    if (b - a <= kLeaf * fp) return 0.5 * (a + b);
+    if (b - a <= kLeaf * fp) {
+      TapePtr pruned = w.interval.pruned(tape);
+      return confirm(w, pruned, pu - half, pu + half, pv - half, pv + half, a, b, fp, budget) ? 0.5 * (a + b) : kInf;
+    }
     const double m = 0.5 * (a + b);
-    const double front = footprintSearch(w, tape, pu, pv, a, m, fp);
-    return front < kInf ? front : footprintSearch(w, tape, pu, pv, m, b, fp);
+    const double front = footprintSearch(w, tape, pu, pv, a, m, fp, budget);
+    return front < kInf ? front : footprintSearch(w, tape, pu, pv, m, b, fp, budget);
+  }
+
+  // Whether some sub-box of the footprint slab, kConfirm footprints wide, is not excluded by
+  // intervals: the over-estimate of interval bounds shrinks with the box, so loose bounds of
+  // a big box do not show as ghost features, while a real sub-pixel feature always keeps one.
+  // When the pixel's budget of evaluations runs out the slab counts as a hit (never miss a feature).
+  bool confirm(Worker& w, const TapePtr& tape, double u0, double u1, double v0, double v1, double a, double b,
+               double fp, int& budget) {
+    if (--budget < 0) return true;
+    const Interval iv = evalBox(w, *tape, Interval(u0, u1), Interval(v0, v1), Interval(a, b));
+    if (iv.hi < 0) return false;
+    if (u1 - u0 <= kConfirm * img_.pixelStep || iv.lo >= 0) return true;
+    TapePtr pruned = w.interval.pruned(tape);
+    const double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1), dm = b - a > kConfirm * fp ? 0.5 * (a + b) : b;
+    for (int k = 0; k < 8; ++k) {
+      if ((k & 4) && dm == b) break;
+      if (confirm(w, pruned, k & 1 ? um : u0, k & 1 ? u1 : um, k & 2 ? vm : v0, k & 2 ? v1 : vm, k & 4 ? dm : a,
+                  k & 4 ? b : dm, fp, budget))
+        return true;
+    }
+    return false;
   }
 
   void finish(Worker& w, RayHit& h, RayHit::Kind kind, double pu, double pv, double d) {
@@ -184,6 +211,7 @@ class Caster {
   TapePtr view_, model_;
   DepthImage& img_;
   const std::vector<double>& fixed_;
+  std::vector<int> budget_;  // per pixel: confirming evaluations left (tiles own their pixels)
 };
 
 }  // namespace
