@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # frep render of the chair at 1024^2 on 2 threads against the mesh pipeline for the same view:
-# frep mesh (sampling + meshing, in-process on 2 threads) at a voxel about one pixel, then
-# POV-Ray of that mesh at 1024^2 (docs/tools/render_ply.py, if povray is installed). Prints
-# wall times and the ratio, measured in this run.
+# frep mesh (sampling + meshing, in-process on 2 threads, --tolerance 0: no simplification) at a
+# voxel about one pixel, then POV-Ray of that mesh at 1024^2 (docs/tools/render_ply.py, if
+# povray is installed). Prints wall times and the ratio, measured in this run.
 #   bench/bench_render.sh [build-dir] [size]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,7 +18,7 @@ t0=$(now)
 "$frep" render examples/chair.hf -b "$bounds" --size "${size}x${size}" --threads 2 -O "$tmp/render.png"
 t1=$(now)
 # The view spans about the box's 3 units over $size pixels: a voxel of one pixel is --res $size.
-"$frep" mesh examples/chair.hf -b "$bounds" --res "$size" --workers 0 --threads 2 --no-progress -O "$tmp/chair.ply"
+"$frep" mesh examples/chair.hf -b "$bounds" --res "$size" --workers 0 --threads 2 --tolerance 0 --no-progress -O "$tmp/chair.ply"
 t2=$(now)
 pov=0
 if command -v povray >/dev/null; then
