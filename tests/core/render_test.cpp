@@ -97,6 +97,28 @@ TEST(Render, PlateThinnerThanAPixelSeenEdgeOnIsNotMissed) {
     }
     EXPECT_TRUE(seen) << "column " << c;
   }
+  // Centre rays alone see nothing: the footprint search is what finds the plate.
+  RenderOptions centreOnly = options(W, H, 1.0, 7.0);
+  centreOnly.footprint = false;
+  EXPECT_EQ(countKind(castRays(plate, cam, centreOnly), RayHit::kNone), size_t(W) * H);
+}
+
+// The same through a perspective frustum: a rod 0.1 pixel footprint thick (at its depth)
+// between two columns of pixel centres.
+TEST(Render, RodThinnerThanAPixelInPerspectiveIsNotMissed) {
+  const int W = 64, H = 48;
+  Camera cam = orbitCamera({0, 0, 0}, -90, 0, 4, true, 0.25);
+  const double step = 2 * 0.25 / W;            // tangent units
+  const double x0 = 4 * (pixelU(cam, W, 40) + 0.5 * step);  // between columns 40 and 41 at depth 4
+  const Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  const Expr dx = x - x0;
+  const Expr rod = min(square(0.05 * 4 * step) - dx * dx - y * y, 0.5 - abs(z));
+  DepthImage img = castRays(rod, cam, options(W, H, 1.0, 8.0));
+  EXPECT_EQ(countKind(img, RayHit::kCentre), 0u);
+  for (int r = 0; r < H; ++r) {
+    if (std::abs(pixelV(cam, W, H, r)) * 4 > 0.45) continue;
+    EXPECT_TRUE(img.at(40, r).kind == RayHit::kFootprint || img.at(41, r).kind == RayHit::kFootprint) << "row " << r;
+  }
 }
 
 // A plate 0.01 pixel thick seen face-on: every centre ray crosses it within a distance far
