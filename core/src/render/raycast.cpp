@@ -25,8 +25,8 @@ constexpr int kTopTile = 32;  // the parallel grain; fixed, so results do not de
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Depth search widths, in pixel footprints at the far end of the range: point checks start at
 // kLeaf; intervals keep splitting to kMinWidth before a box they cannot exclude counts as a hit.
-constexpr double kLeaf = 0.25, kMinWidth = 1.0 / 64, kRootWidth = 1e-4, kConfirm = 1.0 / 16;
-constexpr int kConfirmBudget = 256;  // confirming evaluations per pixel
+constexpr double kLeaf = 0.25, kMinWidth = 1.0 / 64, kRootWidth = 1e-4, kConfirm = 1.0 / 4;
+constexpr int kConfirmBudget = 64;  // confirming evaluations per pixel
 
 Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -125,7 +125,8 @@ class Caster {
       return;
     }
     if (!opt_.footprint || h.kind == RayHit::kFootprint) return;
-    d = footprintSearch(w, tape, pu, pv, a, b, fp, budget_[size_t(r) * size_t(img_.width) + size_t(c)]);
+    // The pixel's cell box is this footprint slab, and the caller found it ambiguous.
+    d = footprintSearch(w, tape, pu, pv, a, b, fp, budget_[size_t(r) * size_t(img_.width) + size_t(c)], true);
     if (d < kInf) finish(w, h, RayHit::kFootprint, pu, pv, d);
   }
 
@@ -159,12 +160,14 @@ class Caster {
   // First depth slab of width <= kLeaf footprints in which the pixel's footprint may hold a
   // point of the solid, confirmed by `confirm`.
   double footprintSearch(Worker& w, const TapePtr& tape, double pu, double pv, double a, double b, double fp,
-                         int& budget) {
+                         int& budget, bool knownAmbiguous = false) {
     const double half = 0.5 * img_.pixelStep;
-    const Interval iv = evalBox(w, *tape, Interval(pu - half, pu + half), Interval(pv - half, pv + half), Interval(a, b));
-    if (iv.hi < 0) return kInf;
+    if (!knownAmbiguous &&
+        evalBox(w, *tape, Interval(pu - half, pu + half), Interval(pv - half, pv + half), Interval(a, b)).hi < 0)
+      return kInf;
     if (b - a <= kLeaf * fp) {
-      TapePtr pruned = w.interval.pruned(tape);
+      // Known ambiguous: `tape` was pruned to this very box by the caller.
+      TapePtr pruned = knownAmbiguous ? tape : w.interval.pruned(tape);
       return confirm(w, pruned, pu - half, pu + half, pv - half, pv + half, a, b, fp, budget) ? 0.5 * (a + b) : kInf;
     }
     const double m = 0.5 * (a + b);
