@@ -75,6 +75,25 @@ TEST(MinMaxForm, ValuePositionsAreLeftAlone) {
   EXPECT_TRUE(minMaxForm(-rUnion(s1, -s2, 0.5)).same(-max(s1, -s2)));
 }
 
+TEST(MinMaxForm, SlabProductsWithConstantSumBecomeMins) {
+  const Expr slab = (X + 1.0) * (1.0 - X);  // p + q = 2: never both negative
+  EXPECT_TRUE(minMaxForm(slab).same(min(X + 1.0, 1.0 - X)));
+  const Expr crossed = (X - 1.0) * (-1.0 - X);  // p + q = -2: both negative on |x| < 1
+  EXPECT_TRUE(minMaxForm(crossed).same(crossed));
+  const Expr notAffineSum = (X - 1.0) * (X - 2.0);  // p + q = 2x - 3
+  EXPECT_TRUE(minMaxForm(notAffineSum).same(notAffineSum));
+  const Expr mixed = (X + 2.0 * Y - 0.5) * (1.5 - X - 2.0 * Y);  // a slab across a diagonal
+  EXPECT_TRUE(minMaxForm(mixed).same(min(X + 2.0 * Y - 0.5, 1.5 - X - 2.0 * Y)));
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> u(-3, 3);
+  PointEvaluator pe;
+  TapePtr a = Tape::compile(mixed, 3), b = Tape::compile(minMaxForm(mixed), 3);
+  for (int i = 0; i < 5000; ++i) {
+    double x[3] = {u(rng), u(rng), u(rng)};
+    EXPECT_EQ(signOf(pe.eval(*a, x)), signOf(pe.eval(*b, x)));
+  }
+}
+
 // A non-convex slab written with HyperFun's sqrt R-functions (hfBlock's (sx &0 sy) &0 sz and
 // '\') summed with a ball: the same set as its R-function search, at a fraction of the cost.
 TEST(MinMaxForm, MinkowskiSumOfRFunctionOperandsKeepsTheSetAndIsCheaper) {

@@ -7,7 +7,9 @@
 // multiplication or division by a positive constant and the branches of a select pass the sign
 // of their operands through, so rewriting beneath them keeps the set f >= 0 and its boundary
 // f = 0 exactly, while anything else (sums, offsets, blends, products of fields) uses values
-// and is left as it is. The value changes: that is the point. The extremum searches (Minkowski
+// and is left as it is. One product is also sign-equivalent to a min: p * q where p + q is a
+// constant >= 0 (HyperFun's slab (x - v)(v + d - x) of hfBlock), since p and q cannot both be
+// negative. The value changes: that is the point. The extremum searches (Minkowski
 // sums, projections, sweeps, offsets) run their operands in this form, where interval bounds
 // and constraint contraction are sharp (min/max of terms) instead of blurred by the sqrt of the
 // R-functions (docs/extremum.md, "Operands in min/max form").
