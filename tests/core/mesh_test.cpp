@@ -313,6 +313,33 @@ TEST(Mesh, ExtremumModelIsSplitInvariant) {
   EXPECT_NEAR(mc::enclosedVolume(whole.positions, whole.triangles), vol, 0.03 * vol);
 }
 
+TEST(Mesh, ExtremumRootsStopAtTheSearchesPrecision) {
+  // Same rounded block: the roots stop once |f| is below 1% of the search's tolerance (the
+  // default), or run every Illinois step (rootStopValue = 0). The same vertices (edge keys)
+  // within a hundredth of a voxel, as many triangles (a quad's diagonal follows the vertices'
+  // positions), far fewer searches.
+  Expr body = remap(blockAt(0, 0, 0, 0.3, 0.3, 0.3), {Expr::x(0) - Expr::x(3), Expr::x(1) - Expr::x(4), Expr::x(2) - Expr::x(5)});
+  ExtremumSpec spec;
+  spec.body = body;
+  spec.inputs = {X(), Y(), Z()};
+  spec.hidden = 3;
+  spec.domain = DomainKind::Ball;
+  spec.radius = 0.2;
+  spec.tolerance = 1e-3;
+  TapePtr tape = Tape::compile(extremum(spec), 3);
+  GridSpec g = cubeGrid(0.8, 15);
+  MeshOptions full;
+  full.rootStopValue = 0.0;
+  Mesh a = meshGrid(tape, g, {}, 0), b = meshGrid(tape, g, full, 0);
+  ASSERT_EQ(a.keys, b.keys);
+  EXPECT_EQ(a.triangles.size(), b.triangles.size());
+  double worst = 0;
+  for (size_t v = 0; v < a.positions.size(); ++v)
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::fabs(a.positions[v][c] - b.positions[v][c]));
+  EXPECT_LT(worst, 0.01 * g.voxel);
+  EXPECT_LT(double(a.stats.rootEvals), 0.8 * double(b.stats.rootEvals));
+}
+
 TEST(Mesh, SelfIntersectionCheckFindsCrossings) {
   // Two triangles crossing each other, one touching another at an interior point, a folded
   // pair sharing an edge, and a clean pair sharing a vertex.

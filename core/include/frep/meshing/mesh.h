@@ -119,6 +119,10 @@ struct MeshOptions {
   std::vector<double> fixedCoords;  // values of x[3], x[4], ... for models of dimension > 3
   int threads = 0;                  // 0: TBB's default; 1: serial (the result is the same)
   int rootIterations = 10;          // Illinois steps per edge after its two end values
+  // An edge's root search stops once |f| <= this. Negative (the default): 1% of the smallest
+  // branch-and-bound tolerance among the model's extremum nodes (0 for models without them):
+  // their searches' values are certified only that far, and each step costs a search.
+  double rootStopValue = -1.0;
   // Roots are kept at least this fraction of the edge away from its ends, so no two vertices
   // coincide and no triangle is degenerate (the surface moves by at most this much).
   double endGuard = 1e-3;
