@@ -108,9 +108,11 @@ int runMesh(const MeshRequest& request) {
   Box box = request.region.bounds.empty() ? Box{} : parseBounds("-b/--bounds", request.region.bounds);
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);
   LoadedModel m = loadModel(request.model, true);
-  if (m.dims != 3)
-    throw badArgs("frep mesh needs a three-dimensional object; '" + m.model.objectName + "' has " +
-                  std::to_string(m.dims) + " coordinate(s) (map them with -x)");
+  // A 1D or 2D object is meshed as frep sample samples it: the slab or prism it is in 3D
+  // (constant along the missing axes), cut by the box.
+  if (m.dims > 3)
+    throw badArgs("frep mesh needs at most three coordinates; '" + m.model.objectName + "' has " +
+                  std::to_string(m.dims) + " (map them with -x, e.g. -x X,Y,Z,0.5)");
   GridSpec grid = makeGrid(box, 3, res);
   for (int a = 0; a < 3; ++a)
     if (grid.dims[a] < 2 || grid.dims[a] >= kMaxMeshGridPoints)

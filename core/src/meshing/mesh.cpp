@@ -506,7 +506,7 @@ class RegionMesher {
           continue;
         }
         if (it > 0 && std::abs(t - prevT[l]) < 1e-10) done[l] = true;
-        if (std::abs(f) <= noise) done[l] = true;
+        if (noise > 0 && std::abs(f) <= noise) done[l] = true;
         prevT[l] = t;
         if (std::isnan(f)) illinois[l] = false;
         if (insideValue(f)) {
