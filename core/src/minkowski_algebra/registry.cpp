@@ -11,9 +11,10 @@ struct Entry {
   ExactTerm term;
 };
 std::mutex gMutex;
+// Never destroyed: its nodes must not outlive the intern table's static destruction.
 std::unordered_map<const Node*, Entry>& table() {
-  static std::unordered_map<const Node*, Entry> t;
-  return t;
+  static auto* t = new std::unordered_map<const Node*, Entry>();
+  return *t;
 }
 }  // namespace
 
