@@ -37,6 +37,7 @@ std::vector<std::string> describeExact(const Expr& f) {
     auto it = table().find(&n);
     if (it == table().end()) return;
     const ExactTerm& t = it->second.term;
+    if (t.kind == ExactTerm::Kind::Sum && t.sum.terms < 2) return;  // a member alone: no operation
     if (t.kind == ExactTerm::Kind::Sum)
       lines.push_back("exact Minkowski algebra (Roerdink): " + t.sum.describe() + " as a union of " +
                       std::to_string(t.pieces) + " primitives, error bound 0 (no search)");

@@ -24,7 +24,7 @@ struct ExactTerm {
 void registerExact(const Expr& e, const ExactTerm& t);
 std::optional<ExactTerm> lookupExact(const Expr& e);
 
-// One line per registered node reachable in f ("exact Minkowski algebra (Roerdink): union of
+// One line per registered sum of two or more members (or chain) reachable in f ("exact Minkowski algebra (Roerdink): union of
 // 28 primitives, error bound 0"), for job reports next to the extremum nodes' bounds.
 std::vector<std::string> describeExact(const Expr& f);
 
