@@ -220,13 +220,20 @@ std::string translateScene(const std::string& text, const std::string& fileName,
   std::string out;
   Cursor c{text, fileName, 0};
   while (c.pos < text.size()) {
-    size_t d = text.find('$', c.pos);
-    if (d == std::string::npos) {
-      out += text.substr(c.pos);
-      break;
+    // POV comments and strings are copied as they are (a '$' in them is not a term).
+    if (text.compare(c.pos, 2, "//") == 0 || text.compare(c.pos, 2, "/*") == 0 || text[c.pos] == '"') {
+      const bool line = text[c.pos + 1] == '/', str = text[c.pos] == '"';
+      size_t e = str ? text.find('"', c.pos + 1) : line ? text.find('\n', c.pos) : text.find("*/", c.pos + 2);
+      e = e == std::string::npos ? text.size() : e + (line ? 0 : str ? 1 : 2);
+      out += text.substr(c.pos, e - c.pos);
+      c.pos = e;
+      continue;
     }
-    out += text.substr(c.pos, d - c.pos);
-    c.pos = d + 1;
+    if (text[c.pos] != '$') {
+      out += text[c.pos++];
+      continue;
+    }
+    ++c.pos;
     out += translateTerm(c, thin);
   }
   return out;

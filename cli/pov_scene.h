@@ -21,7 +21,7 @@ struct PovError : std::runtime_error {
 // a segment, a disc, a rectangle: Remark 6) are drawn `thin` thick.
 std::string povUnion(const minkowski::Reduction& r, double thin);
 
-// Replaces every `$ t1 <+> t2 … $` (sums) and `$ c0 <-> t1 <-> … $` (a block eroded by the
+// Replaces every `$ t1 <+> t2 … $` (sums; not in POV comments or strings) and `$ c0 <-> t1 <-> … $` (a block eroded by the
 // rest, eq. 19–21) of a POV scene by its POV object; terms: xline(l), yline(l), zline(l),
 // xdisc(r), ydisc(r), zdisc(r), sphere(r), block(lx, ly, lz), each optionally followed by its
 // placement `, x, y, z` inside the parentheses. Throws PovError naming file:line:column.
