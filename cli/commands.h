@@ -74,4 +74,14 @@ int runMesh(const MeshRequest& request);
 
 int runKeygen(const std::string& dir);
 
+// frep pov: a scene with `$ ... <+> ... $` Minkowski terms, or a .hf model built from the basic
+// set, as POV-Ray text (Roerdink's preprocessor; docs/pov.md).
+struct PovRequest {
+  std::string input;   // scene text (any extension) or .hf model
+  std::string object;  // -o for a .hf model
+  std::string out;     // -O
+  double thin = 0.01;  // thickness of pieces without interior (segments, discs, rectangles)
+};
+int runPov(const PovRequest& request);
+
 }  // namespace frep::cli

@@ -156,11 +156,19 @@ int main(int argc, char** argv) {
   meshCmd->add_flag("--no-sharp", mesh.noSharp,
                     "Keep merged vertices on the mesher's vertices instead of the model's edges and corners");
 
+  PovRequest pov;
+  CLI::App* povCmd = app.add_subcommand("pov", "POV-Ray scene of Minkowski terms: $ ... <+> ... $ in a scene, or a .hf "
+                                             "model built from the basic set (docs/pov.md)");
+  povCmd->add_option("input", pov.input, "Scene text with $ ... $ terms, or a .hf model")->required();
+  povCmd->add_option("-o,--object", pov.object, "Object of a .hf model (as hfp: default my_model, else the first)");
+  povCmd->add_option("-O,--out", pov.out, "Output POV-Ray file (required)");
+  povCmd->add_option("--thin", pov.thin, "Thickness of pieces without interior: segments, discs (default 0.01)");
+
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
   keygenCmd->add_option("dir", keygenDir, "Directory for the keys")->required();
 
-  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd}) sub->fallthrough();
+  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, povCmd}) sub->fallthrough();
 
   try {
     app.parse(argc, argv);
@@ -168,7 +176,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh and keygen";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
@@ -188,6 +196,7 @@ int main(int argc, char** argv) {
       return runSlice(slice);
     }
     if (keygenCmd->parsed()) return runKeygen(keygenDir);
+    if (povCmd->parsed()) return runPov(pov);
     if (meshCmd->parsed()) {
       checkObjectIsNotAFile(mesh.model);
       mesh.logLevel = logLevel;

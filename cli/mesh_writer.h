@@ -9,7 +9,7 @@
 
 namespace frep::cli {
 
-enum class MeshFormat { Ply, Obj, Stl };
+enum class MeshFormat { Ply, Obj, Stl, Pov };  // Pov: mesh2 declared as frep_mesh (.inc/.pov)
 
 // From the output file's extension (.ply, .obj, .stl; any case). Throws CliError(kExitBadArgs)
 // naming `field`.

@@ -170,6 +170,7 @@ class Master {
   void runInProcess() {
     TapePtr tape = compileJobModel(job_);
     describeErrorBounds(*tape, &report_.errorBounds);
+    for (const std::string& line : describeExactTerms(job_)) report_.errorBounds.push_back(line);
     for (Brick& b : bricks_) {
       if (b.phase == BrickPhase::Done) continue;
       if (gStop) {
@@ -190,6 +191,7 @@ class Master {
   void runFarm() {
     // Compile once here too: a model that does not compile fails before any worker starts.
     describeErrorBounds(*compileJobModel(job_), &report_.errorBounds);
+    for (const std::string& line : describeExactTerms(job_)) report_.errorBounds.push_back(line);
     zmq::context_t ctx(1);
     std::unique_ptr<ZapAuthenticator> zap;
     CurveKeys keys;

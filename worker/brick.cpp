@@ -9,6 +9,7 @@
 
 #include "frep/extremum/extremum.h"
 #include "frep/meshing/mesh_simplify.h"
+#include "frep/minkowski_algebra/registry.h"
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 
@@ -47,7 +48,8 @@ uint64_t jobIdOf(const JobSpec& job) {
   return h;
 }
 
-TapePtr compileJobModel(const JobSpec& job) {
+namespace {
+Expr jobField(const JobSpec& job, uint32_t* dimsOut) {
   lang::CompileOptions opt;
   opt.object = job.object();
   lang::CompileResult r = lang::compile(job.model_source(), job.model_name(), opt);
@@ -67,7 +69,20 @@ TapePtr compileJobModel(const JobSpec& job) {
   if (frep::numVars(f) > 3)
     throw std::runtime_error("the field has " + std::to_string(frep::numVars(f)) +
                              " coordinates: map x[4..] to constants (-x)");
+  *dimsOut = dims;
+  return f;
+}
+}  // namespace
+
+TapePtr compileJobModel(const JobSpec& job) {
+  uint32_t dims = 0;
+  Expr f = jobField(job, &dims);
   return Tape::compile(f, std::min(dims, 3u));
+}
+
+std::vector<std::string> describeExactTerms(const JobSpec& job) {
+  uint32_t dims = 0;
+  return minkowski::describeExact(jobField(job, &dims));
 }
 
 TapePtr ModelCache::get(const JobSpec& job, uint64_t jobId) {
