@@ -73,7 +73,9 @@ struct Brick {
   // suspect; a suspect is leased only alone to a worker that has shown it is alive, and each
   // such worker that dies with it counts; killers.size() >= maxAttempts poisons it.
   bool suspect = false;
-  std::set<std::string> killers;  // worker ids
+  Clock::time_point suspectSince{};
+  std::set<std::string> killers;      // fresh workers (nothing finished) that died with it alone
+  std::set<std::string> weakKillers;  // workers that had finished other bricks
   uint32_t attempts = 0;
   std::map<std::string, Clock::time_point> holders;  // routing id -> lease start
   Clock::time_point firstLease{};
@@ -90,6 +92,7 @@ struct Peer {
   std::set<uint64_t> everHeld;  // a later copy from a former holder is a duplicate, not foreign
   bool proven = false;          // sent something after its hello (it lives past a task)
   bool unreachable = false;     // no route to it: no more tasks (sendTask)
+  uint64_t finished = 0;        // bricks it computed that were merged
 };
 
 class Master {
@@ -184,6 +187,8 @@ class Master {
       report_.domainErrors.add(out.stats.domainErrors);
       report_.extremumSearches += out.extremumSearches;
       report_.extremumUncertified += out.extremumUncertified;
+      for (auto& [rid, p] : peers_)
+        if (p.workerId == who) ++p.finished;
       auto& share = report_.perWorker[who];
       ++share.bricks;
       share.pointEvals += out.stats.pointEvals;
@@ -451,6 +456,13 @@ class Master {
       }
     }
     peers_[rid] = std::move(moved);
+    // What it sent on the old connection while the master was deaf may be lost (it closed
+    // that connection): its leases are issued once more elsewhere, whichever copy comes first.
+    for (uint64_t id : peers_[rid].inflight)
+      if (Brick& b = bricks_[id]; b.phase == BrickPhase::Leased && !b.leaseReissued) {
+        b.leaseReissued = true;
+        reissue_.push_back(id);
+      }
     if (aliases_.size() >= kMaxAliases) aliases_.clear();
     aliases_[oldRid] = rid;
     ++report_.reconnects;
@@ -479,6 +491,7 @@ class Master {
   }
 
   size_t payloadLimit() const { return payloadLimit_; }
+  Clock::duration liveWindow() const { return std::chrono::milliseconds(opt_.heartbeatMs * opt_.liveness); }
 
   static std::string printable(const std::string& rid) {
     std::string s;
@@ -613,21 +626,26 @@ class Master {
 
   // A worker died computing b. Churn (workers that die anyway) must not poison it, a brick
   // that kills its workers must be: the first death only makes b suspect; a suspect is then
-  // leased alone to a worker that has shown it is alive (dispatch), so when that worker dies
-  // b is the common factor and the death counts. maxAttempts distinct workers so killed
-  // poison it. Hello-and-vanish peers never count: they hold no suspect (they never proved
-  // alive) and their first death is not charged.
+  // leased alone to a worker that has shown it is alive, preferably a fresh one that has
+  // finished nothing yet (dispatch), so when that worker dies b is the common factor and the
+  // death counts: maxAttempts distinct fresh workers, or twice as many workers in all, so
+  // killed poison it. A worker that dies on its n-th brick whatever it is (churn) finishes a
+  // suspect given to it fresh. Hello-and-vanish peers never count: they hold no suspect (they
+  // never proved alive) and their first death is not charged.
   void onDeath(Brick& b, const Peer& p) {
     const std::string why = "worker " + p.workerId + " died while computing it";
     if (b.suspect && p.proven && p.inflight.size() == 1) {
-      b.killers.insert(p.workerId);
-      if (int(b.killers.size()) >= opt_.maxAttempts) {
+      (p.finished == 0 ? b.killers : b.weakKillers).insert(p.workerId);
+      if (int(b.killers.size()) >= opt_.maxAttempts ||
+          int(b.killers.size() + b.weakKillers.size()) >= 2 * opt_.maxAttempts) {
         b.lastError = why;
         leased_.erase(b.id);
-        return poison(b, why, std::to_string(b.killers.size()) + " workers died computing it alone");
+        return poison(b, why, std::to_string(b.killers.size() + b.weakKillers.size()) +
+                                  " workers died computing it alone");
       }
     } else if (!b.suspect) {
       b.suspect = true;
+      b.suspectSince = Clock::now();
       ++report_.suspectBricks;
     }
     requeue(b, why, false);
@@ -745,8 +763,12 @@ class Master {
         if (it == peers_.end() || it->second.unreachable || int(it->second.inflight.size()) > round ||
             holdsSuspect(it->second))
           continue;
-        // A suspect brick goes only alone to a worker that has shown it is alive (onDeath).
-        const bool isolates = it->second.proven && it->second.inflight.empty();
+        // A suspect brick goes only alone to a worker that has shown it is alive, a fresh one
+        // unless it has waited two liveness windows for one (onDeath).
+        const Peer& cand = it->second;
+        const bool isolates = cand.proven && cand.inflight.empty() &&
+                              (cand.finished == 0 || suspects_.empty() ||
+                               now - bricks_[suspects_.front()].suspectSince > 2 * liveWindow());
         std::optional<uint64_t> next;
         while (isolates && !suspects_.empty() && !next) {
           uint64_t id = suspects_.front();
