@@ -24,7 +24,7 @@ struct FarmOptions {
   int brickVoxels = 64;          // brick edge, a multiple of 8
   int heartbeatMs = 500;         // both ways
   int liveness = 6;              // missed beats before a peer counts as dead
-  int maxAttempts = 3;           // failures or worker deaths before a brick is poisoned
+  int maxAttempts = 3;           // holder failures, or distinct workers dying with it alone, that poison a brick
   double leaseSeconds = 0;       // re-issue a brick running longer; 0: max(30 s, 10 x median)
   int noWorkerTimeoutSec = 120;  // give up when no worker is alive for this long
   std::string curveDir;          // require CURVE keys (frep keygen)
