@@ -46,6 +46,7 @@ struct FarmRequest {
   bool json = false;         // JSON progress events on stdout
   bool noProgress = false;
   std::string curveDir;
+  bool insecure = false;     // --listen on the network without --curve
 };
 
 struct SampleRequest {

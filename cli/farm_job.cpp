@@ -33,6 +33,10 @@ farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, cons
   if (f.heartbeatMs < 10) throw badArgs("--heartbeat-ms: expected at least 10, got " + std::to_string(f.heartbeatMs));
   if (!f.listen.empty() && f.listen.rfind("tcp://", 0) != 0)
     throw badArgs("--listen: expected tcp://HOST:PORT (e.g. tcp://*:5555), got '" + f.listen + "'");
+  if (!f.listen.empty() && f.curveDir.empty() && !f.insecure && !farm::isLoopbackEndpoint(f.listen))
+    throw badArgs("--listen " + f.listen +
+                  ": without --curve anyone who can reach this address can join the farm and forge results; add "
+                  "--curve DIR (see frep keygen) or, on a trusted network, --insecure");
   if (f.expectWorkers < 0)
     throw badArgs("--expect-workers: expected 0 or more, got " + std::to_string(f.expectWorkers));
   farm::FarmOptions o;
@@ -42,6 +46,7 @@ farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, cons
   o.brickVoxels = f.brick;
   o.heartbeatMs = f.heartbeatMs;
   o.curveDir = f.curveDir;
+  o.insecure = f.insecure;
   o.resume = f.resume;
   o.progressJson = f.json;
   o.progressBar = !f.json && !f.noProgress && ::isatty(2);

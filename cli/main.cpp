@@ -39,7 +39,7 @@ std::string recordedCommandLine(int argc, char** argv) {
   // The output path is left out too: the same grid written anywhere is the same file.
   static const char* execution[] = {"--workers", "--listen", "--expect-workers", "--heartbeat-ms", "--curve",
                                     "--threads", "--log-level", "--brick", "-O", "--out"};
-  static const char* flags[] = {"--resume", "--json", "--no-progress"};
+  static const char* flags[] = {"--resume", "--json", "--no-progress", "--insecure"};
   std::vector<char*> kept;
   for (int i = 0; i < argc; ++i) {
     std::string a = argv[i];
@@ -89,6 +89,8 @@ void addFarmOptions(CLI::App* sub, FarmRequest& f) {
   sub->add_flag("--json", f.json, "JSON progress events on stdout (batch systems)");
   sub->add_flag("--no-progress", f.noProgress, "No progress bar");
   sub->add_option("--curve", f.curveDir, "Require CURVE keys from DIR (see frep keygen)");
+  sub->add_flag("--insecure", f.insecure,
+                "Allow --listen on a non-loopback address without --curve (anyone who reaches it can join)");
 }
 
 void checkObjectIsNotAFile(const ModelRequest& m) {

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <fstream>
@@ -126,6 +127,7 @@ struct WorkerProcess {
 struct MasterThread {
   FarmOutcome outcome;
   std::string error;
+  std::atomic<bool> finished{false};
   std::thread thread;
   std::promise<std::string> bound;
   std::shared_future<std::string> boundFuture = bound.get_future().share();
@@ -139,6 +141,7 @@ struct MasterThread {
         error = e.what();
         if (boundFuture.wait_for(std::chrono::seconds(0)) != std::future_status::ready) bound.set_value("");
       }
+      finished = true;
     });
   }
   std::string endpoint() { return boundFuture.get(); }
