@@ -123,8 +123,20 @@ class ComputeThread {
     if (const char* crash = std::getenv("FREP_TEST_CRASH_BRICK"))
       if (std::strtoull(crash, nullptr, 10) == task.brick_id()) std::abort();
     // Test hook: churn, a worker that dies on whatever brick comes after its first N.
+    // It dies once its earlier results are out (handed to the I/O thread and given time to
+    // leave the socket), so that the bricks it finished count as finished.
     if (const char* n = std::getenv("FREP_TEST_DIE_AFTER"))
-      if (++started_ > std::strtoull(n, nullptr, 10)) std::abort();
+      if (++started_ > std::strtoull(n, nullptr, 10)) {
+        for (int i = 0; i < 300; ++i) {
+          {
+            std::lock_guard<std::mutex> l(mutex_);
+            if (done_.empty()) break;
+          }
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        std::abort();
+      }
     if (const char* slow = std::getenv("FREP_TEST_SLOW_MS"))
       std::this_thread::sleep_for(std::chrono::milliseconds(std::atoi(slow)));
     try {
