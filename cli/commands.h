@@ -8,8 +8,9 @@
 
 namespace frep::cli {
 
-// frep check: diagnostics and the list of objects.
-int runCheck(const ModelRequest& model);
+// frep check: diagnostics and the list of objects; warnings when the model is NaN or a domain
+// error at every point of a small grid over `bounds` (-b text, "" = hfp's ±10).
+int runCheck(const ModelRequest& model, const std::string& bounds = "");
 
 struct EvalRequest {
   ModelRequest model;

@@ -119,6 +119,8 @@ int main(int argc, char** argv) {
   ModelRequest checkModel;
   CLI::App* check = app.add_subcommand("check", "Compile a model: print diagnostics and list its objects");
   addModelOptions(check, checkModel, false);
+  std::string checkBounds;
+  check->add_option("-b,--bounds", checkBounds, "Box sampled for the empty-model warnings (default 10)");
 
   EvalRequest eval;
   CLI::App* evalCmd = app.add_subcommand("eval", "Value, in/on/out and gradient of f at one point");
@@ -176,7 +178,7 @@ int main(int argc, char** argv) {
   try {
     if (check->parsed()) {
       checkObjectIsNotAFile(checkModel);
-      return runCheck(checkModel);
+      return runCheck(checkModel, checkBounds);
     }
     if (evalCmd->parsed()) {
       checkObjectIsNotAFile(eval.model);
