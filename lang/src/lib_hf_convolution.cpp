@@ -233,6 +233,32 @@ Expr convLineR(std::vector<Arg>& a) {
   return min(sum, 1.0) - T;
 }
 
+// frConvPlane(x, p, n, S, T): planes through p_i with normals n_i (Vyatkin-Perturbation lists
+// the plane among the Cauchy kernel's primitives, eq. 7). The kernel over a plane at distance h,
+// in polar coordinates about the foot: 2 pi int rho / (1 + S^2 h^2 + S^2 rho^2)^2 d rho =
+// pi / (S^2 (1 + S^2 h^2)). At hfConvTriangle's scale (S^3 times the area integral) that is
+// pi S / (1 + S^2 h^2): the limit of a growing hfConvTriangle, so the two mix.
+Expr convPlane(std::vector<Arg>& a) {
+  const char* fn = "frConvPlane";
+  Vec3 x = at(coords(fn, a), 0);
+  auto& S = arrayArg(fn, a, 3);
+  std::string per3 = " (3 per element of " + argName(a, 3, "S") + ")";
+  auto& p = arrayExactly(fn, a, 1, 3 * S.size(), per3);
+  auto& n = arrayExactly(fn, a, 2, 3 * S.size(), per3);
+  Expr sum = 0.0;
+  for (size_t i = 0; i < S.size(); ++i) {
+    Vec3 nv = at(n, 3 * i);
+    Expr len2 = norm2(nv);
+    if (len2.isConst() && len2.constValue() == 0.0)
+      throw LibraryError(std::string(fn) + ": normal " + std::to_string(i + 1) + " of " +
+                             argName(a, 2, "n") + " is zero",
+                         2);
+    Expr h = dot3(minus(x, at(p, 3 * i)), nv) / sqrt(len2);
+    sum = sum + kPi * S[i] / (1.0 + S[i] * S[i] * h * h);
+  }
+  return sum - scalarArg(fn, a, 4);
+}
+
 const bool registered = registerAll({
     {"hfConvPoint", "AAAS", "sum 1/(1 + S_i^2 r_i^2)^2 - T", convPoint},
     {"hfConvLine", "AAAAS", "sum of Cauchy kernel integrals over segments b_i -> e_i - T",
@@ -243,6 +269,8 @@ const bool registered = registerAll({
     {"hfConvArc", "AAAAAAAS", "sum of Cauchy kernel integrals over arcs - T", convArc},
     {"hfConvMesh", "AAAAS", "sum of Cauchy kernel integrals over indexed triangles - T",
      convMesh},
+    {"frConvPlane", "AAAAS", "sum pi S_i / (1 + S_i^2 h_i^2) - T: Cauchy kernel over planes",
+     convPlane},
     {"hfConvLineR", "AAAS",
      "min(1, sum of segment integrals, S = 1/R if R < 1 else 1) - field at distance R",
      convLineR},

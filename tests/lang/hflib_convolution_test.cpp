@@ -275,3 +275,25 @@ TEST(HfLibConvolution, LineRFromHyperFunSource) {
               std::min(1.0, lineIntegral({1, 0.7, 0.2}, {0, 0, 0}, {2, 0, 0}, 2)) - T);
   EXPECT_NEAR(frep::lang::testing::evalModel(m, {0, 0, 0.5}), 0.0, 1e-12);
 }
+
+namespace {
+
+// The plane is the limit of a growing triangle: hfConvTriangle over a triangle reaching 1e5
+// around the foot of the point (the tail beyond is below pi / (S R^2) ~ 1e-10).
+TEST(HfLibConvolution, PlaneIsTheLimitOfAGrowingTriangle) {
+  auto x = xyz();
+  auto p = vals({0.3, -0.2, 0.5}), n = vals({0, 0, 2}), S = vals({0.9});
+  Expr f = call("frConvPlane", {arr(x), arr(p), arr(n), arr(S), sc(0.1)});
+  auto big = vals({-1e5, -1e5, 0.5, 3e5, -1e5, 0.5, -1e5, 3e5, 0.5});
+  Expr g = call("hfConvTriangle", {arr(x), arr(big), arr(S), sc(0.1)});
+  for (P3 q : {P3{0, 0, 0.5}, P3{1, 2, 1.7}, P3{-3, 0.4, -0.8}}) {
+    double h = q.z - 0.5;
+    EXPECT_NEAR(at(f, q.x, q.y, q.z), kPi * 0.9 / (1 + 0.81 * h * h) - 0.1, 1e-12);
+    EXPECT_NEAR(at(f, q.x, q.y, q.z), at(g, q.x, q.y, q.z), 1e-7);
+  }
+  auto zero = vals({0, 0, 0});
+  auto err = errorOf("frConvPlane", {arr(x), arr(p), arr(zero, "n"), arr(S), sc(0.1)});
+  EXPECT_EQ(err.first, "frConvPlane: normal 1 of n is zero");
+}
+
+}  // namespace
