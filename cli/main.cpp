@@ -157,6 +157,16 @@ int main(int argc, char** argv) {
   meshCmd->add_flag("--no-sharp", mesh.noSharp,
                     "Keep merged vertices on the mesher's vertices instead of the model's edges and corners");
 
+  RelateRequest relate;
+  CLI::App* relateCmd = app.add_subcommand("relate", "Certified relations of two models: intersection, inclusion, point membership");
+  relateCmd->add_option("a", relate.a.path, "Model A (.hf)")->required();
+  relateCmd->add_option("b", relate.b.path, "Model B (.hf)")->required();
+  relateCmd->add_option("--object-a", relate.a.object, "Object of A (default my_model, else the first)");
+  relateCmd->add_option("--object-b", relate.b.object, "Object of B");
+  relateCmd->add_option("-b,--bounds", relate.bounds, "Box searched (default 10)");
+  relateCmd->add_option("--min-size", relate.minSize, "Smallest box edge of the subdivision (default 1e-4 of the box)");
+  relateCmd->add_option("--at", relate.at, "Also classify the point X,Y,Z against both");
+
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
   keygenCmd->add_option("dir", keygenDir, "Directory for the keys")->required();
@@ -169,7 +179,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh and keygen";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, relate and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
@@ -189,6 +199,7 @@ int main(int argc, char** argv) {
       return runSlice(slice);
     }
     if (keygenCmd->parsed()) return runKeygen(keygenDir);
+    if (relateCmd->parsed()) return runRelate(relate);
     if (meshCmd->parsed()) {
       checkObjectIsNotAFile(mesh.model);
       mesh.logLevel = logLevel;
