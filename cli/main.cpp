@@ -121,6 +121,8 @@ int main(int argc, char** argv) {
   ModelRequest checkModel;
   CLI::App* check = app.add_subcommand("check", "Compile a model: print diagnostics and list its objects");
   addModelOptions(check, checkModel, false);
+  std::string checkBounds;
+  check->add_option("-b,--bounds", checkBounds, "Box sampled for the empty-model warnings (default 10)");
 
   EvalRequest eval;
   CLI::App* evalCmd = app.add_subcommand("eval", "Value, in/on/out and gradient of f at one point");
@@ -165,6 +167,15 @@ int main(int argc, char** argv) {
   povCmd->add_option("-o,--object", pov.object, "Object of a .hf model (as hfp: default my_model, else the first)");
   povCmd->add_option("-O,--out", pov.out, "Output POV-Ray file (required)");
   povCmd->add_option("--thin", pov.thin, "Thickness of pieces without interior: segments, discs (default 0.01)");
+  RelateRequest relate;
+  CLI::App* relateCmd = app.add_subcommand("relate", "Certified relations of two models: intersection, inclusion, point membership");
+  relateCmd->add_option("a", relate.a.path, "Model A (.hf)")->required();
+  relateCmd->add_option("b", relate.b.path, "Model B (.hf)")->required();
+  relateCmd->add_option("--object-a", relate.a.object, "Object of A (default my_model, else the first)");
+  relateCmd->add_option("--object-b", relate.b.object, "Object of B");
+  relateCmd->add_option("-b,--bounds", relate.bounds, "Box searched (default 10)");
+  relateCmd->add_option("--min-size", relate.minSize, "Smallest box edge of the subdivision (default 1e-4 of the box)");
+  relateCmd->add_option("--at", relate.at, "Also classify the point X,Y,Z against both");
 
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
@@ -178,7 +189,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov and keygen";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov, relate and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
@@ -187,7 +198,7 @@ int main(int argc, char** argv) {
   try {
     if (check->parsed()) {
       checkObjectIsNotAFile(checkModel);
-      return runCheck(checkModel);
+      return runCheck(checkModel, checkBounds);
     }
     if (evalCmd->parsed()) {
       checkObjectIsNotAFile(eval.model);
@@ -199,6 +210,7 @@ int main(int argc, char** argv) {
     }
     if (keygenCmd->parsed()) return runKeygen(keygenDir);
     if (povCmd->parsed()) return runPov(pov);
+    if (relateCmd->parsed()) return runRelate(relate);
     if (meshCmd->parsed()) {
       checkObjectIsNotAFile(mesh.model);
       mesh.logLevel = logLevel;

@@ -179,6 +179,12 @@ int runMesh(const MeshRequest& request) {
                             : std::string())
        << "  evaluations: grid points " << s.samplePointEvals << ", root finding " << s.rootEvals << ", gradients "
        << s.gradientEvals << "\n"
+       << "  NaN values " << report.nanValues << (report.nanValues ? " (domain errors, taken as outside)" : "")
+       << ", domain errors " << report.domainErrors.total()
+       << (report.domainErrors.total()
+               ? " (" + report.domainErrors.describe() + "; documented values used, see docs/language.md)"
+               : "")
+       << "\n"
        << "  time " << formatNumber(std::round(meshSeconds * 1000) / 1000) << " s meshing, "
        << formatNumber(std::round(seconds * 1000) / 1000) << " s in all\n"
        << "  " << bricksSummary(report) << "\n"

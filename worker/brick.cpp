@@ -131,6 +131,9 @@ BrickOutput computeBrickOnce(const TapePtr& tape, const JobSpec& job, const std:
     const GridSpec grid = gridOf(job);
     out.piece = meshRegion(tape, grid, lo, hi, mo);
     out.stats.pointEvals = meshPointEvals(out.piece.stats);
+    out.stats.intervalEvals = out.piece.stats.sampleIntervalEvals;
+    out.stats.nanValues = out.piece.stats.nanValues;
+    out.stats.domainErrors = out.piece.stats.domainErrors;
     if (job.mesh().tolerance() > 0) {
       SimplifyOptions so;
       so.tolerance = job.mesh().tolerance();

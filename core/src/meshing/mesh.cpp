@@ -199,6 +199,9 @@ class RegionMesher {
     }
     sampled_ = sample(tape_, grid_, so);
     piece.stats.samplePointEvals = sampled_.stats.pointEvals;
+    piece.stats.sampleIntervalEvals = sampled_.stats.intervalEvals;
+    piece.stats.nanValues = sampled_.stats.nanValues;
+    piece.stats.domainErrors = sampled_.stats.domainErrors;
     for (size_t i = 0; i < sampled_.leaves.size(); ++i) leafIndex_[blockKey(sampled_.leaves[i].origin)] = i;
     for (const Tile& t : sampled_.tiles) tileSign_[tileKey(t.origin, t.size)] = t.inside;
     maxTile_ = 8;

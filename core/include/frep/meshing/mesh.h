@@ -62,6 +62,10 @@ struct MeshStats {
   uint64_t gradientEvals = 0;   // normals
   uint64_t samplePointEvals = 0;  // evaluations of the band sampling (grid points)
   uint64_t fallbackEdges = 0;   // edges whose end values disagreed with their signs (bisection)
+  // The band sampling's: NaN grid values and documented domain-error values. Not in the farm's
+  // mesh payload: workers send them in the result message, as for `frep sample`.
+  uint64_t sampleIntervalEvals = 0, nanValues = 0;
+  DomainCounts domainErrors;
 };
 
 // The simplifier's work counters (mesh_simplify.h), summed over passes, blocks and bricks.
