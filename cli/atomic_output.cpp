@@ -29,15 +29,22 @@ extern "C" void removePendingAndExit(int) {
   ::_exit(kExitInterrupted);
 }
 
+// Installed when the program starts (this file is linked into frep), so that a signal during
+// argument checks or model loading gives the documented code too.
+const bool gHandlersInstalled = [] {
+  struct sigaction sa {};
+  sa.sa_handler = removePendingAndExit;
+  sigemptyset(&sa.sa_mask);
+  sigset_t set;
+  sigemptyset(&set);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr), sigaddset(&set, sig);
+  // A launcher may start us with them blocked (so that none is lost before this point): take them now.
+  sigprocmask(SIG_UNBLOCK, &set, nullptr);
+  return true;
+}();
+
 int trackPending(const std::string& temp) {
-  static const bool installed = [] {
-    struct sigaction sa {};
-    sa.sa_handler = removePendingAndExit;
-    sigemptyset(&sa.sa_mask);
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
-    return true;
-  }();
-  (void)installed;
+  (void)gHandlersInstalled;
   if (temp.size() >= sizeof gPendingTemp[0]) return -1;  // untracked: only a leftover on a signal
   for (int i = 0; i < kSlots; ++i) {
     if (gPending[i]) continue;
