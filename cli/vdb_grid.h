@@ -17,15 +17,3 @@ openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result);
 
 }  // namespace frep::cli
 
-namespace frep::cli {
-
-// The metadata entry frep sample writes last: gridChecksum of the grid as written. frep mesh
-// recomputes it on reading, so a bit flip in the values, masks, tiles, background or transform
-// is found (exit 3) instead of meshed.
-inline constexpr const char* kGridChecksumKey = "frep_grid_checksum";
-
-// 16 hex digits of a 64-bit hash of the grid's background, transform matrix, tiles (level,
-// origin, value, active) and leaves (origin, value mask, values), in the tree's order.
-std::string gridChecksum(const openvdb::FloatGrid& grid);
-
-}  // namespace frep::cli

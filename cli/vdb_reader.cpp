@@ -16,7 +16,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include "vdb_grid.h"
+#include "vdb_checksum.h"
 
 #include "arg_parse.h"
 #include "exit_codes.h"
@@ -75,6 +75,13 @@ class LayoutCheck {
     }
     if (pos_ != b_.size())
       fail(std::to_string(b_.size() - pos_) + " bytes after the last grid (damaged, or not written by OpenVDB)");
+    // frep sample's files are sealed; any frep_ entry without the seal means damaged metadata.
+    if (checksumAt_) {
+      if (b_.compare(checksumAt_, kChecksumDigits, vdbChecksum(b_, checksumAt_)) != 0)
+        fail("the contents do not match " + std::string(kGridChecksumKey) + " (the file is damaged)");
+    } else if (frepMeta_) {
+      fail("frep metadata without " + std::string(kGridChecksumKey) + " (damaged, or written by an older frep: sample again)");
+    }
   }
 
  private:
@@ -110,20 +117,29 @@ class LayoutCheck {
     need(1);
     return uint8_t(b_[pos_++]);
   }
-  void string() { skip(u32()); }
+  std::string string() {
+    const uint32_t n = u32();
+    need(n);
+    pos_ += n;
+    return b_.substr(pos_ - n, n);
+  }
   // OpenVDB's MetaMap: count, then (name, type name, size, value) each; within [pos_, end).
   void metaMap(uint64_t end) {
     const uint32_t count = u32();
     for (uint32_t i = 0; i < count; ++i) {
-      string();
-      string();
-      skip(u32());
+      const std::string name = string(), type = string();
+      const uint32_t size = u32();
+      frepMeta_ = frepMeta_ || name.rfind("frep_", 0) == 0;
+      if (name == kGridChecksumKey && type == "string" && size == kChecksumDigits) checksumAt_ = pos_;
+      skip(size);
       if (pos_ > end) fail("metadata runs past its grid (damaged)");
     }
   }
 
   std::string path_, b_;
   uint64_t pos_ = 0;
+  uint64_t checksumAt_ = 0;  // the checksum's digits, if the file has them
+  bool frepMeta_ = false;
 };
 
 constexpr uint64_t kMaxVdbBytes = uint64_t(16) << 30;  // frep mesh reads at most 16 GiB
@@ -143,39 +159,6 @@ void checkLayout(const std::string& path) {
 }
 
 }  // namespace
-
-std::string gridChecksum(const openvdb::FloatGrid& grid) {
-  uint64_t h = 0xcbf29ce484222325ULL;
-  auto mix = [&h](const void* data, size_t n) {
-    const unsigned char* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ULL;  // FNV-1a, 64 bits
-  };
-  const float background = grid.background();
-  mix(&background, sizeof background);
-  const openvdb::Mat4d m = grid.transform().baseMap()->getAffineMap()->getMat4();
-  mix(m.asPointer(), 16 * sizeof(double));
-  const openvdb::FloatTree& tree = grid.tree();
-  for (auto it = tree.cbeginValueAll(); it; ++it) {
-    if (it.isVoxelValue()) continue;  // leaves below
-    const int32_t level = int32_t(it.getLevel());
-    const openvdb::Coord c = it.getCoord();
-    const float v = *it;
-    const uint8_t on = it.isValueOn();
-    mix(&level, 4), mix(c.data(), 12), mix(&v, 4), mix(&on, 1);
-  }
-  for (auto it = tree.cbeginLeaf(); it; ++it) {
-    mix(it->origin().data(), 12);
-    const auto& mask = it->getValueMask();
-    for (openvdb::Index w = 0; w < mask.WORD_COUNT; ++w) {
-      const uint64_t word = mask.getWord<uint64_t>(w);
-      mix(&word, 8);
-    }
-    mix(it->buffer().data(), it->buffer().size() * sizeof(float));
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  return hex;
-}
 
 SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) {
   openvdb::initialize();
@@ -220,18 +203,6 @@ SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) 
     throw ioError("cannot read VDB '" + path + "': damaged (" + std::string(e.what()) + ")");
   }
   if (!grid) throw ioError("cannot read VDB '" + path + "': grid '" + out.gridName + "' could not be loaded");
-  // frep sample's grids carry a checksum of what they hold; any frep_ entry without it means the
-  // metadata itself was damaged.
-  bool frepMeta = false;
-  for (auto it = grid->beginMeta(); it != grid->endMeta(); ++it) frepMeta = frepMeta || it->first.rfind("frep_", 0) == 0;
-  if (auto sum = grid->getMetadata<openvdb::StringMetadata>(kGridChecksumKey)) {
-    if (sum->value() != gridChecksum(*grid))
-      throw ioError("cannot read VDB '" + path + "': grid '" + out.gridName +
-                    "' does not match its checksum (the file is damaged)");
-  } else if (frepMeta) {
-    throw ioError("cannot read VDB '" + path + "': grid '" + out.gridName + "' has frep metadata but no " +
-                  kGridChecksumKey + " (damaged, or written by an older frep: sample it again)");
-  }
   if (grid->getGridClass() != openvdb::GRID_LEVEL_SET)
     spdlog::warn("{}: grid '{}' is not a level set (class {}); meshing where its values change sign, negative inside",
                  path, out.gridName, openvdb::GridBase::gridClassToString(grid->getGridClass()));

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "exit_codes.h"
+#include "vdb_checksum.h"
 
 #ifndef FREP_VERSION
 #define FREP_VERSION "unknown"
@@ -100,6 +101,19 @@ struct MemoryArchive : openvdb::io::Archive {
   }
 };
 
+// The checksum entry's placeholder digits replaced by the file's checksum (vdb_checksum.h). The
+// entry is found with its length prefixes, which hold NUL bytes no metadata text from argv has.
+void sealChecksum(std::string& bytes) {
+  auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  const std::string key = kGridChecksumKey;
+  const std::string entry = u32(uint32_t(key.size())) + key + u32(6) + "string" + u32(uint32_t(kChecksumDigits)) +
+                            std::string(kChecksumDigits, '0');
+  const size_t at = bytes.find(entry);
+  if (at == std::string::npos) throw openvdb::IoError("the checksum entry is missing from the serialised grid");
+  const size_t digits = at + entry.size() - kChecksumDigits;
+  bytes.replace(digits, kChecksumDigits, vdbChecksum(bytes, digits));
+}
+
 // Every byte handed to the kernel and checked, then fsync and the size read back: a full disk
 // fails here (exit 3) and AtomicOutput never renames a truncated file into place.
 void writeAllOrThrow(const std::string& path, const std::string& bytes) {
@@ -177,12 +191,13 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
   grid->insertMeta("frep_version", openvdb::StringMetadata(FREP_VERSION));
 
   try {
-    grid->insertMeta(kGridChecksumKey, openvdb::StringMetadata(gridChecksum(*grid)));  // last: covers the tree
+    grid->insertMeta(kGridChecksumKey, openvdb::StringMetadata(std::string(kChecksumDigits, '0')));  // sealed below
     MemoryArchive archive;
     uint32_t compression = openvdb::io::COMPRESS_ACTIVE_MASK;
     if (openvdb::io::Archive::hasBloscCompression()) compression |= openvdb::io::COMPRESS_BLOSC;
     archive.setCompression(compression);
     std::string bytes = archive.bytes(openvdb::GridCPtrVec{grid});
+    sealChecksum(bytes);
     makeHeaderDeterministic(bytes);
     writeAllOrThrow(path, bytes);
   } catch (const openvdb::Exception& e) {
