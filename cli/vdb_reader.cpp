@@ -75,13 +75,10 @@ class LayoutCheck {
     }
     if (pos_ != b_.size())
       fail(std::to_string(b_.size() - pos_) + " bytes after the last grid (damaged, or not written by OpenVDB)");
-    // frep sample's files are sealed; any frep_ entry without the seal means damaged metadata.
-    if (checksumAt_) {
-      if (b_.compare(checksumAt_, kChecksumDigits, vdbChecksum(b_, checksumAt_)) != 0)
-        fail("the contents do not match " + std::string(kGridChecksumKey) + " (the file is damaged)");
-    } else if (frepMeta_) {
-      fail("frep metadata without " + std::string(kGridChecksumKey) + " (damaged, or written by an older frep: sample again)");
-    }
+    // frep sample's files are sealed (a tool that rewrites one must drop the seal; unsealed files
+    // get the layout checks only).
+    if (checksumAt_ && b_.compare(checksumAt_, kChecksumDigits, vdbChecksum(b_, checksumAt_)) != 0)
+      fail("the contents do not match " + std::string(kGridChecksumKey) + " (the file is damaged)");
   }
 
  private:
@@ -129,7 +126,6 @@ class LayoutCheck {
     for (uint32_t i = 0; i < count; ++i) {
       const std::string name = string(), type = string();
       const uint32_t size = u32();
-      frepMeta_ = frepMeta_ || name.rfind("frep_", 0) == 0;
       if (name == kGridChecksumKey && type == "string" && size == kChecksumDigits) checksumAt_ = pos_;
       skip(size);
       if (pos_ > end) fail("metadata runs past its grid (damaged)");
@@ -139,7 +135,6 @@ class LayoutCheck {
   std::string path_, b_;
   uint64_t pos_ = 0;
   uint64_t checksumAt_ = 0;  // the checksum's digits, if the file has them
-  bool frepMeta_ = false;
 };
 
 constexpr uint64_t kMaxVdbBytes = uint64_t(16) << 30;  // frep mesh reads at most 16 GiB
