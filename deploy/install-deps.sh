@@ -9,6 +9,7 @@ packages=(
   libprotobuf-dev protobuf-compiler
   libspdlog-dev libtbb-dev libcli11-dev nlohmann-json3-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
+  clang libclang-rt-14-dev
 )
 missing=()
 for p in "${packages[@]}"; do
