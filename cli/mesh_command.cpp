@@ -117,6 +117,7 @@ int runMesh(const MeshRequest& request) {
   for (int a = 0; a < 3; ++a)
     if (grid.dims[a] < 2 || grid.dims[a] >= kMaxMeshGridPoints)
       throw badArgs("--res/-g: the grid needs 2 to " + std::to_string(kMaxMeshGridPoints - 1) + " points per axis");
+  checkJobSize(grid, request.farm.brick);
 
   AtomicOutput out("-O/--out", request.region.out);
   AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");

@@ -27,8 +27,9 @@ int runSample(const SampleRequest& request) {
   Box box = request.region.bounds.empty() ? Box{} : parseBounds("-b/--bounds", request.region.bounds);
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);
   farm::FarmOptions options = farmOptions(request.farm, request.region.out, request.logLevel, request.threads);
-  LoadedModel m = loadModel(request.model, true);
   GridSpec grid = makeGrid(box, 3, res);
+  checkJobSize(grid, request.farm.brick);  // before the model is even read: refused at once
+  LoadedModel m = loadModel(request.model, true);
 
   AtomicOutput out("-O/--out", request.region.out);
   AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");

@@ -16,3 +16,4 @@ namespace frep::cli {
 openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result);
 
 }  // namespace frep::cli
+

@@ -166,13 +166,12 @@ TEST_F(FrepTest, UnwritableOutputIsAnIoErrorAndLeavesNothing) {
   RunResult r = run("slice s.hf --res 16 -O plain/s.png");
   EXPECT_EQ(r.code, 3);
   EXPECT_TRUE(contains(r.err, "frep: error: -O/--out: cannot write 'plain/s.png': Not a directory")) << r.err;
-  // The output is a directory: the image is computed, the final rename fails, the temp goes.
+  // The output is a directory: refused before any work (docs/cli.md: -O is new or a regular file).
   ASSERT_EQ(::mkdir(path("adir").c_str(), 0755), 0);
   RunResult dir = run("sample s.hf --res 16 -O adir");
   EXPECT_EQ(dir.code, 3) << dir.err;
-  EXPECT_TRUE(contains(dir.err, "cannot rename")) << dir.err;
-  // The computed bricks stay in the journal, so that --resume writes the output without work.
-  EXPECT_EQ(listing(), "adir adir.journal plain s.hf");
+  EXPECT_TRUE(contains(dir.err, "'adir' is a directory")) << dir.err;
+  EXPECT_EQ(listing(), "adir plain s.hf");
 }
 
 TEST_F(FrepTest, SliceWritesAHeatMapOfTheRequestedSize) {

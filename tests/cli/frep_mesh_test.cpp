@@ -139,7 +139,7 @@ TEST_F(FrepTest, MeshRejectsBadArguments) {
   } cases[] = {
       {"mesh s.hf --res 16", "-O/--out: the output mesh path"},
       {"mesh s.hf --res 16 -O s.vdb", "-O/--out: 's.vdb' has no mesh extension; use .ply"},
-      {"mesh s.hf --res 16 -O s.ply --brick 12", "--brick: expected a positive multiple of 8"},
+      {"mesh s.hf --res 16 -O s.ply --brick 12", "--brick: expected a multiple of 8 voxels from 8 to 1024"},
       {"mesh s.hf --res 16 -O s.ply --tolerance -0.5", "--tolerance: expected 0 (no simplification) or more voxels"},
       {"mesh s.hf --res 16 -O nodir/s.ply", "-O/--out"},
   };
