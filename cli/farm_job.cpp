@@ -87,11 +87,11 @@ farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, cons
   requireRange("--heartbeat-ms", f.heartbeatMs, 10, 600000);
   requireRange("--expect-workers", f.expectWorkers, 0, kMaxProcesses);
   requireRange("--threads", threads, 0, kMaxProcesses, " (0: all cores)");
+  if (!f.listen.empty()) checkListen(f.listen);
   if (!f.listen.empty() && f.curveDir.empty() && !f.insecure && !farm::isLoopbackEndpoint(f.listen))
     throw badArgs("--listen " + f.listen +
                   ": without --curve anyone who can reach this address can join the farm and forge results; add "
                   "--curve DIR (see frep keygen) or, on a trusted network, --insecure");
-  if (!f.listen.empty()) checkListen(f.listen);
   farm::FarmOptions o;
   o.workers = f.workers;
   o.listen = f.listen;
