@@ -1,7 +1,5 @@
 #include "brick.h"
 
-#include <zlib.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -471,18 +469,6 @@ bool decodePayload(Operation op, const void* data, size_t size, BrickOutput& out
   if (!decodeMeshPiece(data, size, out.piece, error)) return false;
   out.stats.pointEvals = meshPointEvals(out.piece.stats);
   return true;
-}
-
-uint32_t crc32Of(const void* data, size_t size) {
-  uLong c = crc32(0L, Z_NULL, 0);
-  const Bytef* p = static_cast<const Bytef*>(data);
-  while (size > 0) {
-    uInt n = size > (1u << 30) ? (1u << 30) : uInt(size);
-    c = crc32(c, p, n);
-    p += n;
-    size -= n;
-  }
-  return uint32_t(c);
 }
 
 }  // namespace frep::farm

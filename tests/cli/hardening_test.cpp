@@ -20,16 +20,7 @@ class Hardening : public FrepTest {
  protected:
   // As run(), with `prefix` run by bash first (ulimit, trap) and frep exec'd in its place.
   RunResult runWith(const std::string& prefix, const std::string& args) const {
-    std::string script = prefix + "; exec '" FREP_BINARY "' " + args;
-    std::string cmd = "cd '" + dir_ + "' && bash -c \"" + script + "\" >" + path(".out") + " 2>" + path(".err");
-    int status = std::system(cmd.c_str());
-    RunResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = readText(path(".out"));
-    r.err = readText(path(".err"));
-    std::remove(path(".out").c_str());
-    std::remove(path(".err").c_str());
-    return r;
+    return capture("bash -c \"" + prefix + "; exec '" FREP_BINARY "' " + args + "\"");
   }
   bool noTemporaries() const { return listing().find(".tmp") == std::string::npos; }
   std::string sampleArgs(const std::string& out) const {

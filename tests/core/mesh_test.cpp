@@ -288,9 +288,10 @@ TEST(Mesh, RejectsBadRegions) {
   EXPECT_TRUE(empty.triangles.empty());
 }
 
-TEST(Mesh, ExtremumModelIsSplitInvariant) {
-  // Offset of a block by a ball of radius 0.2 (max over u in the ball of block(X - u)):
-  // evaluated by branch and bound, which the root finder runs lane by lane.
+// Offset of a block by a ball of radius 0.2 (max over u in the ball of block(X - u)):
+// evaluated by branch and bound, which the root finder runs lane by lane.
+namespace {
+Expr roundedBlock() {
   Expr body = remap(blockAt(0, 0, 0, 0.3, 0.3, 0.3), {Expr::x(0) - Expr::x(3), Expr::x(1) - Expr::x(4), Expr::x(2) - Expr::x(5)});
   ExtremumSpec spec;
   spec.body = body;
@@ -299,8 +300,12 @@ TEST(Mesh, ExtremumModelIsSplitInvariant) {
   spec.domain = DomainKind::Ball;
   spec.radius = 0.2;
   spec.tolerance = 1e-3;
-  Expr m = extremum(spec);
-  TapePtr tape = Tape::compile(m, 3);
+  return extremum(spec);
+}
+}  // namespace
+
+TEST(Mesh, ExtremumModelIsSplitInvariant) {
+  TapePtr tape = Tape::compile(roundedBlock(), 3);
   GridSpec g = cubeGrid(0.8, 15);
   Mesh whole = meshGrid(tape, g, {}, 0);
   ASSERT_GT(whole.triangles.size(), 100u);
@@ -318,15 +323,7 @@ TEST(Mesh, ExtremumRootsStopAtTheSearchesPrecision) {
   // default), or run every Illinois step (rootStopValue = 0). The same vertices (edge keys)
   // within a hundredth of a voxel, as many triangles (a quad's diagonal follows the vertices'
   // positions), far fewer searches.
-  Expr body = remap(blockAt(0, 0, 0, 0.3, 0.3, 0.3), {Expr::x(0) - Expr::x(3), Expr::x(1) - Expr::x(4), Expr::x(2) - Expr::x(5)});
-  ExtremumSpec spec;
-  spec.body = body;
-  spec.inputs = {X(), Y(), Z()};
-  spec.hidden = 3;
-  spec.domain = DomainKind::Ball;
-  spec.radius = 0.2;
-  spec.tolerance = 1e-3;
-  TapePtr tape = Tape::compile(extremum(spec), 3);
+  TapePtr tape = Tape::compile(roundedBlock(), 3);
   GridSpec g = cubeGrid(0.8, 15);
   MeshOptions full;
   full.rootStopValue = 0.0;

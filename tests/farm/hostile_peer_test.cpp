@@ -67,17 +67,7 @@ struct ScriptedPeer {
   }
   // Envelopes of one kind received within ms, or until count of them arrived.
   std::vector<Envelope> collect(Envelope::BodyCase kind, size_t count, int ms = 5000) {
-    std::vector<Envelope> got;
-    auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
-    while (got.size() < count && std::chrono::steady_clock::now() < deadline) {
-      zmq::pollitem_t item{static_cast<void*>(s), 0, ZMQ_POLLIN, 0};
-      zmq::poll(&item, 1, std::chrono::milliseconds(20));
-      Incoming in;
-      std::string err;
-      while (got.size() < count && receive(s, false, in, &err))
-        if (err.empty() && in.envelope.body_case() == kind) got.push_back(in.envelope);
-    }
-    return got;
+    return collectEnvelopes(s, kind, count, ms);
   }
   void fail(uint64_t jobId, uint64_t brick, bool handedBack) {
     Envelope f;

@@ -155,19 +155,8 @@ TEST(Protocol, BrickForAPeerThatVanishedGoesBackToTheQueue) {
     send(s, "", hello);
     return s;
   };
-  // The envelopes of one kind received within `ms`, or until `count` of them arrived.
-  auto collect = [](zmq::socket_t& s, Envelope::BodyCase kind, size_t count, int ms = 10000) {
-    std::vector<Envelope> got;
-    auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
-    while (got.size() < count && std::chrono::steady_clock::now() < deadline) {
-      zmq::pollitem_t item{static_cast<void*>(s), 0, ZMQ_POLLIN, 0};
-      zmq::poll(&item, 1, std::chrono::milliseconds(20));
-      Incoming in;
-      std::string err;
-      while (got.size() < count && receive(s, false, in, &err))
-        if (err.empty() && in.envelope.body_case() == kind) got.push_back(in.envelope);
-    }
-    return got;
+  auto collect = [](zmq::socket_t& s, Envelope::BodyCase kind, size_t count) {
+    return collectEnvelopes(s, kind, count, 10000);
   };
   // "y" leases both bricks (two in flight per worker): nothing is pending.
   zmq::socket_t y = peer("y");

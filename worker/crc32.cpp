@@ -1,5 +1,5 @@
-// crc32Of for the fuzz build only: the journal needs it, and worker/brick.cpp (which defines it
-// with the same zlib call) would pull in the whole core and front end.
+// crc32Of (brick.h), zlib's CRC-32 in chunks zlib's uInt can hold. A file of its own so that
+// builds needing only the checksum (the journal's fuzz target) do not pull in the core.
 #include <zlib.h>
 
 #include <cstddef>
