@@ -123,7 +123,7 @@ farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& 
   }
 }
 
-void writeReport(AtomicOutput& reportOut, const farm::FarmReport& report) {
+void writeReport(io::AtomicOutput& reportOut, const farm::FarmReport& report) {
   {
     farm::FarmReport final = report;
     final.peakRssBytes = farm::peakRssBytes();  // after the output was written
@@ -145,7 +145,7 @@ std::string poisonedMessage(const farm::FarmReport& report) {
 }
 }  // namespace
 
-void requireComplete(AtomicOutput& reportOut, const farm::FarmReport& report) {
+void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report) {
   if (!report.interrupted && report.poisoned.empty()) return;
   writeReport(reportOut, report);
   if (report.interrupted)

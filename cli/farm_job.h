@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "atomic_output.h"
+#include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "farm_master.h"
 #include "frep/sampling/sample.h"
@@ -37,11 +37,11 @@ farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& 
 
 // Writes report.toJson(), with peak_rss_bytes refreshed (after the output was written), to the
 // report's temporary file and commits it.
-void writeReport(AtomicOutput& reportOut, const farm::FarmReport& report);
+void writeReport(io::AtomicOutput& reportOut, const farm::FarmReport& report);
 
 // An interrupted or poisoned job: writes the report and throws CliError with exit 6 (resume) or
 // 5 (the poisoned bricks named). Returns when the job is complete.
-void requireComplete(AtomicOutput& reportOut, const farm::FarmReport& report);
+void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report);
 
 // "bricks N (C computed, J from the journal), workers W, retries R, T s" for the summary.
 std::string bricksSummary(const farm::FarmReport& report);

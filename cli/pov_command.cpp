@@ -7,10 +7,10 @@
 #include <iostream>
 #include <sstream>
 
-#include "atomic_output.h"
+#include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "exit_codes.h"
-#include "pov_scene.h"
+#include "frep/io/pov_scene.h"
 
 namespace frep::cli {
 namespace {
@@ -75,8 +75,8 @@ int runPov(const PovRequest& req) {
     Expr part;
     try {
       text = "// frep pov " + req.input + ": Roerdink-Minkowski reduction, exact (no search)\n#declare frep_model =\n" +
-             povFromField(m.field, req.thin, &part) + ";\n";
-    } catch (const PovError&) {
+             io::povFromField(m.field, req.thin, &part) + ";\n";
+    } catch (const io::PovError&) {
       std::cerr << locate(m, req.input, part)
                 << " is not reducible to POV primitives: it is not a basic-set term (fr*Line, fr*Disc, frBall, "
                    "frBlock, their exact frMinkowski sums, block erosions) nor a union/intersection/difference of "
@@ -87,13 +87,13 @@ int runPov(const PovRequest& req) {
   } else {
     std::string scene = readFile(req.input);
     try {
-      text = translateScene(scene, req.input, req.thin);
-    } catch (const PovError& e) {
+      text = io::translateScene(scene, req.input, req.thin);
+    } catch (const io::PovError& e) {
       std::cerr << e.what() << "\n";
       return kExitModelError;
     }
   }
-  AtomicOutput out("-O/--out", req.out);
+  io::AtomicOutput out("-O/--out", req.out);
   {
     std::ofstream f(out.tempPath(), std::ios::binary);
     f << text;

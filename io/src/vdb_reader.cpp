@@ -1,6 +1,6 @@
 // A FloatGrid (frep sample's output) read back as sampled values for meshSamples; see
 // vdb_reader.h. One of the two translation units of frep that include OpenVDB.
-#include "vdb_reader.h"
+#include "frep/io/vdb_reader.h"
 
 #include <openvdb/openvdb.h>
 #include <spdlog/spdlog.h>
@@ -18,10 +18,10 @@
 
 #include "vdb_checksum.h"
 
-#include "arg_parse.h"
-#include "exit_codes.h"
+#include "frep/io/format_number.h"
+#include "frep/io/error.h"
 
-namespace frep::cli {
+namespace frep::io {
 namespace {
 
 std::string gridList(const openvdb::GridPtrVec& grids) {
@@ -41,7 +41,7 @@ uint64_t blockId(const int64_t lo[3], int64_t x, int64_t y, int64_t z) {
 // The file's layout checked before OpenVDB sees it (OpenVDB trusts every length it reads and
 // reads past the end of a truncated file): the header, the file's metadata, each grid's
 // descriptor and metadata, every length bounded by what is left, the grids' offsets increasing
-// and the last grid ending exactly at the end of the file. Throws CliError(kExitIoError).
+// and the last grid ending exactly at the end of the file. Throws Error(kExitIoError).
 class LayoutCheck {
  public:
   LayoutCheck(const std::string& path, std::string bytes) : path_(path), b_(std::move(bytes)) {}
@@ -174,13 +174,13 @@ SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) 
     if (!chosen) {
       file.close();
       if (gridName.empty())
-        throw CliError(kExitModelError, path + ": no float grid to mesh (" + gridList(*metas) +
+        throw Error(kExitModelError, path + ": no float grid to mesh (" + gridList(*metas) +
                                             "); frep mesh reads the FloatGrid written by frep sample");
-      throw CliError(kExitModelError, path + ": no grid named '" + gridName + "' (-o/--object); " + gridList(*metas));
+      throw Error(kExitModelError, path + ": no grid named '" + gridName + "' (-o/--object); " + gridList(*metas));
     }
     if (!chosen->isType<openvdb::FloatGrid>()) {
       file.close();
-      throw CliError(kExitModelError, path + ": grid '" + chosen->getName() + "' holds " + chosen->valueType() +
+      throw Error(kExitModelError, path + ": grid '" + chosen->getName() + "' holds " + chosen->valueType() +
                                           " values; frep mesh needs a float grid (as written by frep sample)");
     }
     out.gridName = chosen->getName();
@@ -192,7 +192,7 @@ SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) 
     throw ioError("cannot read VDB '" + path + "': " + e.what());
   } catch (const std::bad_alloc&) {
     throw ioError("cannot read VDB '" + path + "': out of memory (sizes in the file are damaged, or it is too large)");
-  } catch (const CliError&) {
+  } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {  // e.g. std::length_error from a damaged size: bad input, not a bug
     throw ioError("cannot read VDB '" + path + "': damaged (" + std::string(e.what()) + ")");
@@ -215,7 +215,7 @@ SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) 
   }
   for (int a = 0; a < 3; ++a)
     if (hi[a] - lo[a] >= kMaxMeshGridPoints)
-      throw CliError(kExitModelError, path + ": grid '" + out.gridName + "' spans " + std::to_string(hi[a] - lo[a]) +
+      throw Error(kExitModelError, path + ": grid '" + out.gridName + "' spans " + std::to_string(hi[a] - lo[a]) +
                                           " voxels along an axis; frep mesh handles up to " +
                                           std::to_string(kMaxMeshGridPoints - 1));
   SampleResult& s = out.samples;
@@ -299,4 +299,4 @@ SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) 
   return out;
 }
 
-}  // namespace frep::cli
+}  // namespace frep::io

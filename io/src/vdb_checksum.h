@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <string>
 
-namespace frep::cli {
+namespace frep::io {
 
 inline constexpr const char* kGridChecksumKey = "frep_grid_checksum";
 constexpr size_t kVdbHashedFrom = 21 + 36;  // magic, versions, offsets flag, then the UUID
@@ -26,4 +26,4 @@ inline std::string vdbChecksum(const std::string& bytes, size_t digitsAt) {
   return hex;
 }
 
-}  // namespace frep::cli
+}  // namespace frep::io

@@ -1,5 +1,5 @@
 // POV-Ray text of the Minkowski algebra's primitives and the `$ … $` scene preprocessor.
-#include "pov_scene.h"
+#include "frep/io/pov_scene.h"
 
 #include <cctype>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "frep/minkowski_algebra/registry.h"
 
-namespace frep::cli {
+namespace frep::io {
 namespace {
 
 using minkowski::Piece;
@@ -264,4 +264,4 @@ std::string povFromField(const Expr& f, double thin, Expr* offending) {
   throw PovError("not a basic-set term");
 }
 
-}  // namespace frep::cli
+}  // namespace frep::io

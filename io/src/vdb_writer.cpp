@@ -1,6 +1,6 @@
-#include "vdb_writer.h"
+#include "frep/io/vdb_writer.h"
 
-#include "vdb_grid.h"
+#include "frep/io/vdb_grid.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Prune.h>
@@ -14,14 +14,14 @@
 #include <cstring>
 #include <sstream>
 
-#include "exit_codes.h"
+#include "frep/io/error.h"
 #include "vdb_checksum.h"
 
 #ifndef FREP_VERSION
 #define FREP_VERSION "unknown"
 #endif
 
-namespace frep::cli {
+namespace frep::io {
 namespace {
 
 // OpenVDB's Tree4<float, 5, 4, 3> stores tiles of these edge lengths at levels 1, 2, 3.
@@ -205,4 +205,4 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
   }
 }
 
-}  // namespace frep::cli
+}  // namespace frep::io

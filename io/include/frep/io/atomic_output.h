@@ -7,12 +7,12 @@
 
 #include <string>
 
-namespace frep::cli {
+namespace frep::io {
 
 class AtomicOutput {
  public:
   // Creates the temporary file now, so an unwritable path fails before any work is done.
-  // Throws CliError(kExitIoError) naming `field` and the path (also for a non-regular target).
+  // Throws Error(kExitIoError) naming `field` and the path (also for a non-regular target).
   AtomicOutput(const std::string& field, const std::string& path);
   ~AtomicOutput();
   AtomicOutput(const AtomicOutput&) = delete;
@@ -20,7 +20,7 @@ class AtomicOutput {
 
   const std::string& tempPath() const { return temp_; }
   const std::string& path() const { return path_; }
-  void commit();  // fsync temp, rename temp -> path; throws CliError(kExitIoError)
+  void commit();  // fsync temp, rename temp -> path; throws Error(kExitIoError)
 
  private:
   std::string field_, path_, temp_;
@@ -28,4 +28,4 @@ class AtomicOutput {
   int slot_ = -1;  // in the signal handler's table
 };
 
-}  // namespace frep::cli
+}  // namespace frep::io

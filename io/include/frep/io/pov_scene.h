@@ -10,7 +10,7 @@
 #include "frep/expressions/expr.h"
 #include "frep/minkowski_algebra/reduction.h"
 
-namespace frep::cli {
+namespace frep::io {
 
 // A place in the input and what is wrong there (file:line:column: message).
 struct PovError : std::runtime_error {
@@ -32,4 +32,4 @@ std::string translateScene(const std::string& text, const std::string& fileName,
 // of the field is not such a term; `where` names it (set by the caller from the model's objects).
 std::string povFromField(const Expr& field, double thin, Expr* offending);
 
-}  // namespace frep::cli
+}  // namespace frep::io

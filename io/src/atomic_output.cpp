@@ -1,4 +1,4 @@
-#include "atomic_output.h"
+#include "frep/io/atomic_output.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -9,9 +9,9 @@
 #include <cstdio>
 #include <cstring>
 
-#include "exit_codes.h"
+#include "frep/io/error.h"
 
-namespace frep::cli {
+namespace frep::io {
 namespace {
 
 // The temporary files in progress, for the signal handler: Ctrl-C or a batch system's SIGTERM
@@ -119,4 +119,4 @@ void AtomicOutput::commit() {
   if (slot_ >= 0) gPending[slot_] = 0;
 }
 
-}  // namespace frep::cli
+}  // namespace frep::io

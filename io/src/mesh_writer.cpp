@@ -1,6 +1,6 @@
 // PLY, OBJ and STL writers (see mesh_writer.h). Binary formats are little-endian whatever the
 // host, so the bytes are the same on every machine.
-#include "mesh_writer.h"
+#include "frep/io/mesh_writer.h"
 
 #include <algorithm>
 #include <cctype>
@@ -10,9 +10,9 @@
 #include <cstring>
 #include <vector>
 
-#include "exit_codes.h"
+#include "frep/io/error.h"
 
-namespace frep::cli {
+namespace frep::io {
 
 namespace {
 
@@ -201,4 +201,4 @@ void writeMesh(const std::string& path, const Mesh& mesh, MeshFormat format, con
   b.close();
 }
 
-}  // namespace frep::cli
+}  // namespace frep::io
