@@ -39,7 +39,7 @@ std::string recordedCommandLine(int argc, char** argv) {
   // The output path is left out too: the same grid written anywhere is the same file.
   static const char* execution[] = {"--workers", "--listen", "--expect-workers", "--heartbeat-ms", "--curve",
                                     "--threads", "--log-level", "--brick", "-O", "--out"};
-  static const char* flags[] = {"--resume", "--json", "--no-progress"};
+  static const char* flags[] = {"--resume", "--json", "--no-progress", "--insecure"};
   std::vector<char*> kept;
   for (int i = 0; i < argc; ++i) {
     std::string a = argv[i];
@@ -89,6 +89,8 @@ void addFarmOptions(CLI::App* sub, FarmRequest& f) {
   sub->add_flag("--json", f.json, "JSON progress events on stdout (batch systems)");
   sub->add_flag("--no-progress", f.noProgress, "No progress bar");
   sub->add_option("--curve", f.curveDir, "Require CURVE keys from DIR (see frep keygen)");
+  sub->add_flag("--insecure", f.insecure,
+                "Allow --listen on a non-loopback address without --curve (anyone who reaches it can join)");
 }
 
 void checkObjectIsNotAFile(const ModelRequest& m) {
@@ -119,6 +121,8 @@ int main(int argc, char** argv) {
   ModelRequest checkModel;
   CLI::App* check = app.add_subcommand("check", "Compile a model: print diagnostics and list its objects");
   addModelOptions(check, checkModel, false);
+  std::string checkBounds;
+  check->add_option("-b,--bounds", checkBounds, "Box sampled for the empty-model warnings (default 10)");
 
   EvalRequest eval;
   CLI::App* evalCmd = app.add_subcommand("eval", "Value, in/on/out and gradient of f at one point");
@@ -156,6 +160,22 @@ int main(int argc, char** argv) {
   meshCmd->add_flag("--no-sharp", mesh.noSharp,
                     "Keep merged vertices on the mesher's vertices instead of the model's edges and corners");
 
+  PovRequest pov;
+  CLI::App* povCmd = app.add_subcommand("pov", "POV-Ray scene of Minkowski terms: $ ... <+> ... $ in a scene, or a .hf "
+                                             "model built from the basic set (docs/pov.md)");
+  povCmd->add_option("input", pov.input, "Scene text with $ ... $ terms, or a .hf model")->required();
+  povCmd->add_option("-o,--object", pov.object, "Object of a .hf model (as hfp: default my_model, else the first)");
+  povCmd->add_option("-O,--out", pov.out, "Output POV-Ray file (required)");
+  povCmd->add_option("--thin", pov.thin, "Thickness of pieces without interior: segments, discs (default 0.01)");
+  RelateRequest relate;
+  CLI::App* relateCmd = app.add_subcommand("relate", "Certified relations of two models: intersection, inclusion, point membership");
+  relateCmd->add_option("a", relate.a.path, "Model A (.hf)")->required();
+  relateCmd->add_option("b", relate.b.path, "Model B (.hf)")->required();
+  relateCmd->add_option("--object-a", relate.a.object, "Object of A (default my_model, else the first)");
+  relateCmd->add_option("--object-b", relate.b.object, "Object of B");
+  relateCmd->add_option("-b,--bounds", relate.bounds, "Box searched (default 10)");
+  relateCmd->add_option("--min-size", relate.minSize, "Smallest box edge of the subdivision (default 1e-4 of the box)");
+  relateCmd->add_option("--at", relate.at, "Also classify the point X,Y,Z against both");
   RenderRequest render;
   CLI::App* renderCmd = app.add_subcommand("render", "Shaded PNG of a model by certified interval ray casting");
   addModelOptions(renderCmd, render.model, true);
@@ -184,7 +204,7 @@ int main(int argc, char** argv) {
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
   keygenCmd->add_option("dir", keygenDir, "Directory for the keys")->required();
 
-  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, renderCmd}) sub->fallthrough();
+  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, povCmd, renderCmd}) sub->fallthrough();
 
   try {
     app.parse(argc, argv);
@@ -192,7 +212,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, render and keygen";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov, relate, render and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
@@ -201,7 +221,7 @@ int main(int argc, char** argv) {
   try {
     if (check->parsed()) {
       checkObjectIsNotAFile(checkModel);
-      return runCheck(checkModel);
+      return runCheck(checkModel, checkBounds);
     }
     if (evalCmd->parsed()) {
       checkObjectIsNotAFile(eval.model);
@@ -212,6 +232,8 @@ int main(int argc, char** argv) {
       return runSlice(slice);
     }
     if (keygenCmd->parsed()) return runKeygen(keygenDir);
+    if (povCmd->parsed()) return runPov(pov);
+    if (relateCmd->parsed()) return runRelate(relate);
     if (renderCmd->parsed()) {
       checkObjectIsNotAFile(render.model);
       return runRender(render);

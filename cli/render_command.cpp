@@ -11,12 +11,12 @@
 #include <stdexcept>
 
 #include "arg_parse.h"
-#include "atomic_output.h"
 #include "commands.h"
 #include "exit_codes.h"
+#include "frep/io/atomic_output.h"
+#include "frep/io/png_writer.h"
 #include "frep/render/raycast.h"
 #include "frep/render/shade.h"
-#include "png_writer.h"
 
 namespace frep::cli {
 namespace {
@@ -200,15 +200,15 @@ int runRender(const RenderRequest& r) {
     opt.width = w, opt.height = h, opt.threads = r.threads, opt.footprint = !r.noFootprint;
     opt.nearDepth = view.nearDepth, opt.farDepth = view.farDepth;
     const std::string path = framePath(r.out, k, frames);
-    AtomicOutput out("-O/--out", path);
+    io::AtomicOutput out("-O/--out", path);
     RenderStats stats;
     const auto t0 = std::chrono::steady_clock::now();
     DepthImage depth = found[size_t(k)] ? castRays(clipToBox(fields[size_t(k)], box), view.camera, opt, {}, &stats) : DepthImage{};
     if (!found[size_t(k)]) depth.width = w, depth.height = h, depth.hits.assign(size_t(w) * size_t(h), RayHit{});
-    RgbImage img(w, h);
+    io::RgbImage img(w, h);
     img.rgb = shadeImage(depth, view.camera, shade);
     totalMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    writePng(out.tempPath(), img);
+    io::writePng(out.tempPath(), img);
     out.commit();
     pixelStep = 2 * view.camera.halfWidth / w;
     intervals += stats.intervalEvals, points += stats.pointEvals;

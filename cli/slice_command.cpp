@@ -7,13 +7,13 @@
 #include <iostream>
 
 #include "arg_parse.h"
-#include "atomic_output.h"
+#include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "exit_codes.h"
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/tape.h"
 #include "frep/sampling/plane.h"
-#include "heatmap.h"
+#include "frep/io/heatmap.h"
 #include "sampling_grid.h"
 
 namespace frep::cli {
@@ -59,7 +59,7 @@ int runSlice(const SliceRequest& request) {
     throw badArgs("--res/-g: the image would be " + std::to_string(width) + "x" + std::to_string(height) +
                   " pixels; the limit is " + std::to_string(kMaxSide) + " per side");
 
-  AtomicOutput out("-O/--out", request.region.out);
+  io::AtomicOutput out("-O/--out", request.region.out);
   const uint32_t vars = uint32_t(std::max(m.dims, plane.normal < 0 ? 2 : 3));
   TapePtr tape = Tape::compile(m.field, vars);
   PlaneLattice lattice;
@@ -74,7 +74,7 @@ int runSlice(const SliceRequest& request) {
   std::vector<double> values = evaluatePlane(tape, lattice, options, &stats);
   const double evalMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
-  writePng(out.tempPath(), request.mask ? renderMask(values, width, height) : renderHeatmap(values, width, height));
+  io::writePng(out.tempPath(), request.mask ? io::renderMask(values, width, height) : io::renderHeatmap(values, width, height));
   out.commit();
   double lo = INFINITY, hi = -INFINITY;
   size_t nans = 0;

@@ -149,7 +149,7 @@ TEST_F(FrepTest, BadArgumentsNameTheField) {
       {"slice s.hf --res 16", "frep: error: -O/--out: the output PNG path is required"},
       {"sample s.hf --band 0 -O s.vdb", "frep: error: --band: expected an integer from 1 to 64 (voxels), got 0"},
       {"eval s.hf", "--at is required"},
-      {"frob s.hf", "frep: error: unknown verb 'frob'; the verbs are check, eval, slice, sample, mesh, render and keygen"},
+      {"frob s.hf", "frep: error: unknown verb 'frob'; the verbs are check, eval, slice, sample, mesh, pov, relate, render and keygen"},
       {"eval s.hf --at 0,0,0 --log-level loud", "--log-level"},
   };
   for (const Case& c : cases) {
@@ -166,13 +166,12 @@ TEST_F(FrepTest, UnwritableOutputIsAnIoErrorAndLeavesNothing) {
   RunResult r = run("slice s.hf --res 16 -O plain/s.png");
   EXPECT_EQ(r.code, 3);
   EXPECT_TRUE(contains(r.err, "frep: error: -O/--out: cannot write 'plain/s.png': Not a directory")) << r.err;
-  // The output is a directory: the image is computed, the final rename fails, the temp goes.
+  // The output is a directory: refused before any work (docs/cli.md: -O is new or a regular file).
   ASSERT_EQ(::mkdir(path("adir").c_str(), 0755), 0);
   RunResult dir = run("sample s.hf --res 16 -O adir");
   EXPECT_EQ(dir.code, 3) << dir.err;
-  EXPECT_TRUE(contains(dir.err, "cannot rename")) << dir.err;
-  // The computed bricks stay in the journal, so that --resume writes the output without work.
-  EXPECT_EQ(listing(), "adir adir.journal plain s.hf");
+  EXPECT_TRUE(contains(dir.err, "'adir' is a directory")) << dir.err;
+  EXPECT_EQ(listing(), "adir plain s.hf");
 }
 
 TEST_F(FrepTest, SliceWritesAHeatMapOfTheRequestedSize) {
@@ -265,7 +264,7 @@ TEST_F(FrepTest, DomainErrorsAreReportedNotFatal) {
   EXPECT_TRUE(contains(r.out, "value: nan\nstatus: out (NaN: a domain error, counted as outside)\n")) << r.out;
   RunResult s = run("slice n.hf -b 1 --res 16 -O n.png");
   ASSERT_EQ(s.code, 0) << s.err;
-  EXPECT_TRUE(contains(s.out, ", 128 NaN pixels (grey)\n")) << s.out;  // columns 0..7 of 16 rows
+  EXPECT_TRUE(contains(s.out, ", 128 NaN pixels (grey); evaluated 256 of 256 pixels")) << s.out;  // columns 0..7 of 16 rows
   Png png = readPng(path("n.png"));
   EXPECT_EQ(png.at(3, 3)[0], 128);
   EXPECT_EQ(png.at(3, 3)[2], 128);

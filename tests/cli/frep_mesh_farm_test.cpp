@@ -103,12 +103,12 @@ TEST_F(MeshFarmCli, BadFarmArgumentsAreNamed) {
     const char* args;
     const char* message;
   } cases[] = {
-      {" --brick 12", "--brick: expected a positive multiple of 8"},
-      {" --brick 0", "--brick: expected a positive multiple of 8"},
-      {" --workers -2", "--workers: expected 0"},
+      {" --brick 12", "--brick: expected a multiple of 8 voxels from 8 to 1024"},
+      {" --brick 0", "--brick: expected a multiple of 8 voxels from 8 to 1024"},
+      {" --workers -2", "--workers: expected an integer from -1 to 4096"},
       {" --listen localhost:5", "--listen: expected tcp://"},
       {" --threads -1", "--threads: expected 0"},
-      {" --expect-workers -1", "--expect-workers: expected 0"},
+      {" --expect-workers -1", "--expect-workers: expected an integer from 0 to 4096"},
   };
   for (const Case& c : cases) {
     RunResult r = run(meshArgs("x.ply") + c.args);
@@ -117,7 +117,7 @@ TEST_F(MeshFarmCli, BadFarmArgumentsAreNamed) {
   }
   RunResult r = run("mesh part.hf -b 1 --res 64 -O x.ply --heartbeat-ms 5");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--heartbeat-ms: expected at least 10"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--heartbeat-ms: expected an integer from 10 to 600000"), std::string::npos) << r.err;
   EXPECT_EQ(listing(), "part.hf");  // nothing written, not even a report
   EXPECT_EQ(run(meshArgs("x.ply") + " --workers 2 --curve missing").code, 7);  // farm error: no keys
   EXPECT_FALSE(fileExists(path("x.ply")));

@@ -29,7 +29,10 @@ openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path) {
   return openvdb::gridPtrCast<openvdb::FloatGrid>(grids->front());
 }
 
+// As another tool edits a frep file: the seal of frep sample's bytes no longer applies, so it is
+// dropped (docs/cli.md); the other frep_ metadata stay.
 void writeGrids(const std::string& path, const openvdb::GridPtrVec& grids) {
+  for (const auto& g : grids) g->removeMeta("frep_grid_checksum");
   openvdb::io::File file(path);
   file.write(grids);
   file.close();

@@ -22,9 +22,9 @@ namespace frep {
 namespace {
 
 constexpr int kTopTile = 128;
-// Tiles of at most kLeafTile^2 pixels are evaluated as one batch; signOnly classifies down to
-// kSignLeafTile, where smaller decided tiles save more than the extra interval passes cost.
-constexpr int kLeafTile = 16, kSignLeafTile = 16;
+// Tiles of at most kLeafTile^2 pixels are evaluated as one batch (8 x 8 leaves measured slower
+// on Prospero, also with signOnly: the extra interval passes and prunes cost more than they save).
+constexpr int kLeafTile = 16;
 static_assert(kLeafTile * kLeafTile <= int(BatchEvaluator<double>::kBatch), "one batch per leaf tile");
 
 struct PlaneWorker {
@@ -37,7 +37,7 @@ struct PlaneWorker {
 class PlaneEvaluator {
  public:
   PlaneEvaluator(const TapePtr& tape, const PlaneLattice& l, const PlaneOptions& opt, std::vector<double>& out)
-      : tape_(tape), l_(l), opt_(opt), out_(out), nvars_(std::max<uint32_t>(tape->numVars(), 1)) {}
+      : l_(l), opt_(opt), out_(out), nvars_(std::max<uint32_t>(tape->numVars(), 1)) {}
 
   double colCoord(int c) const { return l_.origin[0] + double(c) * l_.step; }
   double rowCoord(int r) const { return l_.origin[1] + double(l_.height - 1 - r) * l_.step; }
@@ -67,13 +67,12 @@ class PlaneEvaluator {
       return;
     }
     TapePtr pruned = w.interval.pruned(tape);
-    const int leafSide = opt_.signOnly ? kSignLeafTile : kLeafTile;
-    if (c1 - c0 <= leafSide && r1 - r0 <= leafSide) {
+    if (c1 - c0 <= kLeafTile && r1 - r0 <= kLeafTile) {
       leaf(w, c0, c1, r0, r1, *pruned);
       return;
     }
-    const int cm = c1 - c0 > leafSide ? c0 + (c1 - c0 + 1) / 2 : c1;
-    const int rm = r1 - r0 > leafSide ? r0 + (r1 - r0 + 1) / 2 : r1;
+    const int cm = c1 - c0 > kLeafTile ? c0 + (c1 - c0 + 1) / 2 : c1;
+    const int rm = r1 - r0 > kLeafTile ? r0 + (r1 - r0 + 1) / 2 : r1;
     tile(w, c0, cm, r0, rm, pruned);
     if (cm < c1) tile(w, cm, c1, r0, rm, pruned);
     if (rm < r1) tile(w, c0, cm, rm, r1, pruned);
@@ -105,7 +104,6 @@ class PlaneEvaluator {
   size_t index(int c, int r) const { return size_t(r) * size_t(l_.width) + size_t(c); }
 
  private:
-  const TapePtr& tape_;
   const PlaneLattice& l_;
   const PlaneOptions& opt_;
   std::vector<double>& out_;

@@ -7,17 +7,17 @@
 
 #include "frep/meshing/mesh.h"
 
-namespace frep::cli {
+namespace frep::io {
 
-enum class MeshFormat { Ply, Obj, Stl };
+enum class MeshFormat { Ply, Obj, Stl, Pov };  // Pov: mesh2 declared as frep_mesh (.inc/.pov)
 
-// From the output file's extension (.ply, .obj, .stl; any case). Throws CliError(kExitBadArgs)
+// From the output file's extension (.ply, .obj, .stl; any case). Throws Error(kExitBadArgs)
 // naming `field`.
 MeshFormat meshFormatFromPath(const std::string& field, const std::string& path);
 const char* meshFormatName(MeshFormat format);
 
 // Writes `mesh` to `path` (the caller's temporary file). `comment` goes into the PLY/OBJ header
-// and the STL header (truncated to its 80 bytes). Throws CliError(kExitIoError).
+// and the STL header (truncated to its 80 bytes). Throws Error(kExitIoError).
 void writeMesh(const std::string& path, const Mesh& mesh, MeshFormat format, const std::string& comment);
 
-}  // namespace frep::cli
+}  // namespace frep::io

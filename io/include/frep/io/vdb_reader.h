@@ -10,7 +10,7 @@
 #include "frep/meshing/mesh.h"
 #include "frep/sampling/sample.h"
 
-namespace frep::cli {
+namespace frep::io {
 
 struct SampledVdb {
   std::string gridName;
@@ -27,10 +27,10 @@ struct SampledVdb {
   std::string transformDescription;  // e.g. "voxel 0.03 at (-1.1, -1.1, -1.1)"
 };
 
-// Throws CliError: kExitIoError when the file cannot be opened or read (missing, not a VDB file,
+// Throws Error: kExitIoError when the file cannot be opened or read (missing, not a VDB file,
 // truncated or corrupt), kExitModelError when it has no usable grid (no float grid; no grid
 // named `gridName`, if given; the grid's type is not float). Messages name the file and list its
 // grids.
 SampledVdb readSampledVdb(const std::string& path, const std::string& gridName);
 
-}  // namespace frep::cli
+}  // namespace frep::io

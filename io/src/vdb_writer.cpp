@@ -1,19 +1,27 @@
-#include "vdb_writer.h"
+#include "frep/io/vdb_writer.h"
 
-#include "vdb_grid.h"
+#include "frep/io/vdb_grid.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Prune.h>
 
-#include <cstdio>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
-#include "exit_codes.h"
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <sstream>
+
+#include "frep/io/error.h"
+#include "vdb_checksum.h"
 
 #ifndef FREP_VERSION
 #define FREP_VERSION "unknown"
 #endif
 
-namespace frep::cli {
+namespace frep::io {
 namespace {
 
 // OpenVDB's Tree4<float, 5, 4, 3> stores tiles of these edge lengths at levels 1, 2, 3.
@@ -65,30 +73,80 @@ void addClippedTile(openvdb::FloatTree& tree, const Tile& tile, float value, con
 
 // OpenVDB stamps a random UUID into every file header; replace it by one derived from the file's
 // contents, so the same grid always gives the same bytes (farm runs are compared byte for byte).
-void makeHeaderDeterministic(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "r+b");
-  if (!f) throw ioError("cannot reopen VDB '" + path + "'");
-  std::string bytes;
-  char buf[1 << 16];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) bytes.append(buf, n);
+void makeHeaderDeterministic(std::string& bytes) {
   constexpr size_t kUuidAt = 21, kUuidLen = 36;  // after magic, version, library version, flag
   bool looksLikeUuid = bytes.size() > kUuidAt + kUuidLen && bytes[kUuidAt + 8] == '-' && bytes[kUuidAt + 13] == '-' &&
                        bytes[kUuidAt + 18] == '-' && bytes[kUuidAt + 23] == '-';
-  if (looksLikeUuid) {
-    uint64_t h1 = 1469598103934665603ULL, h2 = 0x9e3779b97f4a7c15ULL;
-    for (size_t i = kUuidAt + kUuidLen; i < bytes.size(); ++i) {
-      h1 = (h1 ^ uint8_t(bytes[i])) * 1099511628211ULL;
-      h2 = (h2 ^ uint8_t(bytes[i])) * 0x100000001b3ULL + (h2 >> 29);
-    }
-    char uuid[40];
-    std::snprintf(uuid, sizeof uuid, "%08llx-%04llx-%04llx-%04llx-%012llx", (unsigned long long)(h1 >> 32),
-                  (unsigned long long)((h1 >> 16) & 0xffff), (unsigned long long)(h1 & 0xffff),
-                  (unsigned long long)(h2 >> 48), (unsigned long long)(h2 & 0xffffffffffffULL));
-    std::fseek(f, long(kUuidAt), SEEK_SET);
-    std::fwrite(uuid, 1, kUuidLen, f);
+  if (!looksLikeUuid) return;
+  uint64_t h1 = 1469598103934665603ULL, h2 = 0x9e3779b97f4a7c15ULL;
+  for (size_t i = kUuidAt + kUuidLen; i < bytes.size(); ++i) {
+    h1 = (h1 ^ uint8_t(bytes[i])) * 1099511628211ULL;
+    h2 = (h2 ^ uint8_t(bytes[i])) * 0x100000001b3ULL + (h2 >> 29);
   }
-  if (std::fclose(f) != 0) throw ioError("cannot write VDB '" + path + "'");
+  char uuid[40];
+  std::snprintf(uuid, sizeof uuid, "%08llx-%04llx-%04llx-%04llx-%012llx", (unsigned long long)(h1 >> 32),
+                (unsigned long long)((h1 >> 16) & 0xffff), (unsigned long long)(h1 & 0xffff),
+                (unsigned long long)(h2 >> 48), (unsigned long long)(h2 & 0xffffffffffffULL));
+  bytes.replace(kUuidAt, kUuidLen, uuid, kUuidLen);
+}
+
+// The bytes openvdb::io::File::write would put in the file (the same Archive::write, seekable),
+// built in memory: OpenVDB's own file writer ignores a failing stream (ENOSPC, EFBIG).
+struct MemoryArchive : openvdb::io::Archive {
+  std::string bytes(const openvdb::GridCPtrVec& grids) const {
+    std::ostringstream os(std::ios_base::out | std::ios_base::binary);
+    write(os, grids, /*seekable=*/true);
+    if (!os) throw openvdb::IoError("cannot serialise the grid");
+    return os.str();
+  }
+};
+
+// The checksum entry's placeholder digits replaced by the file's checksum (vdb_checksum.h). The
+// entry is found with its length prefixes, which hold NUL bytes no metadata text from argv has.
+void sealChecksum(std::string& bytes) {
+  auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  const std::string key = kGridChecksumKey;
+  const std::string entry = u32(uint32_t(key.size())) + key + u32(6) + "string" + u32(uint32_t(kChecksumDigits)) +
+                            std::string(kChecksumDigits, '0');
+  const size_t at = bytes.find(entry);
+  if (at == std::string::npos) throw openvdb::IoError("the checksum entry is missing from the serialised grid");
+  const size_t digits = at + entry.size() - kChecksumDigits;
+  bytes.replace(digits, kChecksumDigits, vdbChecksum(bytes, digits));
+}
+
+// Every byte handed to the kernel and checked, then fsync and the size read back: a full disk
+// fails here (exit 3) and AtomicOutput never renames a truncated file into place.
+void writeAllOrThrow(const std::string& path, const std::string& bytes) {
+  auto fail = [&](const char* what) {
+    throw ioError("cannot write VDB '" + path + "': " + what + ": " + std::strerror(errno));
+  };
+  int fd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) fail("open");
+  size_t done = 0;
+  while (done < bytes.size()) {
+    ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n == 0) errno = ENOSPC;
+      int err = errno;
+      ::close(fd);
+      errno = err;
+      fail("write");
+    }
+    done += size_t(n);
+  }
+  struct stat st;
+  if (::fsync(fd) != 0 || ::fstat(fd, &st) != 0) {
+    int err = errno;
+    ::close(fd);
+    errno = err;
+    fail("fsync");
+  }
+  if (::close(fd) != 0) fail("close");
+  if (uint64_t(st.st_size) != bytes.size()) {
+    errno = EIO;
+    fail(("size " + std::to_string(st.st_size) + " instead of " + std::to_string(bytes.size())).c_str());
+  }
 }
 
 std::string hex(uint64_t v) {
@@ -133,16 +191,18 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
   grid->insertMeta("frep_version", openvdb::StringMetadata(FREP_VERSION));
 
   try {
-    openvdb::io::File file(path);
+    grid->insertMeta(kGridChecksumKey, openvdb::StringMetadata(std::string(kChecksumDigits, '0')));  // sealed below
+    MemoryArchive archive;
     uint32_t compression = openvdb::io::COMPRESS_ACTIVE_MASK;
     if (openvdb::io::Archive::hasBloscCompression()) compression |= openvdb::io::COMPRESS_BLOSC;
-    file.setCompression(compression);
-    file.write(openvdb::GridCPtrVec{grid});
-    file.close();
-    makeHeaderDeterministic(path);
+    archive.setCompression(compression);
+    std::string bytes = archive.bytes(openvdb::GridCPtrVec{grid});
+    sealChecksum(bytes);
+    makeHeaderDeterministic(bytes);
+    writeAllOrThrow(path, bytes);
   } catch (const openvdb::Exception& e) {
     throw ioError("cannot write VDB '" + path + "': " + e.what());
   }
 }
 
-}  // namespace frep::cli
+}  // namespace frep::io

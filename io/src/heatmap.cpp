@@ -1,9 +1,9 @@
-#include "heatmap.h"
+#include "frep/io/heatmap.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace frep::cli {
+namespace frep::io {
 namespace {
 
 using Rgb = std::array<double, 3>;
@@ -80,4 +80,4 @@ RgbImage renderMask(const std::vector<double>& values, int width, int height) {
   return img;
 }
 
-}  // namespace frep::cli
+}  // namespace frep::io

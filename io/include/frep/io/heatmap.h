@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "png_writer.h"
+#include "frep/io/png_writer.h"
 
-namespace frep::cli {
+namespace frep::io {
 
 // |f| that maps to the darkest colour: the 95th percentile of the given magnitudes, so a few
 // huge values (f grows like |x|^k far away) do not wash the picture out. 1 if all are zero.
@@ -26,4 +26,4 @@ RgbImage renderHeatmap(const std::vector<double>& values, int width, int height)
 // --mask), for which pixels in tiles whose sign an interval decided need no evaluation.
 RgbImage renderMask(const std::vector<double>& values, int width, int height);
 
-}  // namespace frep::cli
+}  // namespace frep::io

@@ -7,7 +7,7 @@
 
 #include "frep/sampling/sample.h"
 
-namespace frep::cli {
+namespace frep::io {
 
 struct VdbMetadata {
   std::string gridName;     // the object's name
@@ -21,7 +21,7 @@ struct VdbMetadata {
 // leaf voxels from the sampler (active in the band), tiles and the background at ±band*voxel,
 // the grid's transform (voxel size, translated to the grid origin) and metadata (frep_sign =
 // "value = -f", frep_operation, frep_model_hash, frep_object, frep_command, frep_band_voxels,
-// frep_band, frep_iso, frep_params, frep_version). Throws CliError(kExitIoError).
+// frep_band, frep_iso, frep_params, frep_version). Throws Error(kExitIoError).
 void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta);
 
-}  // namespace frep::cli
+}  // namespace frep::io

@@ -1,12 +1,12 @@
-#include "png_writer.h"
+#include "frep/io/png_writer.h"
 
 #include <png.h>
 
 #include <cstring>
 
-#include "exit_codes.h"
+#include "frep/io/error.h"
 
-namespace frep::cli {
+namespace frep::io {
 
 void writePng(const std::string& path, const RgbImage& image) {
   png_image info;
@@ -21,4 +21,4 @@ void writePng(const std::string& path, const RgbImage& image) {
   if (!ok) throw ioError("cannot write PNG '" + path + "': " + reason);
 }
 
-}  // namespace frep::cli
+}  // namespace frep::io

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace frep::cli {
+namespace frep::io {
 
 struct RgbImage {
   int width = 0, height = 0;
@@ -14,7 +14,7 @@ struct RgbImage {
   uint8_t* pixel(int col, int row) { return &rgb[(size_t(row) * size_t(width) + size_t(col)) * 3]; }
 };
 
-// Writes image to path (overwriting); throws CliError(kExitIoError) with libpng's reason.
+// Writes image to path (overwriting); throws Error(kExitIoError) with libpng's reason.
 void writePng(const std::string& path, const RgbImage& image);
 
-}  // namespace frep::cli
+}  // namespace frep::io

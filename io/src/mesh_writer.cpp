@@ -1,6 +1,6 @@
 // PLY, OBJ and STL writers (see mesh_writer.h). Binary formats are little-endian whatever the
 // host, so the bytes are the same on every machine.
-#include "mesh_writer.h"
+#include "frep/io/mesh_writer.h"
 
 #include <algorithm>
 #include <cctype>
@@ -10,9 +10,9 @@
 #include <cstring>
 #include <vector>
 
-#include "exit_codes.h"
+#include "frep/io/error.h"
 
-namespace frep::cli {
+namespace frep::io {
 
 namespace {
 
@@ -144,6 +144,29 @@ void stl(Bytes& b, const Mesh& m, const std::string& comment) {
   }
 }
 
+// POV-Ray mesh2 (the fallback of `frep pov` for models that are not reducible): declares
+// frep_mesh; include it and write `object { frep_mesh ... }`.
+void pov(Bytes& b, const Mesh& m, const std::string& comment) {
+  if (!comment.empty()) b.text("// " + oneLine(comment) + "\n");
+  char line[160];
+  b.text("#declare frep_mesh = mesh2 {\n  vertex_vectors { " + std::to_string(m.positions.size()) + "\n");
+  for (const auto& p : m.positions) {
+    std::snprintf(line, sizeof line, "    <%.9g, %.9g, %.9g>\n", double(float(p[0])), double(float(p[1])), double(float(p[2])));
+    b.text(line, std::strlen(line));
+  }
+  b.text("  }\n  normal_vectors { " + std::to_string(m.normals.size()) + "\n");
+  for (const auto& n : m.normals) {
+    std::snprintf(line, sizeof line, "    <%.9g, %.9g, %.9g>\n", double(float(n[0])), double(float(n[1])), double(float(n[2])));
+    b.text(line, std::strlen(line));
+  }
+  b.text("  }\n  face_indices { " + std::to_string(m.triangles.size()) + "\n");
+  for (const auto& t : m.triangles) {
+    std::snprintf(line, sizeof line, "    <%u, %u, %u>\n", t[0], t[1], t[2]);
+    b.text(line, std::strlen(line));
+  }
+  b.text("  }\n  inside_vector <0, 0, 1>\n}\n");
+}
+
 }  // namespace
 
 MeshFormat meshFormatFromPath(const std::string& field, const std::string& path) {
@@ -153,7 +176,8 @@ MeshFormat meshFormatFromPath(const std::string& field, const std::string& path)
   if (ext == "ply") return MeshFormat::Ply;
   if (ext == "obj") return MeshFormat::Obj;
   if (ext == "stl") return MeshFormat::Stl;
-  throw badArgs(field + ": '" + path + "' has no mesh extension; use .ply (binary PLY), .obj or .stl (binary STL)");
+  if (ext == "inc" || ext == "pov") return MeshFormat::Pov;
+  throw badArgs(field + ": '" + path + "' has no mesh extension; use .ply (binary PLY), .obj, .stl (binary STL) or .inc/.pov (POV-Ray mesh2)");
 }
 
 const char* meshFormatName(MeshFormat format) {
@@ -161,6 +185,7 @@ const char* meshFormatName(MeshFormat format) {
     case MeshFormat::Ply: return "binary PLY";
     case MeshFormat::Obj: return "OBJ";
     case MeshFormat::Stl: return "binary STL";
+    case MeshFormat::Pov: return "POV-Ray mesh2";
   }
   return "?";
 }
@@ -171,8 +196,9 @@ void writeMesh(const std::string& path, const Mesh& mesh, MeshFormat format, con
     case MeshFormat::Ply: ply(b, mesh, comment); break;
     case MeshFormat::Obj: obj(b, mesh, comment); break;
     case MeshFormat::Stl: stl(b, mesh, comment); break;
+    case MeshFormat::Pov: pov(b, mesh, comment); break;
   }
   b.close();
 }
 
-}  // namespace frep::cli
+}  // namespace frep::io

@@ -7,7 +7,7 @@
 
 #include "frep/sampling/sample.h"
 
-namespace frep::cli {
+namespace frep::io {
 
 // One FloatGrid of class level set holding -f (negative inside): the sampler's leaf voxels
 // (active in the band), tiles and the background at +-band * voxel, pruned to the canonical
@@ -15,4 +15,5 @@ namespace frep::cli {
 // no metadata (writeLevelSet adds them). Calls openvdb::initialize().
 openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result);
 
-}  // namespace frep::cli
+}  // namespace frep::io
+
