@@ -158,6 +158,35 @@ TEST(Render, IdenticalForAnyThreadCount) {
   }
 }
 
+// Regions of whole tiles (the farm's bricks) give exactly the whole image's hits, for any split;
+// a region that cuts a tile is refused.
+TEST(Render, RegionsOfWholeTilesGiveTheWholeImage) {
+  const Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  const Expr model = max(sphere(1.0), min(0.3 - abs(z), 1.4 - x * x - y * y));
+  Camera cam = orbitCamera({0, 0, 0}, -50, 30, 5, true, 0.35);
+  const RenderOptions opt = options(150, 100, 1.0, 10.0, 1);
+  const DepthImage whole = castRays(model, cam, opt);
+  const TapePtr view = viewTape(model, cam);
+  for (int tile : {32, 64, 96}) {
+    for (int r0 = 0; r0 < opt.height; r0 += tile)
+      for (int c0 = 0; c0 < opt.width; c0 += tile) {
+        const PixelRegion g{c0, r0, std::min(c0 + tile, opt.width), std::min(r0 + tile, opt.height)};
+        const std::vector<RayHit> hits = castRegion(view, cam, opt, g);
+        for (int r = g.r0; r < g.r1; ++r)
+          for (int c = g.c0; c < g.c1; ++c) {
+            const RayHit& a = hits[size_t(r - g.r0) * size_t(g.c1 - g.c0) + size_t(c - g.c0)];
+            const RayHit& b = whole.at(c, r);
+            ASSERT_EQ(a.kind, b.kind) << c << "," << r;
+            ASSERT_EQ(a.depth, b.depth);
+            ASSERT_EQ(a.normal, b.normal);
+          }
+      }
+  }
+  EXPECT_THROW(castRegion(view, cam, opt, PixelRegion{16, 0, 48, 32}), std::invalid_argument);
+  EXPECT_THROW(castRegion(view, cam, opt, PixelRegion{0, 0, 40, 32}), std::invalid_argument);
+  EXPECT_THROW(castRegion(view, cam, opt, PixelRegion{128, 96, 160, 100}), std::invalid_argument);
+}
+
 // The shaded bytes of a sphere against the same Lambert formula evaluated on the analytic hit
 // point and normal of each pixel's centre ray (orthographic, view along +y).
 TEST(Render, ShadedSphereMatchesTheAnalyticImage) {

@@ -21,7 +21,6 @@
 namespace frep {
 namespace {
 
-constexpr int kTopTile = 32;  // the parallel grain; fixed, so results do not depend on threads
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Depth search widths, in pixel footprints at the far end of the range: point checks start at
 // kLeaf; intervals keep splitting to kMinWidth before a box they cannot exclude counts as a hit.
@@ -61,20 +60,22 @@ struct Worker {
 
 class Caster {
  public:
-  Caster(const Camera& cam, const RenderOptions& opt, TapePtr view, TapePtr model, DepthImage& img,
-         const std::vector<double>& fixed)
-      : cam_(cam), opt_(opt), view_(std::move(view)), model_(std::move(model)), img_(img), fixed_(fixed),
-        budget_(img.hits.size(), kConfirmBudget) {}
+  Caster(const Camera& cam, const RenderOptions& opt, TapePtr view, const PixelRegion& region, std::vector<RayHit>& hits)
+      : cam_(cam), opt_(opt), view_(std::move(view)), region_(region), hits_(hits),
+        step_(2.0 * cam.halfWidth / opt.width), budget_(hits.size(), kConfirmBudget) {}
 
   void topTile(Worker& w, int c0, int c1, int r0, int r1) {
     cell(w, c0, c1, r0, r1, opt_.nearDepth, opt_.farDepth, view_);
   }
 
  private:
-  double footprint(double d) const { return cam_.perspective ? std::abs(d) * img_.pixelStep : img_.pixelStep; }
-  double u(int c) const { return pixelU(cam_, img_.width, c); }
-  double v(int r) const { return pixelV(cam_, img_.width, img_.height, r); }
-  RayHit& hit(int c, int r) { return img_.hits[size_t(r) * size_t(img_.width) + size_t(c)]; }
+  double footprint(double d) const { return cam_.perspective ? std::abs(d) * step_ : step_; }
+  double u(int c) const { return pixelU(cam_, opt_.width, c); }
+  double v(int r) const { return pixelV(cam_, opt_.width, opt_.height, r); }
+  size_t index(int c, int r) const {
+    return size_t(r - region_.r0) * size_t(region_.c1 - region_.c0) + size_t(c - region_.c0);
+  }
+  RayHit& hit(int c, int r) { return hits_[index(c, r)]; }
 
   Interval evalBox(Worker& w, const Tape& tape, Interval bu, Interval bv, Interval bd) {
     const Interval box[3] = {bu, bv, bd};
@@ -92,7 +93,7 @@ class Caster {
     for (int r = r0; r < r1 && !open; ++r)
       for (int c = c0; c < c1 && !open; ++c) open = hit(c, r).kind != RayHit::kCentre;
     if (!open) return;
-    const double half = 0.5 * img_.pixelStep;
+    const double half = 0.5 * step_;
     const Interval iv = evalBox(w, *tape, Interval(u(c0) - half, u(c1 - 1) + half),
                                 Interval(v(r1 - 1) - half, v(r0) + half), Interval(a, b));
     if (iv.hi < 0) return;
@@ -126,7 +127,7 @@ class Caster {
     }
     if (!opt_.footprint || h.kind == RayHit::kFootprint) return;
     // The pixel's cell box is this footprint slab, and the caller found it ambiguous.
-    d = footprintSearch(w, tape, pu, pv, a, b, fp, budget_[size_t(r) * size_t(img_.width) + size_t(c)], true);
+    d = footprintSearch(w, tape, pu, pv, a, b, fp, budget_[index(c, r)], true);
     if (d < kInf) finish(w, h, RayHit::kFootprint, pu, pv, d);
   }
 
@@ -161,7 +162,7 @@ class Caster {
   // point of the solid, confirmed by `confirm`.
   double footprintSearch(Worker& w, const TapePtr& tape, double pu, double pv, double a, double b, double fp,
                          int& budget, bool knownAmbiguous = false) {
-    const double half = 0.5 * img_.pixelStep;
+    const double half = 0.5 * step_;
     if (!knownAmbiguous &&
         evalBox(w, *tape, Interval(pu - half, pu + half), Interval(pv - half, pv + half), Interval(a, b)).hi < 0)
       return kInf;
@@ -184,7 +185,7 @@ class Caster {
     if (--budget < 0) return true;
     const Interval iv = evalBox(w, *tape, Interval(u0, u1), Interval(v0, v1), Interval(a, b));
     if (iv.hi < 0) return false;
-    if (u1 - u0 <= kConfirm * img_.pixelStep || iv.lo >= 0) return true;
+    if (u1 - u0 <= kConfirm * step_ || iv.lo >= 0) return true;
     TapePtr pruned = w.interval.pruned(tape);
     const double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1), dm = b - a > kConfirm * fp ? 0.5 * (a + b) : b;
     for (int k = 0; k < 8; ++k) {
@@ -196,27 +197,38 @@ class Caster {
     return false;
   }
 
+  // The hit's point and normal. The gradient comes from the view tape in (u, v, d) by the chain
+  // rule, so a worker needs the one tape: orthographic X = eye + uR + vU + dF gives
+  // f_u = g.R, f_v = g.U, f_d = g.F; perspective X = eye + d(F + uR + vU) gives f_u = d g.R,
+  // f_v = d g.U, f_d = g.(F + uR + vU).
   void finish(Worker& w, RayHit& h, RayHit::Kind kind, double pu, double pv, double d) {
     h.kind = kind;
     h.depth = d;
     for (int i = 0; i < 3; ++i)
       h.point[i] = cam_.perspective ? cam_.eye[i] + d * (cam_.forward[i] + pu * cam_.right[i] + pv * cam_.up[i])
                                     : cam_.eye[i] + pu * cam_.right[i] + pv * cam_.up[i] + d * cam_.forward[i];
-    std::vector<double> x(model_->numVars(), 0.0), g(model_->numVars(), 0.0);
-    for (size_t i = 0; i < x.size(); ++i) x[i] = i < 3 ? h.point[i] : i - 3 < fixed_.size() ? fixed_[i - 3] : 0.0;
-    w.gradient.eval(*model_, x.data(), g.data());
-    const double n = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-    h.normal = n > 0 && std::isfinite(n) ? Vec3{-g[0] / n, -g[1] / n, -g[2] / n} : Vec3{0, 0, 0};
+    const double x[3] = {pu, pv, d};
+    double g[3] = {0, 0, 0};
+    w.gradient.eval(*view_, x, g);
+    double gr = g[0], gu = g[1], gf = g[2];
+    if (cam_.perspective) {
+      gr /= d, gu /= d;
+      gf -= pu * gr + pv * gu;
+    }
+    Vec3 grad;
+    for (int i = 0; i < 3; ++i) grad[size_t(i)] = gr * cam_.right[size_t(i)] + gu * cam_.up[size_t(i)] + gf * cam_.forward[size_t(i)];
+    const double n = std::sqrt(dot(grad, grad));
+    h.normal = n > 0 && std::isfinite(n) ? Vec3{-grad[0] / n, -grad[1] / n, -grad[2] / n} : Vec3{0, 0, 0};
   }
 
   const Camera& cam_;
   const RenderOptions& opt_;
-  TapePtr view_, model_;
-  DepthImage& img_;
-  const std::vector<double>& fixed_;
+  TapePtr view_;
+  PixelRegion region_;
+  std::vector<RayHit>& hits_;
+  double step_;              // pixel spacing on the image plane
   std::vector<int> budget_;  // per pixel: confirming evaluations left (tiles own their pixels)
 };
-
 }  // namespace
 
 Camera lookAtCamera(const Vec3& eye, const Vec3& target, const Vec3& upHint, bool perspective, double halfWidth) {
@@ -255,28 +267,44 @@ double pixelV(const Camera& cam, int width, int height, int row) {
   return (0.5 * double(height - 1) - double(row)) * step;
 }
 
-DepthImage castRays(const Expr& field, const Camera& camera, const RenderOptions& opt, const std::vector<double>& fixed,
-                    RenderStats* stats) {
+namespace {
+void checkView(const Camera& camera, const RenderOptions& opt) {
   if (opt.width <= 0 || opt.height <= 0) throw std::invalid_argument("render: the image size must be positive");
   if (!(opt.farDepth > opt.nearDepth) || !std::isfinite(opt.nearDepth) || !std::isfinite(opt.farDepth))
     throw std::invalid_argument("render: the depth range must be finite and non-empty");
   if (!(camera.halfWidth > 0) || !std::isfinite(camera.halfWidth))
     throw std::invalid_argument("render: the view width must be positive");
-  DepthImage img;
-  img.width = opt.width, img.height = opt.height;
-  img.pixelStep = 2.0 * camera.halfWidth / opt.width;
-  img.hits.assign(size_t(opt.width) * size_t(opt.height), RayHit{});
-  TapePtr view = Tape::compile(remap(field, cameraMap(camera, fixed)), 3);
-  TapePtr model = Tape::compile(field, uint32_t(3 + fixed.size()));
-  Caster caster(camera, opt, view, model, img, fixed);
-  const int tilesX = (opt.width + kTopTile - 1) / kTopTile, tilesY = (opt.height + kTopTile - 1) / kTopTile;
+}
+}  // namespace
+
+TapePtr viewTape(const Expr& field, const Camera& camera, const std::vector<double>& fixed) {
+  return Tape::compile(remap(field, cameraMap(camera, fixed)), 3);
+}
+
+bool isTileRegion(const PixelRegion& g, int width, int height) {
+  auto ok = [](int lo, int hi, int size) {
+    return 0 <= lo && lo < hi && hi <= size && lo % kRenderTile == 0 && (hi % kRenderTile == 0 || hi == size);
+  };
+  return ok(g.c0, g.c1, width) && ok(g.r0, g.r1, height);
+}
+
+std::vector<RayHit> castRegion(const TapePtr& view, const Camera& camera, const RenderOptions& opt,
+                               const PixelRegion& region, RenderStats* stats) {
+  checkView(camera, opt);
+  if (!isTileRegion(region, opt.width, opt.height))
+    throw std::invalid_argument("render: the region [" + std::to_string(region.c0) + "," + std::to_string(region.c1) +
+                                ")x[" + std::to_string(region.r0) + "," + std::to_string(region.r1) +
+                                ") is not made of whole " + std::to_string(kRenderTile) + "-pixel tiles of the image");
+  std::vector<RayHit> hits(size_t(region.c1 - region.c0) * size_t(region.r1 - region.r0));
+  Caster caster(camera, opt, view, region, hits);
+  const int tx0 = region.c0 / kRenderTile, ty0 = region.r0 / kRenderTile;
+  const int tilesX = (region.c1 - 1) / kRenderTile + 1 - tx0, tilesY = (region.r1 - 1) / kRenderTile + 1 - ty0;
   tbb::enumerable_thread_specific<Worker> workers;
   parallelChunks(size_t(tilesX) * size_t(tilesY), 1, opt.threads, [&](size_t b, size_t e) {
     Worker& w = workers.local();
     for (size_t t = b; t < e; ++t) {
-      const int tx = int(t % size_t(tilesX)), ty = int(t / size_t(tilesX));
-      const int c0 = tx * kTopTile, r0 = ty * kTopTile;
-      caster.topTile(w, c0, std::min(c0 + kTopTile, opt.width), r0, std::min(r0 + kTopTile, opt.height));
+      const int c0 = (tx0 + int(t % size_t(tilesX))) * kRenderTile, r0 = (ty0 + int(t / size_t(tilesX))) * kRenderTile;
+      caster.topTile(w, c0, std::min(c0 + kRenderTile, region.c1), r0, std::min(r0 + kRenderTile, region.r1));
     }
   });
   if (stats) {
@@ -286,6 +314,16 @@ DepthImage castRays(const Expr& field, const Camera& camera, const RenderOptions
       stats->pointEvals += w.stats.pointEvals;
     }
   }
+  return hits;
+}
+
+DepthImage castRays(const Expr& field, const Camera& camera, const RenderOptions& opt, const std::vector<double>& fixed,
+                    RenderStats* stats) {
+  checkView(camera, opt);
+  DepthImage img;
+  img.width = opt.width, img.height = opt.height;
+  img.pixelStep = 2.0 * camera.halfWidth / opt.width;
+  img.hits = castRegion(viewTape(field, camera, fixed), camera, opt, PixelRegion{0, 0, opt.width, opt.height}, stats);
   return img;
 }
 

@@ -13,8 +13,9 @@
 // footprint (its square of rays) is searched too: a feature thinner than a pixel between two
 // pixel centres is reported as a sub-pixel hit (RayHit::kFootprint).
 //
-// The image is cut into fixed tiles independent of the thread count, and every pixel's result
-// depends only on its tile's subdivision, so the output is identical for any thread count.
+// The image is cut into fixed kRenderTile-pixel tiles independent of the thread count, and every
+// pixel's result depends only on its tile's subdivision, so the output is identical for any
+// thread count and for any split of the image into regions of whole tiles (the farm's bricks).
 #pragma once
 
 #include <array>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "frep/expressions/expr.h"
+#include "frep/expressions/tape.h"
 
 namespace frep {
 
@@ -73,6 +75,26 @@ struct DepthImage {
 // Image-plane coordinate of a pixel centre (col from the left, row from the top).
 double pixelU(const Camera& cam, int width, int col);
 double pixelV(const Camera& cam, int width, int height, int row);
+
+// The image's tile edge in pixels: castRegion's regions are made of whole tiles.
+constexpr int kRenderTile = 32;
+
+// Pixels [c0, c1) x [r0, r1) of the image (columns from the left, rows from the top).
+struct PixelRegion {
+  int c0 = 0, r0 = 0, c1 = 0, r1 = 0;
+};
+// Whether the region lies in a width x height image and is made of whole tiles: c0, r0
+// multiples of kRenderTile, c1, r1 multiples of it or the image's edge.
+bool isTileRegion(const PixelRegion& region, int width, int height);
+
+// The tape castRegion casts: `field` (x, y, z = vars 0..2, further vars fixed to `fixed`)
+// composed with the camera map, over (u, v, d).
+TapePtr viewTape(const Expr& field, const Camera& camera, const std::vector<double>& fixed = {});
+
+// The hits of the region's pixels (row-major within the region), exactly as castRays finds them
+// for the whole image. Throws std::invalid_argument for a bad view or a region not of whole tiles.
+std::vector<RayHit> castRegion(const TapePtr& view, const Camera& camera, const RenderOptions& options,
+                               const PixelRegion& region, RenderStats* stats = nullptr);
 
 // Casts every pixel's ray against `field` (coordinates x, y, z = vars 0..2; further vars get
 // `fixed` values in order). Throws std::invalid_argument for a bad size or depth range.
