@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "geometric_types.h"
 #include "model_loader.h"
 
 namespace frep::cli {
@@ -99,12 +100,17 @@ struct RenderRequest {
   double fov = 30;         // perspective: horizontal field of view, degrees
   std::string background = "255,255,255", colour = "204,158,97";
   int frames = 0;          // turntable: N frames over 360 degrees of azimuth
-  int tFrames = 0;         // N frames sweeping x[4] over --t-range
-  std::string tRange = "0,1";
-  int threads = 0;
+  GeometricRequest geometric;  // T frames, V/W grid, C/G sections (geometric_types.h)
+  FarmRequest farm;
+  int threads = 0;         // threads of the in-process run (--workers 0)
   bool noFootprint = false;
+  std::string logLevel = "info";
 };
 int runRender(const RenderRequest& request);
+// frep render of a mesh (.ply, .obj, .stl) or a sampled .vdb: its triangles drawn by the
+// z-buffer (render_mesh_command.cpp), with the same cameras and shading.
+bool isMeshOrVdb(const std::string& path);
+int runRenderMesh(const RenderRequest& request);
 
 int runKeygen(const std::string& dir);
 

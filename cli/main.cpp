@@ -76,6 +76,19 @@ void addRegionOptions(CLI::App* sub, RegionRequest& r, const std::string& outHel
   sub->add_option("-O,--out", r.out, outHelp + " (required)");  // required: checked by the command, after -o
 }
 
+// Geometric types of -x (docs/cli.md, "Geometric types"): T frames, V/W grid, C/G sections.
+void addGeometricOptions(CLI::App* sub, GeometricRequest& g) {
+  sub->add_option("--t-frames", g.tFrames, "Frames over the T coordinate of -x (x[4] without -x): numbered pictures");
+  sub->add_option("--t-range", g.tRange, "first,last value of T (default 0,1)");
+  sub->add_option("--v-range", g.vRange, "first,last value of V, the grid's columns (default 0,1)");
+  sub->add_option("--v-cells", g.vCells, "Columns of the V/W grid (default 4)");
+  sub->add_option("--w-range", g.wRange, "first,last value of W, the grid's rows (default 0,1)");
+  sub->add_option("--w-cells", g.wCells, "Rows of the V/W grid (default 4)");
+  sub->add_option("--c-range", g.cRange, "first,last value of C, coloured along the spectrum (default 0,1)");
+  sub->add_option("--c-levels", g.cLevels, "Sections of the C coordinate (default 8)");
+  sub->add_option("--g-values", g.gValues, "Values of the G coordinate, v1,v2,...: their sections in one picture");
+}
+
 void addFarmOptions(CLI::App* sub, FarmRequest& f) {
   sub->add_option("--workers", f.workers, "Local worker processes (default: one per core; 0 computes in-process)");
   sub->add_option("--listen", f.listen,
@@ -194,9 +207,9 @@ int main(int argc, char** argv) {
   renderCmd->add_option("--background", render.background, "Background r,g,b (0-255) or #rrggbb (default white)");
   renderCmd->add_option("--colour,--color", render.colour, "Surface colour r,g,b (0-255) or #rrggbb");
   renderCmd->add_option("--frames", render.frames, "Turntable: N frames turning the azimuth through 360 degrees");
-  renderCmd->add_option("--t-frames", render.tFrames, "N frames sweeping x[4] over --t-range (geometric type t: animation)");
-  renderCmd->add_option("--t-range", render.tRange, "first,last value of x[4] for --t-frames (default 0,1)");
-  renderCmd->add_option("--threads", render.threads, "Threads (default 0: all cores; same output)");
+  addGeometricOptions(renderCmd, render.geometric);
+  addFarmOptions(renderCmd, render.farm);
+  renderCmd->add_option("--threads", render.threads, "Threads of the in-process run, --workers 0 (default 0: all cores; same output)");
   renderCmd->add_flag("--no-footprint", render.noFootprint,
                       "Cast centre rays only (sub-pixel features between pixel centres are then not drawn)");
 
@@ -236,6 +249,7 @@ int main(int argc, char** argv) {
     if (relateCmd->parsed()) return runRelate(relate);
     if (renderCmd->parsed()) {
       checkObjectIsNotAFile(render.model);
+      render.logLevel = logLevel;
       return runRender(render);
     }
     if (meshCmd->parsed()) {

@@ -41,8 +41,9 @@ std::vector<uint8_t> shadeImage(const DepthImage& img, const Camera& cam, const 
       if (dot(n, toEye) < 0) n = {-n[0], -n[1], -n[2]};  // seen from inside (near plane cut)
       const double light = opt.ambient + opt.headlight * std::max(0.0, dot(n, toEye)) +
                            opt.key * std::max(0.0, dot(n, key));
+      const std::array<double, 3> albedo = opt.colourAt ? opt.colourAt(h) : opt.colour;
       for (int i = 0; i < 3; ++i) {
-        double value = opt.colour[size_t(i)] * light;
+        double value = albedo[size_t(i)] * light;
         if (h.kind == RayHit::kFootprint) value = 0.5 * value + 0.5 * opt.background[size_t(i)] / 255.0;
         out[i] = toByte(value);
       }
