@@ -44,6 +44,7 @@ struct SliceRequest {
   std::string axis;  // "" = z (3D objects); ignored for 2D objects
   double at = 0.0;   // position of the slicing plane on that axis
   bool mask = false; // inside/outside only (white/black): tiles an interval decides are not evaluated
+  GeometricRequest geometric;  // T frames, V/W grid, C/G sections (geometric_types.h)
 };
 int runSlice(const SliceRequest& request);
 

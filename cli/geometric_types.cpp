@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "arg_parse.h"
@@ -88,6 +89,15 @@ std::string GeometricTypes::mapping(double tv, double vv, double wv, double sect
     text += (i ? "," : "") + item;
   }
   return text;
+}
+
+std::string framePath(const std::string& out, int frame, int frames) {
+  if (frames <= 1) return out;
+  const size_t dot = out.find_last_of('.'), slash = out.find_last_of('/');
+  const bool hasExt = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+  char num[16];
+  std::snprintf(num, sizeof num, "_%04d", frame);
+  return hasExt ? out.substr(0, dot) + num + out.substr(dot) : out + num;
 }
 
 std::array<double, 3> spectralColour(double s) {

@@ -46,6 +46,9 @@ struct GeometricTypes {
 constexpr int kMaxValues = 10000;
 GeometricTypes parseGeometricTypes(const std::string& mapping, const GeometricRequest& request, bool defaultT);
 
+// The frame's file name: NAME.png -> NAME_0007.png (single pictures keep the name).
+std::string framePath(const std::string& out, int frame, int frames);
+
 // Spectral colour of s in [0, 1]: red (0) through yellow, green, cyan, blue to violet (1).
 std::array<double, 3> spectralColour(double s);
 

@@ -150,6 +150,7 @@ int main(int argc, char** argv) {
   sliceCmd->add_option("--axis", slice.axis, "Axis normal to the plane: x, y or z (default z; not for 2D objects)");
   sliceCmd->add_option("--at", slice.at, "Position of the plane on that axis (default 0)");
   sliceCmd->add_flag("--mask", slice.mask, "Inside white, outside black: only pixels near the boundary are evaluated");
+  addGeometricOptions(sliceCmd, slice.geometric);
 
   SampleRequest sample;
   CLI::App* sampleCmd = app.add_subcommand("sample", "Narrow-band OpenVDB level set (stores -f) of a model");

@@ -65,16 +65,6 @@ Vec3 parseVec(const std::string& field, const std::string& text) {
   return {n[0], n[1], n[2]};
 }
 
-// The frame's file name: NAME.png -> NAME_0007.png (single pictures keep the name).
-std::string framePath(const std::string& out, int frame, int frames) {
-  if (frames <= 1) return out;
-  const size_t dot = out.find_last_of('.'), slash = out.find_last_of('/');
-  const bool hasExt = dot != std::string::npos && (slash == std::string::npos || dot > slash);
-  char num[16];
-  std::snprintf(num, sizeof num, "_%04d", frame);
-  return hasExt ? out.substr(0, dot) + num + out.substr(dot) : out + num;
-}
-
 struct View {
   Camera camera;
   double nearDepth = 0, farDepth = 1;
