@@ -101,6 +101,9 @@ class Master {
       : job_(job), opt_(opt), jobId_(jobIdOf(job)), grid_(gridOf(job)), op_(operationOf(job)) {
     if (opt.brickVoxels < 8 || opt.brickVoxels % 8 != 0)
       throw std::invalid_argument("--brick must be a positive multiple of 8 voxels");
+    if (op_ == Operation::Render && opt.brickVoxels % kRenderTile != 0)  // castRegion's regions
+      throw std::invalid_argument("--brick: a render's bricks are whole " + std::to_string(kRenderTile) +
+                                  "-pixel tiles: expected a multiple of " + std::to_string(kRenderTile));
     if (!opt.listen.empty() && opt.curveDir.empty() && !opt.insecure && !isLoopbackEndpoint(opt.listen))
       throw std::invalid_argument("--listen " + opt.listen +
                                   ": without --curve anyone who can reach this address can join the farm and forge "

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "frep/render/rasterize.h"
 #include "frep/render/raycast.h"
 #include "frep/render/shade.h"
 
@@ -185,6 +186,39 @@ TEST(Render, RegionsOfWholeTilesGiveTheWholeImage) {
   EXPECT_THROW(castRegion(view, cam, opt, PixelRegion{16, 0, 48, 32}), std::invalid_argument);
   EXPECT_THROW(castRegion(view, cam, opt, PixelRegion{0, 0, 40, 32}), std::invalid_argument);
   EXPECT_THROW(castRegion(view, cam, opt, PixelRegion{128, 96, 160, 100}), std::invalid_argument);
+}
+
+// The z-buffer on a unit cube of 12 outward triangles, seen along +y: the pixels are exactly
+// the centres inside the square (none lies on an edge), the depth is the front face's and the
+// normal its outward one; perspective: the near face's square seen from distance 3.5.
+TEST(Render, RasterizedCubeIsTheExactSquare) {
+  Mesh cube;
+  for (int k = 0; k < 8; ++k) cube.positions.push_back({k & 1 ? 0.5 : -0.5, k & 2 ? 0.5 : -0.5, k & 4 ? 0.5 : -0.5});
+  // Faces as corner quads, counter-clockwise seen from outside.
+  const uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& q : quads) cube.triangles.push_back({q[0], q[1], q[2]}), cube.triangles.push_back({q[0], q[2], q[3]});
+  for (bool perspective : {false, true}) {
+    const Camera cam = orbitCamera({0, 0, 0}, -90, 0, 4, perspective, perspective ? 0.3 : 1.0);
+    const int W = 64, H = 48;
+    const DepthImage img = rasterize(cube, cam, options(W, H, 1.0, 8.0));
+    const double half = perspective ? 0.5 / 3.5 : 0.5;  // the front face's square on the image plane
+    size_t inside = 0, hits = 0;
+    for (int r = 0; r < H; ++r)
+      for (int c = 0; c < W; ++c) {
+        const double u = pixelU(cam, W, c), v = pixelV(cam, W, H, r);
+        const bool in = std::abs(u) < half && std::abs(v) < half;
+        inside += in;
+        const RayHit& h = img.at(c, r);
+        hits += h.kind == RayHit::kCentre;
+        ASSERT_EQ(h.kind == RayHit::kCentre, in) << c << "," << r << " perspective " << perspective;
+        if (!in) continue;
+        EXPECT_NEAR(h.point[1], -0.5, 1e-12);
+        EXPECT_EQ(h.normal, (Vec3{0, -1, 0}));
+      }
+    EXPECT_GT(inside, 100u);
+    EXPECT_EQ(hits, inside);
+    EXPECT_NEAR(img.at(W / 2, H / 2).depth, 3.5, 1e-12);
+  }
 }
 
 // The shaded bytes of a sphere against the same Lambert formula evaluated on the analytic hit
