@@ -2,7 +2,7 @@
 # README command 1: set up, build, and run the main jobs on an example: the blended chair of the
 # F-rep survey sampled at 192^3 and meshed at 160^3 by a farm of local workers (one per core),
 # written as an OpenVDB level set and a PLY mesh with their reports, plus a slice picture and a
-# shaded render.
+# shaded render (frep render: the image's tiles computed by the same local workers).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./deploy/build.sh
