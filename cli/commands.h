@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "geometric_types.h"
 #include "model_loader.h"
 
 namespace frep::cli {
@@ -43,6 +44,7 @@ struct SliceRequest {
   std::string axis;  // "" = z (3D objects); ignored for 2D objects
   double at = 0.0;   // position of the slicing plane on that axis
   bool mask = false; // inside/outside only (white/black): tiles an interval decides are not evaluated
+  GeometricRequest geometric;  // T frames, V/W grid, C/G sections (geometric_types.h)
 };
 int runSlice(const SliceRequest& request);
 
@@ -83,6 +85,33 @@ struct MeshRequest {
   std::string logLevel = "info";
 };
 int runMesh(const MeshRequest& request);
+
+// frep render: a shaded PNG of the solid by certified interval ray casting (frep/render), in
+// process on threads; turntable (--frames) and x[4] sweep (--t-frames) write numbered frames.
+struct RenderRequest {
+  ModelRequest model;
+  std::string bounds;      // -b: the region drawn (hfp's default ±10); the view fits the solid in it
+  std::string out;         // -O: PNG path (frames: NAME_0000.png, ...)
+  std::string size = "512x512";
+  double azimuth = -60, elevation = 25;  // degrees
+  double distance = 0;     // 0: fit the solid
+  double zoom = 1;         // > 1 magnifies
+  std::string eye, target, up;  // look-at camera (eye given: azimuth/elevation ignored)
+  bool perspective = false;
+  double fov = 30;         // perspective: horizontal field of view, degrees
+  std::string background = "255,255,255", colour = "204,158,97";
+  int frames = 0;          // turntable: N frames over 360 degrees of azimuth
+  GeometricRequest geometric;  // T frames, V/W grid, C/G sections (geometric_types.h)
+  FarmRequest farm;
+  int threads = 0;         // threads of the in-process run (--workers 0)
+  bool noFootprint = false;
+  std::string logLevel = "info";
+};
+int runRender(const RenderRequest& request);
+// frep render of a mesh (.ply, .obj, .stl) or a sampled .vdb: its triangles drawn by the
+// z-buffer (render_mesh_command.cpp), with the same cameras and shading.
+bool isMeshOrVdb(const std::string& path);
+int runRenderMesh(const RenderRequest& request);
 
 int runKeygen(const std::string& dir);
 

@@ -156,6 +156,16 @@ void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report
   throw CliError(kExitPoisoned, poisonedMessage(report));
 }
 
+void requireComplete(const farm::FarmReport& report) {
+  if (report.interrupted) throw CliError(kExitInterrupted, "stopped by a signal; nothing was written");
+  if (report.poisoned.empty()) return;
+  std::string s = std::to_string(report.poisoned.size()) + " tile(s) failed 3 times and were given up:";
+  for (auto& p : report.poisoned)
+    s += "\n  tile " + std::to_string(p.brick) + " pixels [" + std::to_string(p.lo[0]) + "," + std::to_string(p.hi[0]) +
+         ")x[" + std::to_string(p.lo[1]) + "," + std::to_string(p.hi[1]) + "): " + p.error;
+  throw CliError(kExitPoisoned, s);
+}
+
 std::string bricksSummary(const farm::FarmReport& report) {
   return "bricks " + std::to_string(report.bricks) + " (" + std::to_string(report.bricksComputed) + " computed, " +
          std::to_string(report.bricksFromJournal) + " from the journal), workers " +

@@ -43,6 +43,9 @@ void writeReport(io::AtomicOutput& reportOut, const farm::FarmReport& report);
 // 5 (the poisoned bricks named). Returns when the job is complete.
 void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report);
 
+// The same without a report or journal (frep render): throws CliError with exit 6 or 5.
+void requireComplete(const farm::FarmReport& report);
+
 // "bricks N (C computed, J from the journal), workers W, retries R, T s" for the summary.
 std::string bricksSummary(const farm::FarmReport& report);
 

@@ -76,6 +76,19 @@ void addRegionOptions(CLI::App* sub, RegionRequest& r, const std::string& outHel
   sub->add_option("-O,--out", r.out, outHelp + " (required)");  // required: checked by the command, after -o
 }
 
+// Geometric types of -x (docs/cli.md, "Geometric types"): T frames, V/W grid, C/G sections.
+void addGeometricOptions(CLI::App* sub, GeometricRequest& g) {
+  sub->add_option("--t-frames", g.tFrames, "Frames over the T coordinate of -x (x[4] without -x): numbered pictures");
+  sub->add_option("--t-range", g.tRange, "first,last value of T (default 0,1)");
+  sub->add_option("--v-range", g.vRange, "first,last value of V, the grid's columns (default 0,1)");
+  sub->add_option("--v-cells", g.vCells, "Columns of the V/W grid (default 4)");
+  sub->add_option("--w-range", g.wRange, "first,last value of W, the grid's rows (default 0,1)");
+  sub->add_option("--w-cells", g.wCells, "Rows of the V/W grid (default 4)");
+  sub->add_option("--c-range", g.cRange, "first,last value of C, coloured along the spectrum (default 0,1)");
+  sub->add_option("--c-levels", g.cLevels, "Sections of the C coordinate (default 8)");
+  sub->add_option("--g-values", g.gValues, "Values of the G coordinate, v1,v2,...: their sections in one picture");
+}
+
 void addFarmOptions(CLI::App* sub, FarmRequest& f) {
   sub->add_option("--workers", f.workers, "Local worker processes (default: one per core; 0 computes in-process)");
   sub->add_option("--listen", f.listen,
@@ -137,6 +150,7 @@ int main(int argc, char** argv) {
   sliceCmd->add_option("--axis", slice.axis, "Axis normal to the plane: x, y or z (default z; not for 2D objects)");
   sliceCmd->add_option("--at", slice.at, "Position of the plane on that axis (default 0)");
   sliceCmd->add_flag("--mask", slice.mask, "Inside white, outside black: only pixels near the boundary are evaluated");
+  addGeometricOptions(sliceCmd, slice.geometric);
 
   SampleRequest sample;
   CLI::App* sampleCmd = app.add_subcommand("sample", "Narrow-band OpenVDB level set (stores -f) of a model");
@@ -176,12 +190,35 @@ int main(int argc, char** argv) {
   relateCmd->add_option("-b,--bounds", relate.bounds, "Box searched (default 10)");
   relateCmd->add_option("--min-size", relate.minSize, "Smallest box edge of the subdivision (default 1e-4 of the box)");
   relateCmd->add_option("--at", relate.at, "Also classify the point X,Y,Z against both");
+  RenderRequest render;
+  CLI::App* renderCmd = app.add_subcommand("render", "Shaded PNG of a model by certified interval ray casting");
+  addModelOptions(renderCmd, render.model, true);
+  renderCmd->add_option("-b,--bounds", render.bounds, "Region drawn: B | min,max | bx,by,bz | xmin,ymin,zmin,xmax,ymax,zmax (default 10)");
+  renderCmd->add_option("-O,--out", render.out, "Output PNG file (required); frames add _0000, _0001, ...");
+  renderCmd->add_option("--size", render.size, "Image size WxH in pixels (default 512x512)");
+  renderCmd->add_option("--azimuth", render.azimuth, "Camera azimuth in degrees, from +x towards +y (default -60)");
+  renderCmd->add_option("--elevation", render.elevation, "Camera elevation in degrees above the xy plane (default 25)");
+  renderCmd->add_option("--distance", render.distance, "Camera distance from the target (default: fit the solid)");
+  renderCmd->add_option("--zoom", render.zoom, "Magnification of the fitted view (default 1)");
+  renderCmd->add_option("--eye", render.eye, "Look-at camera: eye position x,y,z (instead of azimuth/elevation)");
+  renderCmd->add_option("--target", render.target, "Point looked at, x,y,z (default: the centre of the solid's box)");
+  renderCmd->add_option("--up", render.up, "Up direction of the image, x,y,z (default 0,0,1)");
+  renderCmd->add_flag("--perspective", render.perspective, "Perspective projection (default orthographic)");
+  renderCmd->add_option("--fov", render.fov, "Perspective: horizontal field of view in degrees (default 30)");
+  renderCmd->add_option("--background", render.background, "Background r,g,b (0-255) or #rrggbb (default white)");
+  renderCmd->add_option("--colour,--color", render.colour, "Surface colour r,g,b (0-255) or #rrggbb");
+  renderCmd->add_option("--frames", render.frames, "Turntable: N frames turning the azimuth through 360 degrees");
+  addGeometricOptions(renderCmd, render.geometric);
+  addFarmOptions(renderCmd, render.farm);
+  renderCmd->add_option("--threads", render.threads, "Threads of the in-process run, --workers 0 (default 0: all cores; same output)");
+  renderCmd->add_flag("--no-footprint", render.noFootprint,
+                      "Cast centre rays only (sub-pixel features between pixel centres are then not drawn)");
 
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
   keygenCmd->add_option("dir", keygenDir, "Directory for the keys")->required();
 
-  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, povCmd}) sub->fallthrough();
+  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, povCmd, renderCmd}) sub->fallthrough();
 
   try {
     app.parse(argc, argv);
@@ -189,7 +226,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov, relate and keygen";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov, relate, render and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
@@ -211,6 +248,11 @@ int main(int argc, char** argv) {
     if (keygenCmd->parsed()) return runKeygen(keygenDir);
     if (povCmd->parsed()) return runPov(pov);
     if (relateCmd->parsed()) return runRelate(relate);
+    if (renderCmd->parsed()) {
+      checkObjectIsNotAFile(render.model);
+      render.logLevel = logLevel;
+      return runRender(render);
+    }
     if (meshCmd->parsed()) {
       checkObjectIsNotAFile(mesh.model);
       mesh.logLevel = logLevel;

@@ -101,6 +101,9 @@ class Master {
       : job_(job), opt_(opt), jobId_(jobIdOf(job)), grid_(gridOf(job)), op_(operationOf(job)) {
     if (opt.brickVoxels < 8 || opt.brickVoxels % 8 != 0)
       throw std::invalid_argument("--brick must be a positive multiple of 8 voxels");
+    if (op_ == Operation::Render && opt.brickVoxels % kRenderTile != 0)  // castRegion's regions
+      throw std::invalid_argument("--brick: a render's bricks are whole " + std::to_string(kRenderTile) +
+                                  "-pixel tiles: expected a multiple of " + std::to_string(kRenderTile));
     if (!opt.listen.empty() && opt.curveDir.empty() && !opt.insecure && !isLoopbackEndpoint(opt.listen))
       throw std::invalid_argument("--listen " + opt.listen +
                                   ": without --curve anyone who can reach this address can join the farm and forge "
@@ -163,6 +166,10 @@ class Master {
       // triangles per cell (3 varints of at most 5 bytes each and a state byte).
       const size_t b = size_t(opt_.brickVoxels);
       payloadLimit_ = 4096 + 8 * (b + 1) * (b + 1) * (b + 1) * (10 + 48 + 5 + 88 + 1) + 12 * b * b * b * 16;
+    }
+    if (op_ == Operation::Render) {  // a kind byte and 7 doubles per pixel
+      const size_t b = size_t(opt_.brickVoxels);
+      payloadLimit_ = 4096 + b * b * (1 + 7 * 8);
     }
   }
 
@@ -567,6 +574,9 @@ class Master {
   }
 
   bool insideBrick(const BrickOutput& out, const Brick& b) const {
+    if (op_ == Operation::Render)  // the brick's pixels, every one
+      return out.tileLo == b.lo && out.tileHi == b.hi &&
+             out.hits.size() == size_t(b.hi[0] - b.lo[0]) * size_t(b.hi[1] - b.lo[1]);
     if (op_ == Operation::Mesh) {
       // The piece of this brick: every vertex on an edge starting at a grid point of the
       // brick's cells, [lo, hi] (a cell's far corners included).
@@ -816,7 +826,24 @@ class Master {
 
   FarmOutcome finish() {
     FarmOutcome o;
-    report_.operation = op_ == Operation::Mesh ? "mesh" : "sample";
+    report_.operation = op_ == Operation::Mesh ? "mesh" : op_ == Operation::Render ? "render" : "sample";
+    if (op_ == Operation::Render && done_ == bricks_.size()) {
+      // The merge step of a render job: each tile's hits to their pixels (split-invariant, as
+      // castRegion's regions give the whole image's hits).
+      DepthImage& img = o.image;
+      img.width = grid_.dims[0], img.height = grid_.dims[1];
+      img.pixelStep = 2.0 * job_.render().half_width() / img.width;
+      img.hits.assign(size_t(img.width) * size_t(img.height), RayHit{});
+      for (const BrickOutput& out : outputs_) {
+        const int w = out.tileHi[0] - out.tileLo[0];
+        for (size_t i = 0; i < out.hits.size(); ++i) {
+          const RayHit& h = out.hits[i];
+          img.hits[size_t(out.tileLo[1] + int(i) / w) * size_t(img.width) + size_t(out.tileLo[0] + int(i) % w)] = h;
+          report_.pixelsHit += h.kind != RayHit::kNone;
+        }
+      }
+      outputs_.clear();
+    }
     if (op_ == Operation::Mesh && done_ == bricks_.size()) {
       // The merge step of a mesh job: the pieces stitched by global edge key (split-invariant).
       // mergePiecesReleasing frees each piece as soon as it is stitched: the master holds about
@@ -907,6 +934,7 @@ std::string FarmReport::toJson() const {
                                                      {"error", simplify.rejectedError},
                                                      {"intersection", simplify.rejectedIntersection}}}};
   }
+  else if (operation == "render") j["output"] = {{"pixels_hit", pixelsHit}};
   else j["output"] = {{"leaves", leaves}, {"tiles", tiles}};
   j["faults"] = {{"retries", retries},           {"duplicates", duplicates},
                  {"late_results", lateResults},  {"malformed", malformed},

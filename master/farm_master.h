@@ -13,6 +13,7 @@
 #include "farm.pb.h"
 #include "frep/meshing/mesh.h"
 #include "frep/meshing/mesh_simplify.h"
+#include "frep/render/raycast.h"
 #include "frep/sampling/sample.h"
 
 namespace frep::farm {
@@ -64,6 +65,7 @@ struct FarmReport {
   DomainCounts domainErrors;
   uint64_t leaves = 0, tiles = 0;        // "sample": merged output
   uint64_t vertices = 0, triangles = 0;  // "mesh": merged output (after simplification)
+  uint64_t pixelsHit = 0;                // "render": pixels on the solid (centre or footprint)
   // "mesh": the simplification of the merged mesh (frep/meshing/mesh_simplify.h; run by the caller).
   double simplifyTolerance = 0;  // voxels; 0: not simplified
   bool sharpFeatures = false;
@@ -91,10 +93,11 @@ struct FarmReport {
 struct FarmOutcome {
   SampleResult result;  // "sample": merged, sorted as sample() sorts
   Mesh mesh;            // "mesh": the bricks' pieces stitched by mergePieces (as meshGrid does)
+  DepthImage image;     // "render": the tiles' hits, as castRays gives them
   FarmReport report;
 };
 
-// Runs a job ("sample" or "mesh"): one scheduling loop; only the final merge depends on the
+// Runs a job ("sample", "mesh" or "render"): one scheduling loop; only the final merge depends on the
 // operation. Throws std::invalid_argument for a bad job or options (unknown operation, brick
 // size, --listen on a non-loopback address without CURVE or insecure) and std::runtime_error
 // for setup failures (bind, journal, keys, local workers that keep dying).

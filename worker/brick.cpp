@@ -63,6 +63,21 @@ Expr jobField(const JobSpec& job, uint32_t* dimsOut) {
   spec.axis.assign(job.map_axis().begin(), job.map_axis().end());
   spec.constant.assign(job.map_constant().begin(), job.map_constant().end());
   Expr f = lang::fieldOf(r.model, spec);
+  if (operationOf(job) == Operation::Render) {
+    const RenderSpec& v = job.render();
+    if (v.section_values_size() > 0) {  // the union of the sections (geometric types C, G)
+      const size_t c = size_t(v.section_coordinate());
+      if (c >= spec.axis.size() || spec.axis[c] != -1)
+        throw std::invalid_argument("job: the section coordinate is not a constant of the mapping");
+      for (int k = 0; k < v.section_values_size(); ++k) {
+        spec.constant[c] = v.section_values(k);
+        const Expr section = lang::fieldOf(r.model, spec);
+        f = k == 0 ? section : max(f, section);
+      }
+    }
+    if (v.clip_lo_size() != 3 || v.clip_hi_size() != 3) throw std::invalid_argument("job: render clip box needs 3 values each");
+    f = clipToBox(f, {v.clip_lo(0), v.clip_lo(1), v.clip_lo(2)}, {v.clip_hi(0), v.clip_hi(1), v.clip_hi(2)});
+  }
   const uint32_t dims = spec.axis.empty() ? uint32_t(r.model.xSize) : 3u;
   if (frep::numVars(f) > 3)
     throw std::runtime_error("the field has " + std::to_string(frep::numVars(f)) +
@@ -72,10 +87,53 @@ Expr jobField(const JobSpec& job, uint32_t* dimsOut) {
 }
 }  // namespace
 
+Expr jobFieldOf(const JobSpec& job) {
+  uint32_t dims = 0;
+  return jobField(job, &dims);
+}
+
 TapePtr compileJobModel(const JobSpec& job) {
   uint32_t dims = 0;
   Expr f = jobField(job, &dims);
+  if (operationOf(job) == Operation::Render) return viewTape(f, cameraOf(job));
   return Tape::compile(f, std::min(dims, 3u));
+}
+
+Expr clipToBox(const Expr& f, const Vec3& lo, const Vec3& hi) {
+  Expr e = f;
+  for (uint32_t i = 0; i < 3; ++i) {
+    e = min(e, Expr::x(i) - lo[i]);
+    e = min(e, hi[i] - Expr::x(i));
+  }
+  return e;
+}
+
+namespace {
+Vec3 vec3(const google::protobuf::RepeatedField<double>& v, const char* name) {
+  if (v.size() != 3) throw std::invalid_argument(std::string("job: render ") + name + " needs 3 values");
+  return {v[0], v[1], v[2]};
+}
+}  // namespace
+
+Camera cameraOf(const JobSpec& job) {
+  const RenderSpec& v = job.render();
+  Camera c;
+  c.eye = vec3(v.eye(), "eye");
+  c.right = vec3(v.right(), "right");
+  c.up = vec3(v.up(), "up");
+  c.forward = vec3(v.forward(), "forward");
+  c.perspective = v.perspective();
+  c.halfWidth = v.half_width();
+  return c;
+}
+
+RenderOptions renderOptionsOf(const JobSpec& job) {
+  const GridSpec g = gridOf(job);
+  RenderOptions o;
+  o.width = g.dims[0], o.height = g.dims[1];
+  o.nearDepth = job.render().near_depth(), o.farDepth = job.render().far_depth();
+  o.footprint = !job.render().no_footprint();
+  return o;
 }
 
 std::vector<std::string> describeExactTerms(const JobSpec& job) {
@@ -95,7 +153,8 @@ TapePtr ModelCache::get(const JobSpec& job, uint64_t jobId) {
 Operation operationOf(const JobSpec& job) {
   if (job.operation().empty() || job.operation() == "sample") return Operation::Sample;
   if (job.operation() == "mesh") return Operation::Mesh;
-  throw std::invalid_argument("job: unknown operation '" + job.operation() + "' (expected sample or mesh)");
+  if (job.operation() == "render") return Operation::Render;
+  throw std::invalid_argument("job: unknown operation '" + job.operation() + "' (expected sample, mesh or render)");
 }
 
 namespace {
@@ -122,6 +181,17 @@ BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::arr
 namespace {
 BrickOutput computeBrickOnce(const TapePtr& tape, const JobSpec& job, const std::array<int32_t, 3>& lo,
                              const std::array<int32_t, 3>& hi, int threads) {
+  if (operationOf(job) == Operation::Render) {
+    RenderOptions opt = renderOptionsOf(job);
+    opt.threads = threads;
+    RenderStats stats;
+    BrickOutput out;
+    out.hits = castRegion(tape, cameraOf(job), opt, PixelRegion{lo[0], lo[1], hi[0], hi[1]}, &stats);
+    out.tileLo = lo, out.tileHi = hi;
+    out.stats.pointEvals = stats.pointEvals;
+    out.stats.intervalEvals = stats.intervalEvals;
+    return out;
+  }
   if (operationOf(job) == Operation::Mesh) {
     MeshOptions mo;
     mo.threads = threads;
@@ -460,12 +530,73 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
   return true;
 }
 
+// ---- render tiles ---------------------------------------------------------------------------
+
+namespace {
+constexpr size_t kRenderHeader = 4 + 6 * 4;
+constexpr size_t kHitBytes = 1 + 7 * 8;
+}  // namespace
+
+std::string encodeRenderTile(const BrickOutput& out) {
+  std::string s;
+  size_t hitCount = 0;
+  for (const RayHit& h : out.hits) hitCount += h.kind != RayHit::kNone;
+  s.reserve(kRenderHeader + out.hits.size() + hitCount * (kHitBytes - 1));
+  s.append("FRR1", 4);
+  for (int a = 0; a < 3; ++a) put(s, out.tileLo[size_t(a)]);
+  for (int a = 0; a < 3; ++a) put(s, out.tileHi[size_t(a)]);
+  for (const RayHit& h : out.hits) {
+    s.push_back(char(h.kind));
+    if (h.kind == RayHit::kNone) continue;
+    put(s, h.depth);
+    for (double c : h.point) put(s, c);
+    for (double c : h.normal) put(s, c);
+  }
+  return s;
+}
+
+bool decodeRenderTile(const void* data, size_t size, BrickOutput& out, std::string* error) {
+  auto fail = [&](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (size < kRenderHeader || std::memcmp(data, "FRR1", 4) != 0) return fail("render payload: bad magic or header");
+  Reader r{static_cast<const char*>(data) + 4, static_cast<const char*>(data) + size};
+  for (int a = 0; a < 3; ++a) r.get(out.tileLo[size_t(a)]);
+  for (int a = 0; a < 3; ++a) r.get(out.tileHi[size_t(a)]);
+  uint64_t pixels = 1;
+  for (int a = 0; a < 2; ++a) {
+    if (out.tileLo[size_t(a)] < 0 || out.tileHi[size_t(a)] <= out.tileLo[size_t(a)]) return fail("render payload: bad region");
+    pixels *= uint64_t(out.tileHi[size_t(a)] - out.tileLo[size_t(a)]);
+  }
+  if (pixels > size - kRenderHeader) return fail("render payload: region exceeds its size");  // a byte per pixel at least
+  out.hits.assign(size_t(pixels), RayHit{});
+  for (RayHit& h : out.hits) {
+    uint8_t kind = 0;
+    if (!r.get(kind)) return fail("render payload: truncated");
+    if (kind > RayHit::kFootprint) return fail("render payload: unknown hit kind");
+    h.kind = RayHit::Kind(kind);
+    if (h.kind == RayHit::kNone) continue;
+    bool ok = r.get(h.depth);
+    for (double& c : h.point) ok = ok && r.get(c);
+    for (double& c : h.normal) ok = ok && r.get(c);
+    if (!ok) return fail("render payload: truncated hit");
+    bool finite = std::isfinite(h.depth);
+    for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(h.point[size_t(a)]) && std::isfinite(h.normal[size_t(a)]);
+    if (!finite) return fail("render payload: non-finite hit");
+  }
+  if (r.p != r.end) return fail("render payload: trailing bytes");
+  return true;
+}
+
 std::string encodePayload(Operation op, const BrickOutput& out) {
+  if (op == Operation::Render) return encodeRenderTile(out);
   return op == Operation::Mesh ? encodeMeshPiece(out.piece) : encodeBrick(out);
 }
 
 bool decodePayload(Operation op, const void* data, size_t size, BrickOutput& out, std::string* error) {
   if (op == Operation::Sample) return decodeBrick(data, size, out, error);
+  if (op == Operation::Render) return decodeRenderTile(data, size, out, error);
   if (!decodeMeshPiece(data, size, out.piece, error)) return false;
   out.stats.pointEvals = meshPointEvals(out.piece.stats);
   return true;

@@ -12,24 +12,28 @@
 
 #include "farm.pb.h"
 #include "frep/meshing/mesh.h"
+#include "frep/render/raycast.h"
 #include "frep/sampling/sample.h"
 
 namespace frep::farm {
 
 // What a job computes (JobSpec.operation).
-enum class Operation { Sample, Mesh };
-// "sample" (or empty, proto3's default) and "mesh"; throws std::invalid_argument otherwise.
+enum class Operation { Sample, Mesh, Render };
+// "sample" (or empty, proto3's default), "mesh" and "render"; throws std::invalid_argument otherwise.
 Operation operationOf(const JobSpec& job);
 
 // One brick's result. "sample": leaves and tiles; "mesh": piece (the core mesher's MeshPiece of
-// the brick's cells). stats holds the counters reported to the master (for "mesh":
-// pointEvals = grid-point + root-finding + gradient evaluations).
+// the brick's cells); "render": hits (castRegion's hits of the brick's pixels [lo, hi) in x, y,
+// row-major). stats holds the counters reported to the master (for "mesh": pointEvals =
+// grid-point + root-finding + gradient evaluations).
 struct BrickOutput {
   std::vector<LeafBlock> leaves;
   std::vector<Tile> tiles;
   SampleStats stats;
   uint64_t extremumSearches = 0, extremumUncertified = 0;  // this brick's extremum searches
   MeshPiece piece;
+  std::vector<RayHit> hits;
+  std::array<int32_t, 3> tileLo{}, tileHi{};  // "render": the region of `hits`
 };
 
 // The grid a job samples, and setting it (origin, dims, voxel) on a job.
@@ -39,8 +43,9 @@ void setGrid(JobSpec& job, const GridSpec& grid);
 // Stable 64-bit id of a job (FNV-1a over its serialized spec): results are keyed by it.
 uint64_t jobIdOf(const JobSpec& job);
 
-// Compiles a job's model (HyperFun source, object, params, iso) to a tape. Throws
-// std::runtime_error with the diagnostics when the model does not compile.
+// Compiles a job's model (HyperFun source, object, params, iso) to a tape; for "render" the
+// tape of the field clipped to the RenderSpec's box and composed with its camera (viewTape).
+// Throws std::runtime_error with the diagnostics when the model does not compile.
 TapePtr compileJobModel(const JobSpec& job);
 // One line per exact Minkowski algebra term of the model (Roerdink: no search, error bound 0),
 // for the report next to describeErrorBounds' lines.
@@ -59,8 +64,18 @@ class ModelCache {
 // The error bound of each extremum node of a model (one line each, for the job report).
 std::string describeErrorBounds(const Tape& tape, std::vector<std::string>* lines);
 
-// Computes the region [lo, hi) of the job's grid: samples it ("sample") or meshes its cells
-// ("mesh", core meshRegion with the job's MeshSpec). threads: 0 = all cores; never changes the
+// The job's field over x, y, z, before the camera ("render": clipped, the sections' union).
+Expr jobFieldOf(const JobSpec& job);
+
+// A "render" job's camera and options (std::invalid_argument for a malformed RenderSpec).
+Camera cameraOf(const JobSpec& job);
+RenderOptions renderOptionsOf(const JobSpec& job);
+// The field drawn: f restricted to the box, as hfp draws only inside -b.
+Expr clipToBox(const Expr& f, const Vec3& lo, const Vec3& hi);
+
+// Computes the region [lo, hi) of the job's grid: samples it ("sample"), meshes its cells
+// ("mesh", core meshRegion with the job's MeshSpec) or casts its pixels' rays ("render",
+// castRegion; the region must be made of whole kRenderTile tiles). threads: 0 = all cores; never changes the
 // result.
 BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::array<int32_t, 3>& lo,
                          const std::array<int32_t, 3>& hi, int threads);
@@ -90,8 +105,17 @@ std::string encodeMeshPiece(const MeshPiece& piece);
 // triangle index out of range or repeated, trailing bytes. Never reads out of bounds.
 bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string* error);
 
+// Render tile codec (little-endian): "FRR1", the region tileLo and tileHi (3 x i32 each), then
+// per pixel (row-major) a kind byte (RayHit::Kind) and, for a hit, depth, point and normal
+// (7 x f64, bit-exact).
+std::string encodeRenderTile(const BrickOutput& out);
+// Returns false (with a reason) on a malformed payload: bad magic, an empty or negative region,
+// an unknown kind, a non-finite value, truncation or trailing bytes. Never reads out of bounds.
+bool decodeRenderTile(const void* data, size_t size, BrickOutput& out, std::string* error);
+
 // The job's payload codec: encodeBrick/decodeBrick for "sample", encodeMeshPiece/decodeMeshPiece
-// (into out.piece, with out.stats.pointEvals from the piece's stats) for "mesh".
+// (into out.piece, with out.stats.pointEvals from the piece's stats) for "mesh",
+// encodeRenderTile/decodeRenderTile for "render".
 std::string encodePayload(Operation op, const BrickOutput& out);
 bool decodePayload(Operation op, const void* data, size_t size, BrickOutput& out, std::string* error);
 

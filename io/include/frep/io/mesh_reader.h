@@ -1,0 +1,17 @@
+// Reading triangle meshes for frep render: PLY (ascii, binary little or big endian; vertex x, y,
+// z of any scalar type, other properties skipped; faces as lists, polygons fanned), OBJ (v and f
+// lines, negative indices, v/vt/vn forms; polygons fanned; other lines ignored) and STL (binary,
+// or ASCII when it starts with "solid" and has facets). Only positions and triangles are read.
+#pragma once
+
+#include <string>
+
+#include "frep/meshing/mesh.h"
+
+namespace frep::io {
+
+// Throws Error(kExitIoError) naming the file (and the line or element) when it cannot be read,
+// is truncated, or is malformed (an index out of range, a non-finite coordinate, no triangles).
+Mesh readMesh(const std::string& path);
+
+}  // namespace frep::io
