@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "geometric_types.h"
 #include "model_loader.h"
@@ -83,6 +84,15 @@ struct MeshRequest {
   double tolerance = -1;   // --tolerance, voxels (SimplifyOptions); < 0: the default (0.1, 0 for a .vdb)
   bool noSharp = false;    // --no-sharp: SimplifyOptions::sharpFeatures = false
   std::string logLevel = "info";
+  std::string format;      // --format: the format of -O whatever its extension ("" = from it)
+  std::string up;          // --up z|y: the file's up axis ("" = the format's: y for .glb, else z)
+  // More files of the same mesh (hfp's -wrl, -stl, -stlb, -pov, -cli): a format name and a path.
+  struct Extra {
+    std::string format, path;
+  };
+  std::vector<Extra> extraOutputs;
+  std::string sliceStep;   // -gs: CLI layer thickness, hfp style D | Dxy,Dz | Dx,Dy,Dz ("" = one voxel)
+  bool timing = false;     // hfp's -t (the times are always printed)
 };
 int runMesh(const MeshRequest& request);
 

@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "exit_codes.h"
+#include "hfp_invocation.h"
 
 #ifndef FREP_VERSION
 #define FREP_VERSION "unknown"
@@ -122,6 +123,27 @@ void setUpLogging(const std::string& level) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // hfp's command line (no verb): `frep model.hf -g 60 -stl out.stl` runs frep mesh.
+  std::vector<std::string> hfpArgs;
+  std::vector<char*> hfpArgv;
+  if (isHfpInvocation(argc, argv)) {
+    try {
+      HfpTranslation t = translateHfp(argc, argv);
+      if (t.help) {
+        std::cout << hfpHelp();
+        return kExitOk;
+      }
+      for (const auto& note : t.notes) std::cerr << "frep: note: " << note << "\n";
+      hfpArgs.push_back(argv[0]);
+      hfpArgs.insert(hfpArgs.end(), t.args.begin(), t.args.end());
+      for (auto& a : hfpArgs) hfpArgv.push_back(a.data());
+      argc = int(hfpArgv.size());
+      argv = hfpArgv.data();
+    } catch (const CliError& e) {
+      std::cerr << "frep: error: " << e.what() << "\nRun 'frep MODEL.hf -h' for hfp-style usage.\n";
+      return e.code;
+    }
+  }
   CLI::App app{"frep " FREP_VERSION ": evaluate, slice and sample F-rep models written in HyperFun (.hf)."};
   app.footer(std::string(exitCodeHelp()) + "\nOptions -o (object), -a, -b, -g, -i, -x follow hfp; "
              "output files are -O/--out. See docs/cli.md.");
@@ -164,7 +186,22 @@ int main(int argc, char** argv) {
   CLI::App* meshCmd = app.add_subcommand("mesh", "Watertight triangle mesh of a model's surface (on the farm), or of the "
                                                "float grid of a .vdb written by frep sample (-o names the grid)");
   addModelOptions(meshCmd, mesh.model, true);
-  addRegionOptions(meshCmd, mesh.region, "Output mesh: .ply (binary), .obj or .stl (binary)", 128);
+  addRegionOptions(meshCmd, mesh.region,
+                   "Output mesh: .ply (binary), .obj, .stl (binary), .wrl (VRML 2.0), .inc/.pov (POV-Ray mesh2), "
+                   ".3mf, .glb (glTF 2.0 binary) or .cli (layer slices)", 128);
+  meshCmd->add_option("--format", mesh.format,
+                      "Format of -O whatever its extension: ply, obj, stl, stl-ascii, wrl, pov, 3mf, glb, cli, cli-binary");
+  meshCmd->add_option("--up", mesh.up,
+                      "Up axis of the file: z (the model's axes) or y ((x, y, z) written as (x, z, -y)); default y for "
+                      ".glb (glTF is Y-up), z for the others");
+  std::string wrlOut, stlOut, stlbOut, povOut, cliOut;
+  meshCmd->add_option("--wrl", wrlOut, "Also write VRML 2.0 with normals and colours (hfp's -wrl)");
+  meshCmd->add_option("--stl", stlOut, "Also write ASCII STL (hfp's -stl)");
+  meshCmd->add_option("--stlb", stlbOut, "Also write binary STL (hfp's -stlb)");
+  meshCmd->add_option("--pov", povOut, "Also write a POV-Ray mesh2 (hfp's -pov)");
+  meshCmd->add_option("--cli", cliOut, "Also write layer slices in the Common Layer Interface format, ASCII (hfp's -cli)");
+  meshCmd->add_option("--gs", mesh.sliceStep, "CLI layer thickness, hfp's -gs: D | Dxy,Dz | Dx,Dy,Dz (the z step; default one voxel)");
+  meshCmd->add_flag("--timing", mesh.timing, "hfp's -t (the times are always printed)");
   meshCmd->add_option("--threads", mesh.threads,
                       "Threads of the in-process run (--workers 0) and of the master's simplification (default 0: all cores; same output)");
   addFarmOptions(meshCmd, mesh.farm);
@@ -255,6 +292,15 @@ int main(int argc, char** argv) {
     }
     if (meshCmd->parsed()) {
       checkObjectIsNotAFile(mesh.model);
+      const std::pair<const char*, std::string*> extras[] = {
+          {"wrl", &wrlOut}, {"stl-ascii", &stlOut}, {"stl", &stlbOut}, {"pov", &povOut}, {"cli", &cliOut}};
+      for (const auto& [format, path] : extras)
+        if (!path->empty()) mesh.extraOutputs.push_back({format, *path});
+      if (mesh.region.out.empty() && !mesh.extraOutputs.empty()) {  // the first of them is the main output
+        mesh.region.out = mesh.extraOutputs.front().path;
+        if (mesh.format.empty()) mesh.format = mesh.extraOutputs.front().format;
+        mesh.extraOutputs.erase(mesh.extraOutputs.begin());
+      }
       mesh.logLevel = logLevel;
       return runMesh(mesh);
     }

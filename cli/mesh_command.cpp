@@ -15,10 +15,12 @@
 #include "commands.h"
 #include "exit_codes.h"
 #include "farm_job.h"
+#include "frep/attributes/colour.h"
 #include "frep/meshing/mesh.h"
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/io/mesh_writer.h"
 #include "frep/meshing/mesh_grid.h"
+#include "mesh_outputs.h"
 #include "sampling_grid.h"
 #include "frep/io/vdb_reader.h"
 
@@ -37,8 +39,8 @@ bool hasVdbExtension(const std::string& path) {
 // frep mesh input.vdb: the sampled values of a FloatGrid (frep sample's output) meshed in-process
 // by the core's meshSamples, the same marching tetrahedra as the model mesher (docs/mesh.md).
 int runMeshVdb(const MeshRequest& request) {
-  if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj or .stl) is required");
-  io::MeshFormat format = io::meshFormatFromPath("-O/--out", request.region.out);
+  if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj, .stl, .wrl, .pov, .3mf, .glb) is required");
+  std::vector<MeshOutput> outputs = resolveMeshOutputs(request);
   if (request.threads < 0) throw badArgs("--threads: expected 0 (all cores) or more, got " + std::to_string(request.threads));
   // The grid's extent and transform are the file's; the model options have nothing to act on.
   const std::string input = "'" + request.model.path + "' is a .vdb: its grid and transform are used as stored";
@@ -53,7 +55,7 @@ int runMeshVdb(const MeshRequest& request) {
       !request.farm.curveDir.empty())
     throw badArgs("--listen/--expect-workers/--resume/--curve: a .vdb is meshed in-process (use --threads)");
 
-  io::AtomicOutput out("-O/--out", request.region.out);
+  openMeshOutputFiles(outputs);
   const auto start = std::chrono::steady_clock::now();
   io::SampledVdb vdb = io::readSampledVdb(request.model.path, request.model.object);
   const double readSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -74,15 +76,20 @@ int runMeshVdb(const MeshRequest& request) {
   if (mesh.triangles.empty()) spdlog::warn("grid '{}' has no sign change between active voxels: the mesh is empty", vdb.gridName);
   std::string comment = "frep mesh of grid '" + vdb.gridName + "' in " + request.model.path +
                         " (sampled values); normals point outward (decreasing f)";
-  io::writeMesh(out.tempPath(), mesh, format, comment);
-  out.commit();
+  std::array<double, 6> box{0, 0, 0, 0, 0, 0};
+  for (size_t i = 0; i < mesh.positions.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      if (i == 0 || mesh.positions[i][c] < box[c]) box[c] = mesh.positions[i][c];
+      if (i == 0 || mesh.positions[i][c] > box[3 + c]) box[3 + c] = mesh.positions[i][c];
+    }
+  std::vector<std::string> wrote = writeMeshOutputs(outputs, mesh, request, vdb.gridName, comment, box,
+                                                    (box[5] - box[2]) / 64);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   const MeshStats& s = mesh.stats;
   std::ostream& text = request.farm.json ? std::cerr : std::cout;
-  text << "wrote " << request.region.out << " (" << io::meshFormatName(format) << "): " << mesh.positions.size()
-       << " vertices, " << mesh.triangles.size() << " triangles\n"
-       << "  from grid '" << vdb.gridName << "' of " << request.model.path << ": " << leaves << " leaves, "
+  for (const auto& line : wrote) text << line << "\n";
+  text << "  from grid '" << vdb.gridName << "' of " << request.model.path << ": " << leaves << " leaves, "
        << vdb.transformDescription << "\n"
        << "  cells examined " << s.cellsVisited << ", crossed " << s.cellsCrossed << ", left out " << sm.incompleteCells
        << "\n"
@@ -98,8 +105,8 @@ int runMeshVdb(const MeshRequest& request) {
 
 int runMesh(const MeshRequest& request) {
   if (hasVdbExtension(request.model.path)) return runMeshVdb(request);
-  if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj or .stl) is required");
-  io::MeshFormat format = io::meshFormatFromPath("-O/--out", request.region.out);
+  if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj, .stl, .wrl, .pov, .3mf, .glb) is required");
+  std::vector<MeshOutput> outputs = resolveMeshOutputs(request);
   if (request.threads < 0) throw badArgs("--threads: expected 0 (all cores) or more, got " + std::to_string(request.threads));
   if (request.tolerance < 0 && request.tolerance != -1)
     throw badArgs("--tolerance: expected 0 (no simplification) or more voxels, got " + formatNumber(request.tolerance));
@@ -119,7 +126,7 @@ int runMesh(const MeshRequest& request) {
       throw badArgs("--res/-g: the grid needs 2 to " + std::to_string(kMaxMeshGridPoints - 1) + " points per axis");
   checkJobSize(grid, request.farm.brick);
 
-  io::AtomicOutput out("-O/--out", request.region.out);
+  openMeshOutputFiles(outputs);
   io::AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
   // Adaptive simplification: each worker does the blocks inside its brick, the master the rest
   // (deterministic, so the file still does not depend on the split; docs/mesh.md).
@@ -158,8 +165,17 @@ int runMesh(const MeshRequest& request) {
   std::string comment = "frep mesh of '" + m.model.objectName + "', grid " + std::to_string(grid.dims[0]) + "x" +
                         std::to_string(grid.dims[1]) + "x" + std::to_string(grid.dims[2]) + " voxel " +
                         formatNumber(grid.voxel) + "; normals point outward (decreasing f)";
-  io::writeMesh(out.tempPath(), mesh, format, comment);
-  out.commit();
+  // Colours after the merge and the simplification, at the final vertices half a voxel inside:
+  // the same for any split of the job (colour.h).
+  const bool coloured = !m.colour.empty() && wantsColours(outputs);
+  if (coloured) colourMesh(mesh, ColourField(m.colour, 3), 0.5 * grid.voxel, request.threads);
+  const std::array<double, 6> extent{grid.origin[0],
+                                  grid.origin[1],
+                                  grid.origin[2],
+                                  grid.origin[0] + grid.voxel * (grid.dims[0] - 1),
+                                  grid.origin[1] + grid.voxel * (grid.dims[1] - 1),
+                                  grid.origin[2] + grid.voxel * (grid.dims[2] - 1)};
+  std::vector<std::string> wrote = writeMeshOutputs(outputs, mesh, request, m.model.objectName, comment, extent, grid.voxel);
   writeReport(reportOut, report);
   std::remove(options.journalPath.c_str());  // the output is complete: nothing to resume
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -167,9 +183,9 @@ int runMesh(const MeshRequest& request) {
   const MeshStats& s = mesh.stats;
   const double dense = double(grid.dims[0] - 1) * double(grid.dims[1] - 1) * double(grid.dims[2] - 1);
   std::ostream& text = request.farm.json ? std::cerr : std::cout;
-  text << "wrote " << request.region.out << " (" << io::meshFormatName(format) << "): " << mesh.positions.size()
-       << " vertices, " << mesh.triangles.size() << " triangles\n"
-       << "  grid " << grid.dims[0] << "x" << grid.dims[1] << "x" << grid.dims[2] << " points of "
+  for (const auto& line : wrote) text << line << "\n";
+  if (coloured) text << "  colours: s[1..3] of '" << m.model.objectName << "' half a voxel inside every vertex\n";
+  text << "  grid " << grid.dims[0] << "x" << grid.dims[1] << "x" << grid.dims[2] << " points of "
        << formatNumber(grid.voxel) << ", cells examined " << s.cellsVisited << " ("
        << formatNumber(std::round(1e4 * double(s.cellsVisited) / dense) / 100) << "% of " << uint64_t(dense)
        << "), crossed " << s.cellsCrossed << "\n"

@@ -85,6 +85,7 @@ LoadedModel loadModel(const ModelRequest& request, bool toView) {
   m.spec.iso = request.iso;
   m.dims = mapCoordinates(m.model, request.mapping, toView, m.spec);
   m.field = lang::fieldOf(m.model, m.spec);
+  m.colour = lang::colourOf(m.model, m.spec);
   return m;
 }
 

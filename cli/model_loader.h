@@ -25,6 +25,7 @@ struct LoadedModel {
   lang::FieldSpec spec;                  // -a, -i and -x as resolved against the model
   std::vector<lang::ObjectInfo> objects;
   Expr field;                            // f - iso over `dims` coordinates, parameters bound
+  std::vector<Expr> colour;              // s[1..3] over the same coordinates; empty: no colour
   int dims = 0;
 };
 

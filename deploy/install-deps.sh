@@ -10,6 +10,8 @@ packages=(
   libspdlog-dev libtbb-dev libcli11-dev nlohmann-json3-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
   povray  # frep pov scenes are rendered in tests (docs/pov.md)
+  lib3mf-dev libtinygltf-dev  # the .3mf and .glb mesh writers (io/)
+  assimp-utils python3-stl  # independent readers of the mesh files in tests/cli/frep_mesh_formats_test.cpp
   clang libclang-rt-14-dev
 )
 missing=()

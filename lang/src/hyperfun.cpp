@@ -47,6 +47,8 @@ CompileResult compile(const std::string& source, const std::string& fileName,
     result.model.xSize = o.info.xSize;
     result.model.aSize = o.info.aSize;
     result.model.field = o.field;
+    result.model.attributes = o.attributes;
+    result.model.hasAttributes = o.attributesWritten;
     result.model.sourceHash = fnv1a(source);
     result.ok = o.ok && diags.errorCount() == 0;
   }

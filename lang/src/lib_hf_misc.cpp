@@ -83,7 +83,8 @@ std::vector<LibraryFunction> all() {
       {"hfSawtooth", "SSSS", "(2/(a pi)) (0.5 - sum_{k<n} sin(2 pi k f t)/k)", sawtooth},
       {"hfBezierVolume", "ASSSAA", "Bezier volume function & the bounding box", bezierVolume},
   };
-  // Attribute functions fill HyperFun's s[] colour array; frepfarm keeps geometry only.
+  // Attribute functions fill HyperFun's s[] attribute array (colour). The lowering compiles them
+  // itself (lang/src/lower_attributes.cpp); the entries make their names known (checks, help).
   // Signature "*": any number of arguments of either kind.
   for (const char* name :
        {"hfA_SetColor", "hfA_Wave", "hfA_CheckerBoard", "hfA_Union", "hfA_Crackles", "hfA_Circles",
@@ -91,7 +92,7 @@ std::vector<LibraryFunction> all() {
         "hfA_Clamp", "hfA_Floor", "hfA_Pulse", "hfA_LookUpTable", "hfA_SmoothLookUpTable",
         "hfA_Step", "hfA_SmoothStep", "hfA_Modulo", "hfA_Spline", "hfA_RGBToHSV",
         "hfA_HSVToRGB"})
-    fns.push_back({name, "*", "attribute function: accepted, returns 1, no effect on geometry",
+    fns.push_back({name, "*", "attribute function: writes s[] (s[1..3] = colour), see docs/language.md",
                    attribute});
   return fns;
 }

@@ -174,6 +174,8 @@ void ObjectLowering::finish(LoweredObject& out) {
   }
   if (v.state == Def::Poisoned) return;
   out.field = v.scalar;
+  out.attributes = env_.at("s").elems;
+  out.attributesWritten = attributesWritten_;
   out.ok = true;
 }
 

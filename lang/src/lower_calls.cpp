@@ -179,24 +179,6 @@ Expr ObjectLowering::callLibrary(const AstExpr& e, const LibraryFunction& f) {
   return result;
 }
 
-Expr ObjectLowering::callAttribute(const AstExpr& e) {
-  if (!sh_.warnedAttributes) {
-    sh_.warnedAttributes = true;
-    sh_.diags.warning(e.loc, "attribute functions (" + e.spelling +
-                                 ", hfA_*) are accepted but ignored: they only set s[] "
-                                 "(colour) and do not change geometry; the call's value is 1");
-  }
-  // Check the arguments for errors; their values are not used.
-  for (const auto& a : e.args) {
-    if (a->kind == AstExpr::Kind::Name) {
-      auto it = env_.find(a->name);
-      if (it != env_.end() && it->second.isArray) continue;
-    }
-    lower(*a);
-  }
-  return Expr(1.0);
-}
-
 Expr ObjectLowering::callObject(const AstExpr& e, const ObjectDecl& callee, const LoweredObject& lowered) {
   if (e.args.size() != 2 && e.args.size() != 3)
     throw CompileError{e.loc, "object '" + callee.spelling + "' is called with its arrays: " +

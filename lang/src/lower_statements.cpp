@@ -62,6 +62,7 @@ Value& ObjectLowering::assignableArray(const Stmt& s) {
   }
   if (!it->second.isArray)
     throw CompileError{s.loc, "'" + s.spelling + "' is a scalar variable, not an array"};
+  if (s.name == "s") attributesWritten_ = true;
   return it->second;
 }
 

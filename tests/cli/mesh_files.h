@@ -54,12 +54,16 @@ inline ReadMesh readPly(const std::string& bytes) {
       EXPECT_EQ(line, "format binary_little_endian 1.0");
     }
   }
-  EXPECT_EQ(props.size(), 7u);
+  // x y z nx ny nz [red green blue: per-vertex colours of models that set s[]] and the faces.
+  const bool coloured = props.size() == 10;
+  EXPECT_TRUE(props.size() == 7u || coloured) << props.size();
+  if (coloured) EXPECT_EQ(props[6], "property uchar red");
   EXPECT_EQ(props.back(), "property list uchar uint vertex_indices");
+  const size_t stride = coloured ? 27 : 24;
   size_t at = end + 11;
-  EXPECT_EQ(bytes.size(), at + nv * 24 + nf * 13);
-  if (bytes.size() != at + nv * 24 + nf * 13) return m;
-  for (size_t i = 0; i < nv; ++i, at += 24) {
+  EXPECT_EQ(bytes.size(), at + nv * stride + nf * 13);
+  if (bytes.size() != at + nv * stride + nf * 13) return m;
+  for (size_t i = 0; i < nv; ++i, at += stride) {
     m.positions.push_back({f32(bytes, at), f32(bytes, at + 4), f32(bytes, at + 8)});
     m.normals.push_back({f32(bytes, at + 12), f32(bytes, at + 16), f32(bytes, at + 20)});
   }

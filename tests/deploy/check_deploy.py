@@ -360,7 +360,7 @@ def check_dockerfile(compose_programs):
             cmd = m.group(1).replace("\\\n", " ").replace("/usr/local/bin/", BIN_DIR + "/")
             cmd = cmd.replace("> /runtime-packages.txt", "")
             p = subprocess.run(["bash", "-o", "pipefail", "-c", cmd], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, timeout=60)
+                               stderr=subprocess.PIPE, text=True, timeout=300)
             pkgs = p.stdout.split()
             require(p.returncode == 0, f"pipeline failed: {p.stderr.strip()}")
             require(any(x.startswith("libzmq") for x in pkgs) and "libc6" in pkgs,

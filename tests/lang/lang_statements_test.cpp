@@ -309,6 +309,7 @@ TEST(LangStatements, SelectionPrefersMyModelThenWarnsOnUnknownName) {
   EXPECT_EQ(r.diagnostics[0].message, "no object named 'nothere'; using 'my_model'");
 }
 
+// hfA_SetColor is compiled (lang_attributes_test.cpp); the procedural textures (hfA_Wave) warn.
 TEST(LangStatements, AttributeFunctionsWarnOnceAndKeepGeometry) {
   CompileResult r = compile(R"(m(x[3], a[1], s[3]) {
     m = x[1];
@@ -320,7 +321,7 @@ TEST(LangStatements, AttributeFunctionsWarnOnceAndKeepGeometry) {
   ASSERT_TRUE(r.ok) << allDiagnostics(r);
   ASSERT_EQ(r.diagnostics.size(), 1u);
   EXPECT_EQ(r.diagnostics[0].severity, Diagnostic::Severity::Warning);
-  EXPECT_EQ(r.diagnostics[0].line, 3);
+  EXPECT_EQ(r.diagnostics[0].line, 4);
   EXPECT_EQ(r.objects[0].sSize, 3);
   EXPECT_CLOSE(evalModel(r.model, {0.25, 0, 0}), 0.25);
 }

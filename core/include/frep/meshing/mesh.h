@@ -115,6 +115,9 @@ struct Mesh {
   std::vector<std::array<double, 3>> normals;
   std::vector<std::array<uint32_t, 3>> triangles;
   std::vector<EdgeKey> keys;  // the global edge of each vertex
+  // Per-vertex colour (red, green, blue in [0, 1]) or empty: filled after the merge and the
+  // simplification by colourMesh (frep/attributes/colour.h), so it never depends on the split.
+  std::vector<std::array<float, 3>> colours;
   MeshStats stats;            // sums over the pieces
   SimplifyCarry carry;        // the pieces' (mergePieces keeps it with its vertices and triangles)
 };

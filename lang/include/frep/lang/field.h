@@ -23,4 +23,9 @@ struct FieldSpec {
 // not fit the model (too many params, mapping of the wrong length).
 Expr fieldOf(const Model& model, const FieldSpec& spec);
 
+// The colour of the model, s[1..3] (red, green, blue; docs/language.md, "Attributes"), with the
+// same parameters and coordinate mapping as fieldOf (the isovalue does not apply). Empty when
+// the model does not write s or its s has fewer than 3 elements.
+std::vector<Expr> colourOf(const Model& model, const FieldSpec& spec);
+
 }  // namespace frep::lang

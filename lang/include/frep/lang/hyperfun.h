@@ -29,6 +29,11 @@ struct Model {
   int xSize = 0;           // dimension n of x[n]
   int aSize = 0;           // size of a[m]
   Expr field;              // f(x, a) with x as Expr::x(i), a as Expr::param(i) (0-based)
+  // The attribute array s[1..k] at the end of the object's body, over the same x and a
+  // (docs/language.md, "Attributes"): s[1..3] is the colour (red, green, blue in [0, 1], as
+  // hfp writes it). hasAttributes: the object writes s (an assignment or an hfA_* call).
+  std::vector<Expr> attributes;
+  bool hasAttributes = false;
   uint64_t sourceHash = 0; // hash of the source text (metadata, caches)
 };
 

@@ -14,6 +14,8 @@ struct LoweredObject {
   ObjectInfo info;
   bool ok = false;  // lowered without errors
   Expr field;       // f(x, a): Expr::x(i), Expr::param(i)
+  std::vector<Expr> attributes;  // s[] at the end of the body
+  bool attributesWritten = false;
 };
 
 // Index of the object compile() selects: options.object, else "my_model", else the first

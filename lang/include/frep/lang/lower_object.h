@@ -124,7 +124,9 @@ class ObjectLowering {
   Expr callBuiltin(const AstExpr& e, const Builtin& b);
   static std::string describeSignature(const std::string& sig);
   Expr callLibrary(const AstExpr& e, const LibraryFunction& f);
+  // hfA_*: writes s[] (or another array) and returns the function's value (lower_attributes.cpp).
   Expr callAttribute(const AstExpr& e);
+  Value& attributeArray(const AstExpr& e, size_t index, size_t minSize);
   Expr callObject(const AstExpr& e, const ObjectDecl& callee, const LoweredObject& lowered);
 
   // ---- result -----------------------------------------------------------------------------
@@ -135,5 +137,6 @@ class ObjectLowering {
   std::set<std::string> assigned_;
   long iterations_ = 0;
   size_t errors_ = 0;
+  bool attributesWritten_ = false;  // s[] was assigned or written by an hfA_* call
 };
 }  // namespace frep::lang::detail

@@ -1,0 +1,233 @@
+// frep mesh's file formats read back by readers independent of its writers: tests/cli/tools/
+// read_mesh.py (Python's standard library; numpy-stl for STL) and assimp's `assimp info`.
+// Counts, closed and consistently oriented triangles, per-vertex colours against the model's
+// s[] formula at the vertices, the same bytes for any worker count, glTF's Y-up, CLI slices of
+// a sphere against the disc areas, and hfp's command line.
+#include <cmath>
+#include <sstream>
+
+#include "frep_runner.h"
+
+namespace frep_cli_test {
+namespace {
+
+const char* kReader = FREP_SOURCE_DIR "/tests/cli/tools/read_mesh.py";
+
+// Unit sphere coloured by position: s = (0.5 + x/2, 0.5 + y/2, 0.5 + z/2).
+const char* kColoured = R"(my_model(x[3], a[1], s[3]) {
+  s[1] = 0.5 + 0.5*x[1];  s[2] = 0.5 + 0.5*x[2];  s[3] = 0.5 + 0.5*x[3];
+  my_model = 1 - x[1]*x[1] - x[2]*x[2] - x[3]*x[3];
+}
+)";
+const double kVoxel = 0.15;  // -b 1.5 -g 20
+
+struct Read {
+  size_t vertices = 0, triangles = 0;
+  bool closedOriented = false, normals = false, colours = false;
+  std::vector<std::vector<double>> rows;  // x y z [nx ny nz] [r g b]
+};
+
+class MeshFormatsTest : public FrepTest {
+ protected:
+  Read readBack(const std::string& file, const std::string& format = "") {
+    RunResult r = capture("/usr/bin/python3 '" + std::string(kReader) + "' '" + path(file) + "' " + format + " --text");
+    EXPECT_EQ(r.code, 0) << r.err;
+    Read m;
+    std::istringstream in(r.out);
+    std::string key;
+    int flag = 0;
+    in >> key >> m.vertices >> key >> m.triangles >> key >> flag;
+    m.closedOriented = flag;
+    in >> key >> flag;
+    m.normals = flag;
+    in >> key >> flag;
+    m.colours = flag;
+    const size_t width = 3 + (m.normals ? 3 : 0) + (m.colours ? 3 : 0);
+    for (size_t i = 0; i < m.vertices; ++i) {
+      std::vector<double> row(width);
+      for (double& v : row) in >> v;
+      m.rows.push_back(row);
+    }
+    return m;
+  }
+  void mesh(const std::string& out, const std::string& extra = "", const std::string& model = kColoured) {
+    write("m.hf", model);
+    RunResult r = run("mesh m.hf -b 1.5 -g 20 --workers 0 -O " + out + " " + extra);
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+};
+
+// The colour formula half a voxel inside the vertex (docs/language.md, "Attributes").
+double expected(double p, double n) { return std::min(1.0, std::max(0.0, 0.5 + 0.5 * (p - 0.5 * kVoxel * n))); }
+
+TEST_F(MeshFormatsTest, EveryWriterReadsBackWithColours) {
+  mesh("ref.ply");
+  Read ref = readBack("ref.ply");
+  ASSERT_GT(ref.triangles, 300u);
+  ASSERT_TRUE(ref.closedOriented);
+  ASSERT_TRUE(ref.normals && ref.colours);
+  struct Case {
+    std::string file, format;
+    bool colours;
+    double tolerance;  // of a colour channel: bytes are rounded to 1/255
+  };
+  const Case cases[] = {{"a.ply", "", true, 0.5 / 255 + 1e-6}, {"a.obj", "", true, 1e-6},
+                        {"a.wrl", "", true, 1e-6},             {"a.pov", "", true, 1e-6},
+                        {"a.3mf", "", true, 0.5 / 255 + 1e-6}, {"a.glb", "--up z", true, 1e-6},
+                        {"a.stl", "", false, 0},               {"b.stl", "--format stl-ascii", false, 0}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file + " " + c.format);
+    mesh(c.file, c.format);
+    Read m = readBack(c.file, c.file == "b.stl" ? "stl" : "");
+    EXPECT_EQ(m.triangles, ref.triangles);
+    EXPECT_EQ(m.vertices, ref.vertices);  // STL: vertices merged by position, so none coincide
+    EXPECT_TRUE(m.closedOriented);
+    EXPECT_EQ(m.colours, c.colours);
+    if (!m.colours || c.file.find("stl") != std::string::npos) continue;
+    double worst = 0;
+    for (size_t i = 0; i < m.vertices; ++i) {
+      const auto& row = m.rows[i];
+      const auto& r = ref.rows[i];  // normals from the PLY (same vertex order in every format)
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(row[k], r[k], 1e-6);
+        worst = std::max(worst, std::fabs(row[row.size() - 3 + k] - expected(r[k], r[3 + k])));
+      }
+    }
+    EXPECT_LE(worst, c.tolerance);
+  }
+}
+
+TEST_F(MeshFormatsTest, SetColorColoursTheSurfaceOfItsOwnSolid) {
+  // hfA_SetColor(f, ...) tests f >= 0: evaluated half a voxel inside, every vertex gets it.
+  mesh("red.ply", "", R"(my_model(x[3], a[1], s[3]) {
+    r = 1 - x[1]*x[1] - x[2]*x[2] - x[3]*x[3];
+    d = hfA_SetColor(r, s, 1, 0, 0.5);
+    my_model = r;
+  })");
+  Read m = readBack("red.ply");
+  ASSERT_TRUE(m.colours);
+  for (const auto& row : m.rows) {
+    EXPECT_EQ(row[6], 1.0);
+    EXPECT_EQ(row[7], 0.0);
+    EXPECT_NEAR(row[8], 128.0 / 255, 1e-9);
+  }
+}
+
+TEST_F(MeshFormatsTest, AssimpReadsTheCommonFormats) {
+  if (capture("command -v assimp").code != 0) GTEST_SKIP() << "assimp-utils not installed";
+  mesh("ref.ply");
+  const size_t triangles = readBack("ref.ply").triangles;
+  for (std::string file : {"a.ply", "a.obj", "a.stl", "a.glb"}) {
+    SCOPED_TRACE(file);
+    mesh(file);
+    RunResult r = capture("assimp info " + file);
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("Faces:              " + std::to_string(triangles) + "\n"), std::string::npos) << r.out;
+  }
+}
+
+TEST_F(MeshFormatsTest, ColouredBytesAreTheSameForAnyWorkerCount) {
+  write("m.hf", kColoured);
+  for (std::string ext : {"ply", "obj", "wrl", "3mf", "glb", "pov", "cli"}) {
+    SCOPED_TRACE(ext);
+    std::string first;
+    for (std::string workers : {"0", "1", "2"}) {
+      RunResult r = run("mesh m.hf -b 1.5 -g 24 --brick 8 --workers " + workers + " -O w" + workers + "." + ext);
+      ASSERT_EQ(r.code, 0) << r.err;
+      std::string bytes = readText(path("w" + workers + "." + ext));
+      ASSERT_FALSE(bytes.empty());
+      if (first.empty()) first = bytes;
+      EXPECT_TRUE(bytes == first) << "--workers " << workers;
+    }
+  }
+}
+
+TEST_F(MeshFormatsTest, GlbIsYUpUnlessAskedOtherwise) {
+  mesh("z.ply");
+  mesh("y.glb");
+  mesh("z.glb", "--up z");
+  mesh("y.obj", "--up y");
+  Read z = readBack("z.ply"), y = readBack("y.glb"), zg = readBack("z.glb"), yo = readBack("y.obj");
+  ASSERT_EQ(y.vertices, z.vertices);
+  for (size_t i = 0; i < z.vertices; ++i) {
+    const auto &p = z.rows[i], &q = y.rows[i];
+    EXPECT_NEAR(q[0], p[0], 1e-7);  // (x, y, z) -> (x, z, -y)
+    EXPECT_NEAR(q[1], p[2], 1e-7);
+    EXPECT_NEAR(q[2], -p[1], 1e-7);
+    EXPECT_NEAR(q[4], p[5], 1e-7);  // normals turn with it
+    EXPECT_NEAR(zg.rows[i][1], p[1], 1e-7);
+    EXPECT_NEAR(yo.rows[i][1], p[2], 1e-6);
+  }
+  EXPECT_TRUE(y.closedOriented);  // a rotation keeps the winding outward
+}
+
+TEST_F(MeshFormatsTest, CliSlicesOfASphereAreItsDiscs) {
+  write("m.hf", kColoured);
+  ASSERT_EQ(run("mesh m.hf -b 1.5 -g 60 --tolerance 0 --workers 0 -O s.cli --gs 0.1").code, 0);
+  ASSERT_EQ(run("mesh m.hf -b 1.5 -g 60 --tolerance 0 --workers 0 -O b.cli --format cli-binary --gs 0.1").code, 0);
+  for (std::string file : {"s.cli", "b.cli"}) {
+    SCOPED_TRACE(file);
+    RunResult r = capture("/usr/bin/python3 '" + std::string(kReader) + "' " + file + " --text");
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::istringstream in(r.out);
+    std::string key;
+    int layers = 0, declared = 0, withContour = 0;
+    in >> key >> layers >> declared;
+    EXPECT_EQ(layers, 30);  // 3 / 0.1
+    EXPECT_EQ(declared, layers);
+    for (int l = 0; l < layers; ++l) {
+      double top = 0;
+      int polylines = 0;
+      in >> key >> top >> polylines;
+      const double cut = top - 0.05;
+      const double disc = M_PI * (1 - cut * cut);
+      if (std::fabs(cut) < 0.95) EXPECT_EQ(polylines, 1) << "layer " << top;
+      for (int k = 0; k < polylines; ++k) {
+        int dir = 0, n = 0, closed = 0;
+        double area = 0;
+        in >> key >> dir >> n >> area >> closed;
+        EXPECT_EQ(dir, 1);  // counter-clockwise around material
+        EXPECT_EQ(closed, 1);
+        // Vertices on the sphere, contour points on chords: inscribed, within a few % of the disc.
+        EXPECT_LE(area, disc * (1 + 1e-6));
+        EXPECT_GE(area, disc * 0.97 - 0.01) << "layer " << top;
+        ++withContour;
+      }
+    }
+    EXPECT_GE(withContour, 19);
+  }
+}
+
+TEST_F(MeshFormatsTest, HfpCommandLine) {
+  write("m.hf", kColoured);
+  RunResult r = run("m.hf -b 1.5 -g 20 -stl a.stl -wrl a.wrl -stlb b.stl -pov a.pov -cli a.cli -gs 0.3 -t -d 5 --workers 0");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("-d 5 ignored"), std::string::npos) << r.err;
+  EXPECT_EQ(readText(path("a.stl")).rfind("solid my_model", 0), 0u);
+  mesh("ref.ply");
+  const size_t triangles = readBack("ref.ply").triangles;
+  EXPECT_EQ(readBack("a.stl").triangles, triangles);
+  EXPECT_EQ(readBack("b.stl").triangles, triangles);
+  EXPECT_EQ(readBack("a.wrl").triangles, triangles);
+  EXPECT_EQ(readBack("a.pov").triangles, triangles);
+  EXPECT_TRUE(fileExists(path("a.cli")));
+  // hfp's default grid is -g 30.
+  ASSERT_EQ(run("m.hf -b 1.5 -stlb d.stl --workers 0").code, 0);
+  ASSERT_EQ(run("mesh m.hf -b 1.5 -g 30 --workers 0 -O e.stl").code, 0);
+  EXPECT_TRUE(readText(path("d.stl")) == readText(path("e.stl")));
+  r = run("m.hf -g 20 -foo 3 -stl x.stl");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("unknown hfp option '-foo'; hfp's options are"), std::string::npos) << r.err;
+  r = run("m.hf -g 20");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no output"), std::string::npos) << r.err;
+  r = run("m.hf -h");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("-stlb FILE"), std::string::npos);
+  r = run("mesh m.hf -O a.glb --up x");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--up: expected z or y"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace frep_cli_test
