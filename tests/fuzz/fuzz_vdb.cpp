@@ -1,0 +1,54 @@
+// Fuzz target: frep mesh's .vdb reader (io/src/vdb_reader.cpp) on arbitrary files, then the
+// mesher on what it accepts, as frep mesh in.vdb does (fuzz_target.h). OpenVDB itself is not
+// instrumented; frepfarm's checks in front of it must refuse whatever would make it misbehave.
+// The first byte's low bit asks to re-seal the file (recompute its frep_grid_checksum): the
+// seal detects damage, not an attacker, who can compute it too, so OpenVDB's parser must also
+// meet mutated files that pass every check.
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+
+#include "../../io/src/vdb_checksum.h"
+#include "frep/io/error.h"
+#include "frep/io/vdb_reader.h"
+#include "frep/meshing/mesh_grid.h"
+#include "fuzz_target.h"
+
+namespace {
+
+void reseal(std::string& bytes) {
+  auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  const std::string key = frep::io::kGridChecksumKey;
+  const std::string entry = u32(uint32_t(key.size())) + key + u32(6) + "string" + u32(uint32_t(frep::io::kChecksumDigits));
+  const size_t at = bytes.find(entry);
+  if (at == std::string::npos || at + entry.size() + frep::io::kChecksumDigits > bytes.size()) return;
+  const size_t digits = at + entry.size();
+  bytes.replace(digits, frep::io::kChecksumDigits, frep::io::vdbChecksum(bytes, digits));
+}
+
+}  // namespace
+
+void frep::fuzz::vdb(const uint8_t* data, size_t size) {
+  if (size == 0) return;
+  std::string bytes(reinterpret_cast<const char*>(data) + 1, size - 1);
+  if (data[0] & 1) reseal(bytes);
+  static const std::string path = "/tmp/frep_fuzz_vdb." + std::to_string(::getpid()) + ".vdb";
+  if (FILE* f = std::fopen(path.c_str(), "wb")) {
+    std::fwrite(bytes.data(), 1, bytes.size(), f);
+    std::fclose(f);
+  }
+  try {
+    const io::SampledVdb v = io::readSampledVdb(path, "");
+    if (v.samples.leaves.size() <= 4096) {
+      SampledMeshOptions options;
+      options.threads = 1;
+      (void)meshSamples(v.samples, options);
+    }
+  } catch (const io::Error& e) {
+    FREP_FUZZ_CHECK(e.code == io::kExitIoError || e.code == io::kExitModelError);
+  }
+  std::remove(path.c_str());
+}
+
+FREP_FUZZ_ENTRY(frep::fuzz::vdb)
