@@ -37,5 +37,5 @@ run() {
 }
 run hf 4000 "-max_len=4096" "$REPO/examples"
 run payload 30000 "" "$seeds/payload"
-run journal 20000 "-max_len=4096" "$seeds/journal"
+run journal 20000 "" "$seeds/journal"
 run vdb 8000 "" "$seeds/vdb"

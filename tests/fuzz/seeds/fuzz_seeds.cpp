@@ -16,7 +16,7 @@
 namespace {
 
 const char* kModel = R"(my_model(x[3], a[1]) {
-  my_model = hfBlock(x, -0.7, -0.6, -0.5, 1.3, 1.2, 1.1) | (0.9 - sqrt(x[1]^2 + x[2]^2 + (x[3] - 0.8)^2));
+  my_model = ((0.7 - abs(x[1])) & (0.6 - abs(x[2])) & (0.5 - abs(x[3]))) | (0.9 - sqrt(x[1]^2 + x[2]^2 + (x[3] - 0.8)^2));
 })";
 
 void put(const std::string& dir, const std::string& name, char kind, const std::string& bytes) {
@@ -29,6 +29,7 @@ void put(const std::string& dir, const std::string& name, char kind, const std::
 int main(int argc, char** argv) {
   if (argc != 2) return std::fprintf(stderr, "usage: fuzz_seeds DIR\n"), 2;
   const std::string dir = argv[1];
+  ::mkdir(dir.c_str(), 0755);
   using namespace frep;
   farm::JobSpec job;
   job.set_model_source(kModel);
@@ -70,6 +71,7 @@ int main(int argc, char** argv) {
   io::VdbMetadata meta;
   meta.gridName = "my_model";
   const std::string sealed = vdbs + "/sealed.vdb.tmp";
+  std::ofstream(sealed).close();  // writeLevelSet writes into an existing file (AtomicOutput's)
   io::writeLevelSet(sealed, sample(tape, GridSpec::fromBounds({-1.5, -1.5, -1.5}, {1.5, 1.5, 1.5}, 12), so), meta);
   std::ifstream in(sealed, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
