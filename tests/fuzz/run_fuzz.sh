@@ -38,4 +38,7 @@ run() {
 run hf 4000 "-max_len=4096" "$REPO/examples"
 run payload 30000 "" "$seeds/payload"
 run journal 20000 "" "$seeds/journal"
-run vdb 8000 "" "$seeds/vdb"
+# OpenVDB's readers leak the node they were building when a refused size throws (their bug, a
+# few hundred KiB in a process that then exits 3): leaks are not findings for this target.
+export ASAN_OPTIONS=detect_leaks=0
+run vdb 8000 "-detect_leaks=0" "$seeds/vdb"

@@ -1,7 +1,6 @@
 // Writes the fuzz targets' seed corpora from the code that makes the real inputs, so the seeds
 // follow the formats: a worker's brick payloads (FRB2, raw and simplified FRM3) and a task envelope
-// for `payload`, a journal of them for `journal`, frep sample's sealed .vdb (and the same file
-// unsealed: the seal's key renamed) for `vdb`. The .hf seeds are examples/ itself. Run by
+// for `payload`, a journal of them for `journal`, frep sample's sealed .vdb for `vdb`. The .hf seeds are examples/ itself. Run by
 // run_fuzz.sh: fuzz_seeds DIR writes DIR/<target>/.
 #include <sys/stat.h>
 
@@ -77,9 +76,6 @@ int main(int argc, char** argv) {
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::remove(sealed.c_str());
   put(vdbs, "sealed", 0, bytes);
-  put(vdbs, "sealed_resealing", 1, bytes);
-  const size_t key = bytes.find("frep_grid_checksum");
-  if (key != std::string::npos) bytes[key + 17] = 'n';  // frep_grid_checksun: no seal, layout checks only
-  put(vdbs, "unsealed", 0, bytes);
+  put(vdbs, "sealed_resealing", 1, bytes);  // re-sealed after mutation with FREP_FUZZ_VDB_CRAFTED=1
   return 0;
 }
