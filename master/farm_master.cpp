@@ -34,7 +34,8 @@ void onStopSignal(int) { gStop = true; }
 
 // Installs SIGTERM/SIGINT handlers for the lifetime of a job, restoring the old ones after.
 struct SignalScope {
-  struct sigaction oldTerm {}, oldInt {};
+  struct sigaction oldTerm {}, oldInt {}, oldHup {};
+  // SIGHUP too (a closed terminal): the job stops as for SIGTERM, local workers are stopped.
   SignalScope() {
     gStop = false;
     struct sigaction sa {};
@@ -42,10 +43,12 @@ struct SignalScope {
     sigemptyset(&sa.sa_mask);
     sigaction(SIGTERM, &sa, &oldTerm);
     sigaction(SIGINT, &sa, &oldInt);
+    sigaction(SIGHUP, &sa, &oldHup);
   }
   ~SignalScope() {
     sigaction(SIGTERM, &oldTerm, nullptr);
     sigaction(SIGINT, &oldInt, nullptr);
+    sigaction(SIGHUP, &oldHup, nullptr);
   }
 };
 

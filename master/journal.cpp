@@ -1,7 +1,10 @@
 #include "journal.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstring>
 #include <stdexcept>
 #include <vector>
@@ -15,6 +18,37 @@ constexpr char kMagic[4] = {'F', 'R', 'J', '1'};
 // A record is one brick's payload: never more than a frame the master accepts from a worker.
 constexpr uint64_t kMaxRecord = kMaxJournalRecord;
 constexpr long kRecordHeader = 8 + 4 + 8;  // brick, crc, size
+
+// Opens the journal as -O's policy does (io/src/atomic_output.cpp): only a regular file, never
+// through a symbolic link (a planted `out.vdb.journal -> ~/.bashrc` would be truncated), never
+// blocking on a FIFO (O_NONBLOCK; fstat then refuses it). nullptr with errno ENOENT when absent
+// and not created; any other failure is a JournalIoError naming what the path is.
+FILE* openJournal(const std::string& path, int flags, const char* mode) {
+  auto notRegular = [&](const char* what) {
+    return JournalIoError("journal " + path + " is " + what + "; frep keeps its journal only in a regular file");
+  };
+  int fd = ::open(path.c_str(), flags | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0644);
+  struct stat st;
+  if (fd < 0) {
+    if (errno == ENOENT && !(flags & O_CREAT)) return nullptr;
+    const int err = errno;
+    if (::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode)) throw notRegular("a symbolic link");
+    if (::lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) throw notRegular("not a regular file");
+    throw JournalIoError("cannot open journal " + path + ": " + std::strerror(err));
+  }
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw notRegular("not a regular file (a FIFO, device, socket or directory)");
+  }
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  FILE* f = ::fdopen(fd, mode);
+  if (!f) {
+    const int err = errno;
+    ::close(fd);
+    throw JournalIoError("cannot open journal " + path + ": " + std::strerror(err));
+  }
+  return f;
+}
 }  // namespace
 
 Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
@@ -22,7 +56,7 @@ Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
     : path_(path) {
   long goodEnd = 0;
   if (resume) {
-    if (FILE* in = std::fopen(path.c_str(), "rb")) {
+    if (FILE* in = openJournal(path, O_RDONLY, "rb")) {
       char magic[4];
       uint64_t id = 0;
       bool headerOk = std::fread(magic, 1, 4, in) == 4 && std::memcmp(magic, kMagic, 4) == 0 &&
@@ -58,17 +92,14 @@ Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
     }
   }
   if (goodEnd > 0) {
-    if (::truncate(path.c_str(), goodEnd) != 0)
+    file_ = openJournal(path, O_WRONLY | O_APPEND, "ab");
+    if (!file_ || ::ftruncate(fileno(file_), goodEnd) != 0)
       throw JournalIoError("cannot truncate journal " + path + ": " + std::strerror(errno));
-    file_ = std::fopen(path.c_str(), "ab");
   } else {
-    file_ = std::fopen(path.c_str(), "wb");
-    if (file_) {
-      std::fwrite(kMagic, 1, 4, file_);
-      std::fwrite(&jobId, sizeof jobId, 1, file_);
-    }
+    file_ = openJournal(path, O_WRONLY | O_CREAT | O_TRUNC, "wb");
+    std::fwrite(kMagic, 1, 4, file_);
+    std::fwrite(&jobId, sizeof jobId, 1, file_);
   }
-  if (!file_) throw JournalIoError("cannot open journal " + path + ": " + std::strerror(errno));
   if (std::fflush(file_) != 0 || std::ferror(file_))
     throw JournalIoError("cannot write journal " + path + ": " + std::strerror(errno));
   flush();

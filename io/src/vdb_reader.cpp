@@ -16,6 +16,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "allocation_cap.h"
 #include "vdb_checksum.h"
 
 #include "frep/io/format_number.h"
@@ -139,7 +140,11 @@ class LayoutCheck {
 
 constexpr uint64_t kMaxVdbBytes = uint64_t(16) << 30;  // frep mesh reads at most 16 GiB
 
-void checkLayout(const std::string& path) {
+// The largest single allocation OpenVDB may make while it reads a file of `fileBytes`: a node's
+// values (at most 256 KiB for a float tree) or a compressed block (at most the file).
+size_t allocationCapFor(uint64_t fileBytes) { return size_t(64 << 20) + size_t(fileBytes); }
+
+uint64_t checkLayout(const std::string& path) {
   struct stat st;
   if (::stat(path.c_str(), &st) != 0) throw ioError("cannot read VDB '" + path + "': " + std::strerror(errno));
   if (!S_ISREG(st.st_mode)) throw ioError("cannot read VDB '" + path + "': not a regular file");
@@ -151,6 +156,7 @@ void checkLayout(const std::string& path) {
   if (!in.read(bytes.data(), std::streamsize(bytes.size())) || in.peek() != EOF)
     throw ioError("cannot read VDB '" + path + "': the file changed or could not be read to its end");
   LayoutCheck(path, std::move(bytes)).run();
+  return uint64_t(st.st_size);
 }
 
 }  // namespace
@@ -159,8 +165,9 @@ SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) 
   openvdb::initialize();
   SampledVdb out;
   openvdb::FloatGrid::Ptr grid;
-  checkLayout(path);
+  const uint64_t fileBytes = checkLayout(path);
   try {
+    const AllocationCap cap(allocationCapFor(fileBytes));
     openvdb::io::File file(path);
     file.open(false);  // read everything now: a corrupt file fails here, not half way through
     openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();

@@ -61,6 +61,30 @@ TEST_F(Hardening, OutputMustBeNewOrARegularFile) {
   EXPECT_GT(readText(path("old.vdb")).size(), 1000u);
 }
 
+// The journal beside -O (out.vdb.journal) as a planted symlink, FIFO or directory: refused with
+// exit 3 naming the journal, the link's target neither created nor truncated, nothing blocks on
+// the FIFO; with or without --resume, in-process and with a worker.
+TEST_F(Hardening, JournalIsNeverOpenedThroughASymlinkOrASpecialFile) {
+  write("sphere.hf", kSphere);
+  write("victim.txt", "precious");
+  ASSERT_EQ(::symlink("victim.txt", path("a.vdb.journal").c_str()), 0);
+  ASSERT_EQ(::symlink("created.txt", path("b.vdb.journal").c_str()), 0);
+  ASSERT_EQ(::mkfifo(path("c.vdb.journal").c_str(), 0644), 0);
+  ASSERT_EQ(::mkdir(path("d.vdb.journal").c_str(), 0755), 0);
+  for (const char* out : {"a.vdb", "b.vdb", "c.vdb", "d.vdb"})
+    for (const char* extra : {" --workers 0", " --workers 0 --resume", " --workers 1"}) {
+      RunResult r = run("sample sphere.hf -b 1.5 --res 16 --no-progress -O " + std::string(out) + extra);
+      EXPECT_EQ(r.code, 3) << out << extra << ": " << r.err;
+      EXPECT_NE(r.err.find(std::string(out) + ".journal"), std::string::npos) << r.err;
+      EXPECT_FALSE(fileExists(path(out))) << out;
+    }
+  EXPECT_EQ(readText(path("victim.txt")), "precious");
+  EXPECT_FALSE(fileExists(path("created.txt")));
+  EXPECT_EQ(typeOf(path("a.vdb.journal")), mode_t(S_IFLNK));
+  EXPECT_EQ(typeOf(path("c.vdb.journal")), mode_t(S_IFIFO));
+  EXPECT_TRUE(noTemporaries()) << listing();
+}
+
 // A full disk while the .vdb is written (here a file size limit below the file's size but above
 // the journal's): exit 3, no truncated file under the final name, no temporary file left.
 TEST_F(Hardening, FullDiskDuringTheFinalWriteLeavesNoOutput) {
@@ -153,19 +177,19 @@ TEST_F(Hardening, ListenEndpointIsCheckedUpFront) {
   EXPECT_EQ(listing(), "sphere.hf");
 }
 
-// SIGTERM or SIGINT at many moments of a run (argument checks, model loading, planning, the
+// SIGTERM, SIGINT or SIGHUP at many moments of a run (argument checks, model loading, planning, the
 // job, the final write): the process exits 0 (finished first) or 6, never dies by the signal,
 // and leaves no temporary file. The plan is large (2 M bricks of 8^3) so planning takes a while.
 TEST_F(Hardening, SignalsAtAnyMomentCleanUpAndExitSix) {
   write("sphere.hf", kSphere);
   int sixes = 0;
-  for (int sig : {SIGTERM, SIGINT}) {
+  for (int sig : {SIGTERM, SIGINT, SIGHUP}) {
     for (int delayMs : {0, 2, 5, 10, 20, 40, 80, 160, 320, 640}) {
       // Blocked until frep has its handlers (it unblocks them then): a signal that arrives before
       // frep even runs is delivered at that point instead of killing the loader.
       sigset_t set, old;
       sigemptyset(&set);
-      sigaddset(&set, SIGTERM), sigaddset(&set, SIGINT);
+      sigaddset(&set, SIGTERM), sigaddset(&set, SIGINT), sigaddset(&set, SIGHUP);
       ::sigprocmask(SIG_BLOCK, &set, &old);
       pid_t pid = ::fork();
       if (pid != 0) ::sigprocmask(SIG_SETMASK, &old, nullptr);

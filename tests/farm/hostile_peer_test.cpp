@@ -267,3 +267,32 @@ TEST(HostilePeer, ListenOnTheNetworkWithoutCurveNeedsInsecure) {
     EXPECT_NE(std::string(e.what()).find("--insecure"), std::string::npos) << e.what();
   }
 }
+
+// Garbage from a welcomed peer drops the peer, not its bricks: four peers in turn say hello, are
+// leased the same two bricks (a dropped peer's bricks go back to the front of the queue) and send
+// an unparsable frame. Were garbage charged to the bricks, the third would poison both; instead
+// each peer is banned, told bye, and a real worker finishes the job as --workers 0 does.
+TEST(HostilePeer, GarbageFromAWelcomedPeerDropsThePeerNotItsBricks) {
+  JobSpec j = sphereJob();
+  SampleResult ref = reference(j);
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
+  zmq::context_t ctx(1);
+  for (int k = 0; k < 4; ++k) {
+    ScriptedPeer g(ctx, ep, "garbage-" + std::to_string(k));
+    ASSERT_EQ(g.collect(Envelope::kTask, 2).size(), 2u) << k;
+    const std::string junk = "\xff\xff\xff\xff not a protobuf envelope";
+    g.s.send(zmq::buffer(junk));
+    EXPECT_EQ(g.collect(Envelope::kBye, 1, 2000).size(), 1u) << "peer " << k << " was not dropped";
+    g.s.set(zmq::sockopt::linger, 0);
+  }
+  EXPECT_EQ(runRealWorker(ep), 0);
+  master.join();
+  ASSERT_EQ(master.error, "");
+  const FarmReport& r = master.outcome.report;
+  EXPECT_TRUE(r.poisoned.empty()) << r.poisoned.size() << " brick(s) poisoned";
+  EXPECT_GE(r.malformed, 4u);
+  EXPECT_EQ(r.bannedPeers, 4u);
+  EXPECT_EQ(r.bricksComputed, 8u);
+  expectSameLeaves(ref, master.outcome.result);
+}

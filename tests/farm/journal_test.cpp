@@ -2,6 +2,8 @@
 // more than the file holds; records after the damage are dropped, those before are replayed.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstring>
@@ -75,4 +77,29 @@ TEST(Journal, EveryTruncationReplaysTheWholeRecordsBeforeIt) {
     EXPECT_EQ(replayed(path), whole) << n;
   }
   std::remove(path.c_str());
+}
+
+// The journal is opened as -O is (O_NOFOLLOW, regular files only): a symlink planted at its
+// name is neither followed nor truncated (before: fopen("wb") truncated the link's target), a
+// FIFO does not block the master, with or without resume.
+TEST(Journal, NeverOpensThroughASymlinkOrASpecialFile) {
+  const std::string dir = testing::TempDir() + "journal_nofollow_" + std::to_string(::getpid()) + "/";
+  ::mkdir(dir.c_str(), 0755);
+  const std::string victim = dir + "victim", link = dir + "link.journal", fifo = dir + "fifo.journal";
+  std::ofstream(victim) << "precious";
+  ASSERT_EQ(::symlink(victim.c_str(), link.c_str()), 0);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  for (const std::string& p : {link, fifo})
+    for (bool resume : {false, true})
+      EXPECT_THROW(Journal(p, 42, resume, [](uint64_t, const std::string&) {}), frep::farm::JournalIoError)
+          << p << " resume " << resume;
+  EXPECT_EQ(readAll(victim), "precious");
+  // A dangling symlink is not created through either.
+  const std::string dangling = dir + "dangling.journal";
+  ASSERT_EQ(::symlink((dir + "made").c_str(), dangling.c_str()), 0);
+  EXPECT_THROW(Journal(dangling, 42, false, nullptr), frep::farm::JournalIoError);
+  struct stat st;
+  EXPECT_NE(::lstat((dir + "made").c_str(), &st), 0);
+  // A regular journal still works.
+  EXPECT_EQ((writeJournal(dir + "ok.journal", 2), replayed(dir + "ok.journal")), 2);
 }

@@ -1,16 +1,44 @@
 #!/bin/sh
-# Bounded fuzz run (CI): builds tests/fuzz with clang (ASan+UBSan, libFuzzer) in BUILD and runs
-# every target for a fixed number of iterations from its kept corpus. Exit 0: no findings.
+# Bounded fuzz run (CI, deploy/test.sh): builds tests/fuzz with clang (ASan+UBSan, libFuzzer) in
+# BUILD, writes seeds from the current formats (fuzz_seeds) and runs each target for a fixed
+# number of iterations from its seeds and its kept corpus (corpus/<target>/: examples of each
+# finding, replayed by the normal build's fuzz_corpus_tests). Allocations over 512 MiB and runs
+# over 30 s count as findings. Exit 0: no findings; otherwise the failing input is kept as
+# BUILD/findings/<target>-crash-* (add it to corpus/<target>/ with its fix).
+# FUZZ_SCALE=N multiplies every iteration count (a longer local run).
 set -eu
 HERE=$(cd "$(dirname "$0")" && pwd)
-BUILD=${1:-$HERE/../../build-fuzz}
-RUNS=${FUZZ_RUNS:-20000}
+REPO=$(cd "$HERE/../.." && pwd)
+BUILD=${1:-$REPO/build-fuzz}
+SCALE=${FUZZ_SCALE:-1}
 cmake -S "$HERE" -B "$BUILD" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug >/dev/null
-cmake --build "$BUILD" -j2
-for target in journal; do
+cmake --build "$BUILD" -j"$(nproc)"
+seeds=$(mktemp -d)
+trap 'rm -rf "$seeds"' EXIT
+"$BUILD/fuzz_seeds" "$seeds"
+mkdir -p "$BUILD/findings"
+# target, iterations, extra options, seed directories
+run() {
+  target=$1 runs=$(($2 * SCALE)) opts=$3
+  shift 3
   work=$(mktemp -d)
-  cp "$HERE"/corpus/$target/* "$work"/ 2>/dev/null || true
-  "$BUILD/fuzz_$target" -runs="$RUNS" -seed=1 -max_len=4096 -rss_limit_mb=1024 -malloc_limit_mb=512 \
-      -artifact_prefix="$work/crash-" "$work"
+  start=$(date +%s)
+  # shellcheck disable=SC2086
+  "$BUILD/fuzz_$target" -runs="$runs" -seed=1 $opts -timeout=30 -rss_limit_mb=2048 -malloc_limit_mb=512 \
+      -print_final_stats=0 -artifact_prefix="$BUILD/findings/$target-" "$work" "$HERE/corpus/$target" "$@" \
+      >"$BUILD/findings/$target.log" 2>&1 || {
+    tail -40 "$BUILD/findings/$target.log"
+    echo "run_fuzz: $target: FINDING (input kept in $BUILD/findings/)"
+    rm -rf "$work"
+    exit 1
+  }
+  echo "run_fuzz: $target: $runs runs, $(( $(date +%s) - start )) s, 0 findings ($(ls "$work" | wc -l) new inputs)"
   rm -rf "$work"
-done
+}
+run hf 4000 "-max_len=4096" "$REPO/examples"
+run payload 30000 "" "$seeds/payload"
+run journal 20000 "" "$seeds/journal"
+# OpenVDB's readers leak the node they were building when a refused size throws (their bug, a
+# few hundred KiB in a process that then exits 3): leaks are not findings for this target.
+export ASAN_OPTIONS=detect_leaks=0
+run vdb 8000 "-detect_leaks=0" "$seeds/vdb"

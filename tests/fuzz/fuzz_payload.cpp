@@ -1,0 +1,76 @@
+// Fuzz target: what the farm decodes from the network. The first byte picks the decoder, the rest
+// is its input: 0 a brick result's FRB2 payload (decodeBrick), 1 a mesh piece's FRM3 payload
+// (decodeMeshPiece, then the master's merge of it), 2 an Envelope frame (wire.cpp's parse) and,
+// when it holds a task, the job a worker would compute (fuzz_target.h). Oracles: a payload
+// that decodes re-encodes to bytes that decode and re-encode to the same bytes (the codec has
+// one meaning per payload), and nothing crashes or reads out of bounds.
+#include <stdexcept>
+#include <string>
+
+#include "brick.h"
+#include "farm.pb.h"
+#include "frep/meshing/mesh.h"
+#include "fuzz_target.h"
+
+namespace frep::fuzz {
+namespace {
+
+void sampleBrick(const uint8_t* data, size_t size) {
+  farm::BrickOutput out;
+  std::string err;
+  if (!farm::decodeBrick(data, size, out, &err)) {
+    FREP_FUZZ_CHECK(!err.empty());
+    return;
+  }
+  const std::string once = farm::encodeBrick(out);
+  farm::BrickOutput again;
+  FREP_FUZZ_CHECK(farm::decodeBrick(once.data(), once.size(), again, &err));
+  FREP_FUZZ_CHECK(farm::encodeBrick(again) == once);
+}
+
+void meshPiece(const uint8_t* data, size_t size) {
+  MeshPiece piece;
+  std::string err;
+  if (!farm::decodeMeshPiece(data, size, piece, &err)) {
+    FREP_FUZZ_CHECK(!err.empty());
+    return;
+  }
+  const std::string once = farm::encodeMeshPiece(piece);
+  MeshPiece again;
+  FREP_FUZZ_CHECK(farm::decodeMeshPiece(once.data(), once.size(), again, &err));
+  FREP_FUZZ_CHECK(farm::encodeMeshPiece(again) == once);
+  try {
+    const Mesh m = mergePieces({piece});
+    FREP_FUZZ_CHECK(m.positions.size() == piece.vertices.size());
+  } catch (const std::invalid_argument&) {
+    // a piece the merge refuses by name
+  }
+}
+
+void envelope(const uint8_t* data, size_t size) {
+  farm::Envelope e;
+  if (!e.ParseFromArray(data, int(size))) return;
+  if (!e.has_task()) return;
+  const farm::JobSpec& job = e.task().job();
+  try {
+    (void)farm::operationOf(job);
+    (void)farm::gridOf(job);
+    (void)farm::jobIdOf(job);
+  } catch (const std::invalid_argument&) {
+  }
+}
+
+}  // namespace
+
+void payload(const uint8_t* data, size_t size) {
+  if (size == 0) return;
+  switch (data[0] % 3) {
+    case 0: return sampleBrick(data + 1, size - 1);
+    case 1: return meshPiece(data + 1, size - 1);
+    default: return envelope(data + 1, size - 1);
+  }
+}
+
+}  // namespace frep::fuzz
+
+FREP_FUZZ_ENTRY(frep::fuzz::payload)
