@@ -243,7 +243,8 @@ PYBIND11_MODULE(frepfarm, mod) {
     } catch (const ModelError& e) {
       modelError(e.what());
     } catch (const io::Error& e) {
-      ioErrorType(e.what());
+      if (e.code == io::kExitBadArgs) PyErr_SetString(PyExc_ValueError, e.what());
+      else ioErrorType(e.what());
     }
   });
 
