@@ -12,7 +12,7 @@ packages=(
   povray  # frep pov scenes are rendered in tests (docs/pov.md)
   clang libclang-rt-14-dev
   pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module and its tests (python/)
-  python3-yaml docker-compose  # tests/deploy: the compose file checked by Debian's docker-compose 1.29
+  python3-yaml python3-jsonschema docker-compose  # tests/deploy: Compose v1 (docker-compose 1.29) and schemas
   slurm-wlm munge  # tests/deploy/slurm_e2e.sh: a real single-node Slurm (about 16 s to install)
 )
 missing=()
