@@ -2,7 +2,7 @@
 # Installs the build tree into a temporary prefix (cmake --install), then builds tests/consumer
 # against it twice, with find_package(frepfarm) and with pkg-config, and runs both programs: the
 # model's value at (0.5, 0.25, 0) must be 1 - 0.25 - 0.0625 = 0.6875 exactly. Also runs the
-# installed frep and frep-worker.
+# installed frep and frep-worker, and the installed Python module.
 #   run_consumer_test.sh BUILD_DIR
 set -euo pipefail
 build="$(cd "$1" && pwd)"
@@ -34,3 +34,13 @@ c++ -O1 -o "$tmp/consumer-pc" "$here/main.cpp" $(pkg-config --cflags --libs frep
 got="$("$tmp/consumer-pc")"
 [ "$got" = "$expect" ] || { echo "pkg-config consumer printed '$got', expected $expect"; exit 1; }
 echo "pkg-config frepfarm: $got"
+
+# The Python module, when it was built: installed under the prefix, importable from there.
+module="$(find "$prefix" -name 'frepfarm*.so' | head -n 1)"
+if ls "$build"/python/frepfarm*.so >/dev/null 2>&1; then
+  [ -n "$module" ] || { echo "the Python module was built but not installed"; exit 1; }
+  got="$(cd "$tmp" && PYTHONPATH="$(dirname "$module")" /usr/bin/python3 -c \
+    'import frepfarm; print(frepfarm.compile("my_model(x[3], a[1]) { my_model = 1 - x[1]^2 - x[2]^2 - x[3]^2; }").eval([0.5, 0.25, 0.0])[0])')"
+  [ "$got" = "$expect" ] || { echo "installed Python module printed '$got', expected $expect"; exit 1; }
+  echo "installed Python module ($module): $got"
+fi
