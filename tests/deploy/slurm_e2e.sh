@@ -5,7 +5,8 @@
 #   1. a sphere at res 32 with 2 workers: job exit 0, output equal to `frep sample --workers 0`;
 #   2. the same with workers that abort after 3 bricks (FREP_TEST_DIE_AFTER=3): the
 #      slots restart them, exit 0, same output;
-#   3. a model with a syntax error: exit 1 (the master's code, not 75) within seconds.
+#   3. a model with a syntax error: exit 1 (the master's code, not 75) within seconds;
+#   4. a bad option (--band 0) that only the master sees: exit 2, workers stopped, no hold.
 # Exit 77 (ctest SKIP_RETURN_CODE) when Slurm is not installed or cannot start here (not root,
 # no daemons). Needs python3-openvdb for the comparison when the files differ in frep_command.
 #   slurm_e2e.sh SOURCE_DIR BIN_DIR
@@ -138,8 +139,21 @@ rc=$(run_job bad "$bad")
 took=$((SECONDS - start))
 echo "job bad model: exit $rc in $took s"
 [ "$rc" = 1 ] || { fail "bad model: job exited $rc, expected 1 (model error)"; show_logs bad; }
-[ "$took" -lt 60 ] || fail "bad model: the job took $took s (a hold, not a fast failure)"
+# No step started: no worker waited for a master (times are printed, not judged: shared machine).
+! ls "$tmp"/jobs/bad/frep-*-worker-*.log >/dev/null 2>&1 || fail "bad model: worker steps were started"
 grep -q "bad.hf:2:" "$tmp/jobs/bad/batch.log" || { fail "bad model: no file:line diagnostic in the job's output"; show_logs bad; }
+
+# An error the master finds after the steps started (a bad option): its code 2, not a
+# worker's 75 after minutes of waiting for a master that is gone.
+job_args=(--res 32 -b 1.5 --band 0)
+start=$SECONDS
+rc=$(run_job badargs "$model")
+took=$((SECONDS - start))
+echo "job bad option (--band 0): exit $rc in $took s"
+[ "$rc" = 2 ] || { fail "bad option: job exited $rc, expected 2 (the master's bad-arguments code)"; show_logs badargs; }
+# The workers were stopped by the script, not by their own --master-timeout (exit 75, 300 s).
+grep -q "master exited 2" "$tmp/jobs/badargs/batch.log" || fail "bad option: the script did not report the master's 2"
+! grep -q "exited 75" "$tmp"/jobs/badargs/frep-*-worker-*.log 2>/dev/null || fail "bad option: a worker timed out waiting"
 
 [ $failures -eq 0 ] && echo "slurm e2e: all passed" && exit 0
 echo "slurm e2e: $failures failure(s)"
