@@ -321,7 +321,10 @@ def check_dockerfile(compose_programs):
         # Every source folder the top-level CMakeLists.txt adds must be in the image (tests and
         # bench only when the Dockerfile does not switch them off).
         with open(os.path.join(SRC, "CMakeLists.txt")) as f:
-            subdirs = re.findall(r"add_subdirectory\(\s*([\w./-]+)", f.read())
+            top = f.read()
+        subdirs = re.findall(r"add_subdirectory\(\s*([\w./-]+)", top)
+        # Files the top level include()s from the checkout (cmake/FrepInstall.cmake): their folder.
+        subdirs += sorted({p.split("/")[0] for p in re.findall(r"include\(\s*([\w.-]+/[\w./-]+)\s*\)", top)})
         run_text = " ".join(a for k, a in instr if k == "RUN")
         for d in subdirs:
             if d == "tests" and "FREP_BUILD_TESTS=OFF" in run_text:
