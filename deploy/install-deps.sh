@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package frepfarm needs to build, test and benchmark. Idempotent:
 # packages already present are skipped, so a second run does no network access at all.
+#   install-deps.sh [--build-only]    --build-only: not the tools only tests use (the Docker
+#                                     image's build stage: no Slurm, docker-compose, pytest)
 set -euo pipefail
 packages=(
   build-essential cmake pkg-config
@@ -13,7 +15,14 @@ packages=(
   lib3mf-dev libtinygltf-dev  # the .3mf and .glb mesh writers (io/)
   assimp-utils python3-stl  # independent readers of the mesh files in tests/cli/frep_mesh_formats_test.cpp
   clang libclang-rt-14-dev
+  pybind11-dev python3-dev python3-numpy  # the Python module (python/)
 )
+test_packages=(
+  python3-pytest  # tests/python
+  python3-yaml python3-jsonschema docker-compose  # tests/deploy: Compose v1 (docker-compose 1.29) and schemas
+  slurm-wlm munge  # tests/deploy/slurm_e2e.sh: a real single-node Slurm (about 16 s to install)
+)
+[ "${1:-}" = --build-only ] || packages+=("${test_packages[@]}")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -6,6 +6,7 @@ usage: check_deploy.py SOURCE_DIR BIN_DIR
 - every YAML file (docker-compose.yml, deploy/k8s/*.yaml) parses and has the expected structure;
 - every flag the deploy files pass to frep / frep-worker appears in that program's --help;
 - deploy/Dockerfile: debian:12, COPY sources and RUN scripts exist, exec-form ENTRYPOINT;
+- docker-compose.yml is accepted by the real docker-compose 1.29 (`config`, no engine needed);
 - deploy/slurm/frep.sbatch passes `bash -n`;
 - then each topology runs as local processes on a tiny sphere (res 32): the compose master and
   two workers with the compose commands, the same for the Kubernetes manifests, and the sbatch
@@ -19,6 +20,7 @@ import json
 import os
 import re
 import shlex
+import shutil
 import signal
 import socket
 import subprocess
@@ -319,7 +321,10 @@ def check_dockerfile(compose_programs):
         # Every source folder the top-level CMakeLists.txt adds must be in the image (tests and
         # bench only when the Dockerfile does not switch them off).
         with open(os.path.join(SRC, "CMakeLists.txt")) as f:
-            subdirs = re.findall(r"add_subdirectory\(\s*([\w./-]+)", f.read())
+            top = f.read()
+        subdirs = re.findall(r"add_subdirectory\(\s*([\w./-]+)", top)
+        # Files the top level include()s from the checkout (cmake/FrepInstall.cmake): their folder.
+        subdirs += sorted({p.split("/")[0] for p in re.findall(r"include\(\s*([\w.-]+/[\w./-]+)\s*\)", top)})
         run_text = " ".join(a for k, a in instr if k == "RUN")
         for d in subdirs:
             if d == "tests" and "FREP_BUILD_TESTS=OFF" in run_text:
@@ -419,6 +424,28 @@ def check_compose(docs, frep_help, worker_help):
             check_flags(result["master"][2:], frep_help, "frep sample")
             check_flags(result["worker"][1:], worker_help, "frep-worker")
     return result
+
+
+def check_compose_tool(parsed):
+    """Debian 12's docker-compose 1.29 (Compose v1) reads the file: `config` needs no engine. Its
+    resolved master command must be the one this script parsed, and FREP_WORKERS must reach both
+    --expect-workers and deploy.replicas."""
+    with Check("docker-compose.yml: accepted by docker-compose (v1) `config`, FREP_WORKERS interpolated"):
+        tool = shutil.which("docker-compose")
+        require(tool, "docker-compose is not installed (deploy/install-deps.sh installs Debian's docker-compose)")
+        env = {k: v for k, v in os.environ.items() if not k.startswith("FREP_")}
+        env["FREP_WORKERS"] = "5"
+        p = subprocess.run([tool, "-f", os.path.join(SRC, "docker-compose.yml"), "config"], cwd=SRC, env=env,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=60)
+        require(p.returncode == 0, f"docker-compose config exited {p.returncode}: {p.stderr.strip()}")
+        resolved = yaml.safe_load(p.stdout)
+        master, worker = resolved["services"]["master"], resolved["services"]["worker"]
+        margv = as_argv(master.get("entrypoint")) + as_argv(master.get("command"))
+        require(flag_value(margv, "--expect-workers") == "5", f"--expect-workers is {flag_value(margv, '--expect-workers')!r}, expected 5")
+        require(str(worker.get("deploy", {}).get("replicas")) == "5", f"worker replicas {worker.get('deploy')}")
+        if parsed:
+            expected = set_flag(list(parsed["master"]), "--expect-workers", "5")
+            require(margv == expected, f"docker-compose resolves the master to {margv}, this check read {expected}")
 
 
 def k8s_objects(docs):
@@ -528,15 +555,17 @@ def check_sbatch_syntax():
             text = f.read()
         require(re.search(r"^#SBATCH\s+--signal=", text, re.M), "no #SBATCH --signal= for a graceful stop")
         require("scontrol show hostnames" in text and "SLURM_JOB_NODELIST" in text, "master host not from the node list")
-        require("SLURM_PROCID" in text and "FREP_MASTER" in text, "no SLURM_PROCID split / FREP_MASTER")
+        require("master_task" in text and "worker_task" in text and "FREP_MASTER" in text,
+                "no master step / worker step / FREP_MASTER")
+        require(re.search(r'"\$\{FREP_BIN\}frep" check', text), "the model is not checked before the steps start")
         require(re.search(r"\bsrun\b", text), "no srun")
     return text
 
 
 def sbatch_command_flags(text, program):
     """The options on the line(s) of the sbatch script that exec `program`."""
-    m = re.search(r'exec "\$\{FREP_BIN\}' + re.escape(program) + r'"((?:[^\n]*\\\n)*[^\n]*)', text)
-    require(m, f"the task script does not exec \"${{FREP_BIN}}{program}\"")
+    m = re.search(r'(?:exec )?"\$\{FREP_BIN\}' + re.escape(program) + r'" (?!check)((?:[^\n]*\\\n)*[^\n]*)', text)
+    require(m, f"the task script does not run \"${{FREP_BIN}}{program}\"")
     segment = m.group(1)
     flags = re.findall(r"(?<![\w$-])--?[A-Za-z][\w-]*", segment)
     # Options kept in bash arrays (curve=(--curve "$DIR")) and expanded as "${curve[@]}".
@@ -719,6 +748,7 @@ def main():
 
     docs = check_yaml_files()
     c = check_compose(docs, frep_help, worker_help)
+    check_compose_tool(c)
     compose_programs = [program_name(c[k]) for k in ("master", "worker")] if c else []
     check_dockerfile(compose_programs)
     k = check_k8s(docs, frep_help, worker_help)

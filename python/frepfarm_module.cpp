@@ -1,0 +1,295 @@
+// The Python module `frepfarm`: HyperFun models compiled by frep_lang, evaluated by the core's
+// batch evaluator on NumPy arrays, sampled and meshed by the core, written by frep_io (docs/python.md).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <cstdlib>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "frep/evaluators/eval.h"
+#include "frep/io/atomic_output.h"
+#include "frep/io/error.h"
+#include "frep/io/mesh_writer.h"
+#include "frep/io/vdb_writer.h"
+#include "frep/lang/field.h"
+#include "frep/lang/hyperfun.h"
+#include "frep/meshing/mesh.h"
+#include "frep/meshing/mesh_simplify.h"
+#include "frep/sampling/sample.h"
+
+namespace py = pybind11;
+using namespace frep;
+
+namespace {
+
+// Raised for a model with errors; args[0] holds every diagnostic as file:line:column: ...
+struct ModelError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Model {
+  std::string name;
+  int dims = 0;                      // the object's x[n]
+  std::vector<std::string> objects;  // every object in the source
+  std::vector<std::string> warnings;
+  uint64_t sourceHash = 0;
+  std::vector<double> params;
+  double iso = 0;
+  TapePtr tape;  // f - iso over the model's coordinates, parameters bound
+};
+
+Model compileModel(const std::string& source, const std::string& file, const std::string& object,
+                   const std::vector<double>& params, double iso) {
+  lang::CompileOptions options;
+  options.object = object;
+  lang::CompileResult r = lang::compile(source, file, options);
+  std::string errors;
+  Model m;
+  for (const lang::Diagnostic& d : r.diagnostics) {
+    if (d.severity == lang::Diagnostic::Severity::Error) errors += d.format() + "\n";
+    else m.warnings.push_back(d.format());
+  }
+  if (!r.ok) throw ModelError(errors.empty() ? file + ": no object to evaluate" : errors.substr(0, errors.size() - 1));
+  if (params.size() > size_t(r.model.aSize))
+    throw py::value_error("params: object '" + r.model.objectName + "' has a[" + std::to_string(r.model.aSize) +
+                          "], got " + std::to_string(params.size()) + " values");
+  lang::FieldSpec spec;
+  spec.params = params;
+  spec.iso = iso;
+  m.name = r.model.objectName;
+  m.dims = r.model.xSize;
+  for (const lang::ObjectInfo& o : r.objects) m.objects.push_back(o.name);
+  m.sourceHash = r.model.sourceHash;
+  m.params = params;
+  m.iso = iso;
+  m.tape = Tape::compile(lang::fieldOf(r.model, spec), uint32_t(std::max(m.dims, 3)));
+  return m;
+}
+
+Model loadModel(const std::string& path, const std::string& object, const std::vector<double>& params, double iso) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw io::ioError("cannot read model '" + path + "': " + std::strerror(errno));
+  std::string text;
+  char buf[65536];
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
+  const bool bad = std::ferror(f);
+  std::fclose(f);
+  if (bad) throw io::ioError("cannot read model '" + path + "': read error");
+  return compileModel(text, path, object, params, iso);
+}
+
+// f at each row of an (N, dims) array, by the batch evaluator (256 points per call).
+py::array_t<double> evalPoints(const Model& m, py::array_t<double, py::array::c_style | py::array::forcecast> points) {
+  if (points.ndim() == 1 && points.shape(0) == m.dims) points = points.reshape({py::ssize_t(1), py::ssize_t(m.dims)});
+  if (points.ndim() != 2 || points.shape(1) != m.dims)
+    throw py::value_error("points: expected an array of shape (N, " + std::to_string(m.dims) + ") for object '" +
+                          m.name + "' (x[" + std::to_string(m.dims) + "])");
+  const size_t n = size_t(points.shape(0));
+  py::array_t<double> out{py::ssize_t(n)};
+  const double* in = points.data();
+  double* res = out.mutable_data();
+  {
+    py::gil_scoped_release unlocked;
+    BatchEvaluator<double> eval;
+    eval.reserve(*m.tape);
+    const uint32_t vars = m.tape->numVars();
+    for (size_t start = 0; start < n; start += BatchEvaluator<double>::kBatch) {
+      const size_t count = std::min(BatchEvaluator<double>::kBatch, n - start);
+      for (uint32_t v = 0; v < vars; ++v) {
+        double* lane = eval.in(v);
+        for (size_t k = 0; k < count; ++k) lane[k] = v < uint32_t(m.dims) ? in[(start + k) * m.dims + v] : 0.0;
+      }
+      const double* values = eval.eval(*m.tape, count);
+      std::copy(values, values + count, res + start);
+    }
+  }
+  return out;
+}
+
+std::vector<double> fixedCoordsOf(const Model& m, const std::vector<double>& fixed) {
+  const size_t extra = m.dims > 3 ? size_t(m.dims - 3) : 0;
+  if (fixed.size() != extra)
+    throw py::value_error("fixed: object '" + m.name + "' has x[" + std::to_string(m.dims) + "], so fixed needs " +
+                          std::to_string(extra) + " values (x[4] and above), got " + std::to_string(fixed.size()));
+  return fixed;
+}
+
+GridSpec gridOf(const std::array<double, 3>& lo, const std::array<double, 3>& hi, int res) {
+  for (int a = 0; a < 3; ++a)
+    if (!(hi[a] > lo[a])) throw py::value_error("box: hi must exceed lo on every axis");
+  if (res < 2 || res > 4096) throw py::value_error("res: expected 2 to 4096 points along the longest axis");
+  return GridSpec::fromBounds(lo, hi, res);
+}
+
+struct Volume {
+  SampleResult result;
+  std::string name;
+  uint64_t sourceHash = 0;
+  double iso = 0;
+  std::string params;
+};
+
+Volume sampleModel(const Model& m, std::array<double, 3> lo, std::array<double, 3> hi, int res, int band,
+                   const std::vector<double>& fixed) {
+  if (band < 1 || band > 64) throw py::value_error("band: expected 1 to 64 voxels");
+  SampleOptions options;
+  options.bandVoxels = band;
+  options.fixedCoords = fixedCoordsOf(m, fixed);
+  GridSpec grid = gridOf(lo, hi, res);
+  Volume v;
+  {
+    py::gil_scoped_release unlocked;
+    v.result = sample(m.tape, grid, options);
+  }
+  v.name = m.name;
+  v.sourceHash = m.sourceHash;
+  v.iso = m.iso;
+  for (size_t i = 0; i < m.params.size(); ++i) v.params += (i ? "," : "") + std::to_string(m.params[i]);
+  return v;
+}
+
+// Writes the grid as frep sample does (frep_io: -f as a level set, metadata), atomically.
+void writeVdb(const Volume& v, const std::string& path) {
+  io::AtomicOutput out("path", path);
+  io::VdbMetadata meta;
+  meta.gridName = v.name;
+  meta.commandLine = "frepfarm (Python) sample";
+  meta.params = v.params;
+  meta.sourceHash = v.sourceHash;
+  meta.iso = v.iso;
+  io::writeLevelSet(out.tempPath(), v.result, meta);
+  out.commit();
+}
+
+// pyopenvdb (python3-openvdb) is built on Boost.Python, which cannot take a C++ grid from this
+// module: the grid goes through a temporary .vdb written by frep_io and read by pyopenvdb.
+py::object toPyOpenVdb(const Volume& v) {
+  py::module_ vdb = py::module_::import("pyopenvdb");
+  const char* dir = std::getenv("TMPDIR");
+  std::string path = std::string(dir && *dir ? dir : "/tmp") + "/frepfarm-" + std::to_string(::getpid()) + "-" +
+                     std::to_string(reinterpret_cast<uintptr_t>(&v)) + ".vdb";
+  writeVdb(v, path);
+  py::object grid;
+  try {
+    grid = vdb.attr("read")(path, v.name);
+  } catch (...) {
+    std::remove(path.c_str());
+    throw;
+  }
+  std::remove(path.c_str());
+  return grid;
+}
+
+py::array_t<double> rows(const std::vector<std::array<double, 3>>& v) {
+  py::array_t<double> a({py::ssize_t(v.size()), py::ssize_t(3)});
+  if (!v.empty()) std::copy(v.data()->data(), v.data()->data() + 3 * v.size(), a.mutable_data());
+  return a;
+}
+
+struct PyMesh {
+  Mesh mesh;
+  double errorBound = 0;
+};
+
+PyMesh meshModel(const Model& m, std::array<double, 3> lo, std::array<double, 3> hi, int res, double simplify,
+                 const std::vector<double>& fixed) {
+  GridSpec grid = gridOf(lo, hi, res);
+  MeshOptions options;
+  options.fixedCoords = fixedCoordsOf(m, fixed);
+  PyMesh out;
+  py::gil_scoped_release unlocked;
+  out.mesh = meshGrid(m.tape, grid, options);
+  if (simplify > 0) {
+    SimplifyOptions s;
+    s.tolerance = simplify;
+    s.fixedCoords = options.fixedCoords;
+    out.errorBound = simplifyMesh(out.mesh, m.tape, grid, s).errorBound;
+  }
+  return out;
+}
+
+void writeMeshFile(const PyMesh& m, const std::string& path) {
+  io::MeshFormat format = io::meshFormatFromPath("path", path);
+  io::AtomicOutput out("path", path);
+  io::writeMesh(out.tempPath(), m.mesh, format, "frepfarm (Python)");
+  out.commit();
+}
+
+}  // namespace
+
+PYBIND11_MODULE(frepfarm, mod) {
+  mod.doc() = "frepfarm: F-rep solids in the HyperFun language (inside is f >= 0)";
+  mod.attr("__version__") = FREP_VERSION;
+  // frep_io installs handlers for SIGINT/SIGTERM/SIGHUP when it is loaded (for the frep
+  // command's exit code 6); in Python, Ctrl-C must stay KeyboardInterrupt.
+  py::module_ signal = py::module_::import("signal");
+  signal.attr("signal")(signal.attr("SIGINT"), signal.attr("default_int_handler"));
+  signal.attr("signal")(signal.attr("SIGTERM"), signal.attr("SIG_DFL"));
+  signal.attr("signal")(signal.attr("SIGHUP"), signal.attr("SIG_DFL"));
+
+  static py::exception<ModelError> modelError(mod, "ModelError", PyExc_ValueError);
+  static py::exception<io::Error> ioErrorType(mod, "IoError", PyExc_OSError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const ModelError& e) {
+      modelError(e.what());
+    } catch (const io::Error& e) {
+      if (e.code == io::kExitBadArgs) PyErr_SetString(PyExc_ValueError, e.what());
+      else ioErrorType(e.what());
+    }
+  });
+
+  py::class_<Model>(mod, "Model", "A compiled HyperFun object: f(x) - iso, parameters bound")
+      .def_readonly("name", &Model::name)
+      .def_readonly("dims", &Model::dims, "n of the object's x[n]")
+      .def_readonly("objects", &Model::objects, "every object in the source")
+      .def_readonly("warnings", &Model::warnings)
+      .def("eval", &evalPoints, py::arg("points"),
+           "f at each row of an (N, dims) float64 array (or one point of length dims): N values")
+      .def("sample", &sampleModel, py::arg("lo"), py::arg("hi"), py::arg("res") = 128, py::arg("band") = 3,
+           py::arg("fixed") = std::vector<double>{},
+           "Sparse narrow-band sampling of the box [lo, hi] with res points along its longest axis")
+      .def("mesh", &meshModel, py::arg("lo"), py::arg("hi"), py::arg("res") = 128, py::arg("simplify") = 0.0,
+           py::arg("fixed") = std::vector<double>{},
+           "Watertight mesh of f = 0 in [lo, hi]; simplify > 0: tolerance in voxels (frep mesh's 0.1)");
+
+  mod.def("compile", &compileModel, py::arg("source"), py::arg("file") = "<string>", py::arg("object") = "",
+          py::arg("params") = std::vector<double>{}, py::arg("iso") = 0.0,
+          "Compiles HyperFun source text; errors raise ModelError (file:line:column)");
+  mod.def("load", &loadModel, py::arg("path"), py::arg("object") = "", py::arg("params") = std::vector<double>{},
+          py::arg("iso") = 0.0, "Reads and compiles a .hf file");
+
+  py::class_<Volume>(mod, "Volume", "A sampled model: f in the narrow band, inside/outside tiles elsewhere")
+      .def_property_readonly("voxel", [](const Volume& v) { return v.result.grid.voxel; })
+      .def_property_readonly("origin", [](const Volume& v) { return v.result.grid.origin; })
+      .def_property_readonly("dims", [](const Volume& v) { return v.result.grid.dims; })
+      .def_property_readonly("leaf_count", [](const Volume& v) { return v.result.leaves.size(); })
+      .def("world", [](const Volume& v, int64_t i, int64_t j, int64_t k) { return v.result.grid.world(i, j, k); },
+           "world point of voxel (i, j, k)")
+      .def("inside_volume", [](const Volume& v) { return insideVolume(v.result); },
+           "grid points with f >= 0 times the voxel volume")
+      .def("write_vdb", &writeVdb, py::arg("path"), "Writes the .vdb that frep sample writes (frep_io)")
+      .def("to_pyopenvdb", &toPyOpenVdb, "A pyopenvdb.FloatGrid (through a temporary .vdb file)");
+
+  py::class_<PyMesh>(mod, "Mesh", "A watertight, outward-oriented triangle mesh")
+      .def_property_readonly("vertices", [](const PyMesh& m) { return rows(m.mesh.positions); })
+      .def_property_readonly("normals", [](const PyMesh& m) { return rows(m.mesh.normals); })
+      .def_property_readonly("triangles", [](const PyMesh& m) {
+        py::array_t<uint32_t> a({py::ssize_t(m.mesh.triangles.size()), py::ssize_t(3)});
+        if (!m.mesh.triangles.empty())
+          std::copy(m.mesh.triangles.data()->data(), m.mesh.triangles.data()->data() + 3 * m.mesh.triangles.size(),
+                    a.mutable_data());
+        return a;
+      })
+      .def_readonly("error_bound", &PyMesh::errorBound, "simplification's bound on the distance to the surface")
+      .def("write", &writeMeshFile, py::arg("path"), "Writes .ply, .obj or .stl (frep_io)");
+}
