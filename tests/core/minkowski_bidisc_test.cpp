@@ -249,6 +249,52 @@ TEST(MinkowskiBidisc, VolumeMatchesTheMixedVolumeFormula) {
   EXPECT_NEAR(count * h[0] * h[1] * h[2] / (2 * kPi * a * b * (a + b)), 1.0, 4e-3);
 }
 
+// Subtraction chain (eq. 19–21) with a bidisc: a block eroded by a sum is the block moved in by
+// the sum's support function (erosionExpr's block case, checked against the search for one-axis
+// sums in minkowski_algebra_test.cpp), so here the bidisc sum's support function is checked
+// against a brute-force max over its circles' points and its segment's ends; a sphere eroded by
+// it has no closed form and is refused.
+TEST(MinkowskiBidisc, SupportFunctionForErosionIsTheBruteForceMax) {
+  const Mat3 rot = rotationXYZ(0.4, 0.2, -0.3);
+  Sum sub;
+  sub.add(member(ShapeKind::Disc, 0, 0.3, rot));
+  sub.add(member(ShapeKind::Disc, 2, 0.2, rot));
+  sub.add(member(ShapeKind::Segment, 1, 0.5, rot));
+  Reduction r = reduce(sub);
+  ASSERT_TRUE(r.ok);
+  auto axis = [&](int a) { return Vec3{rot[a], rot[3 + a], rot[6 + a]}; };
+  const Vec3 ex = axis(0), ey = axis(1), ez = axis(2);
+  std::mt19937 rng(17);
+  std::normal_distribution<double> g(0, 1);
+  for (int trial = 0; trial < 40; ++trial) {
+    Vec3 n{g(rng), g(rng), g(rng)};
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (double& v : n) v /= len;
+    auto dot = [&](const Vec3& a) { return a[0] * n[0] + a[1] * n[1] + a[2] * n[2]; };
+    // xdisc(0.3) spans ey, ez; zdisc(0.2) spans ex, ey; yline(0.5) from 0 to 0.5 ey.
+    double h1 = -INFINITY, h2 = -INFINITY;
+    for (int k = 0; k < 100000; ++k) {
+      const double t = 2 * kPi * k / 100000;
+      h1 = std::max(h1, 0.3 * (std::cos(t) * dot(ey) + std::sin(t) * dot(ez)));
+      h2 = std::max(h2, 0.2 * (std::cos(t) * dot(ex) + std::sin(t) * dot(ey)));
+    }
+    const double brute = h1 + h2 + std::max(0.0, 0.5 * dot(ey)) + dot(sub.offset);
+    EXPECT_NEAR(supportValue(r, n), brute, 1e-8);
+  }
+  const std::vector<Expr> xs{Expr::x(0), Expr::x(1), Expr::x(2)};
+  Sum c0;
+  Shape blk = member(ShapeKind::Block, 0, 0);
+  blk.size = {3, 2.5, 2};
+  c0.add(blk);
+  Expr out;
+  EXPECT_TRUE(erosionExpr(c0, r, xs, &out, nullptr));
+  Sum ball;
+  ball.add(member(ShapeKind::Sphere, 0, 1.6));
+  std::string why;
+  EXPECT_FALSE(erosionExpr(ball, r, xs, &out, &why));
+  EXPECT_NE(why.find("bidisc"), std::string::npos);
+}
+
 // A sphere with two disc axes, or three disc axes: not reduced (no closed form), with the reason.
 TEST(MinkowskiBidisc, HigherSurfacesAreNotReduced) {
   Sum bs;
