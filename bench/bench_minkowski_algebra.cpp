@@ -10,6 +10,8 @@
 //           it samples every voxel; the whole grid is extrapolated as its CPU time per sampled
 //           voxel × the voxels the EXACT run samples (the narrow band): a lower bound for the
 //           search, which prunes no better than the exact field. --full-search runs it all.
+// --bidisc: the fourth term is xdisc(0.25) instead of the sphere (discs on two axes: the
+// closed-form bidisc gauge, bidisc.h); the search adds that disc to the same one-axis union.
 // CPU seconds of this process (bench_timing.h); the ratio uses the same run's figures.
 #include <cmath>
 #include <cstdio>
@@ -58,10 +60,11 @@ Run runSample(const Expr& f, const GridSpec& g, int zlo, int zhi) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool fullSearch = false;
+  bool fullSearch = false, bidisc = false;
   int res = 256;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--full-search")) fullSearch = true;
+    if (!std::strcmp(argv[i], "--bidisc")) bidisc = true;
     if (!std::strcmp(argv[i], "--res") && i + 1 < argc) res = std::atoi(argv[++i]);
   }
   const Mat3 rot = rotationXYZ(0.3, -0.2, 0.5);
@@ -70,7 +73,7 @@ int main(int argc, char** argv) {
                          member(ShapeKind::Disc, 2, 0.4, rot)})
     head.add(s);
   all = head;
-  all.add(member(ShapeKind::Sphere, 0, 0.25, rot));
+  all.add(bidisc ? member(ShapeKind::Disc, 0, 0.25, rot) : member(ShapeKind::Sphere, 0, 0.25, rot));
   for (Sum* s : {&head, &all})
     for (int i = 0; i < 3; ++i) s->offset[i] = 0;
   // Centre the solid: move the local origin to -R·(L/2).
@@ -82,10 +85,16 @@ int main(int argc, char** argv) {
   Reduction rAll = reduce(all), rHead = reduce(head);
   Expr exact = unionExpr(rAll);
   Expr ball = 0.25 - sqrt(square(Expr::x(0)) + square(Expr::x(1)) + square(Expr::x(2)));
+  if (bidisc) {  // minus the distance to xdisc(0.25) in the rotated frame
+    const Expr h = Expr::x(0) * rot[0] + Expr::x(1) * rot[3] + Expr::x(2) * rot[6];
+    const Expr rho = sqrt(square(Expr::x(0) - h * rot[0]) + square(Expr::x(1) - h * rot[3]) +
+                          square(Expr::x(2) - h * rot[6]));
+    ball = -sqrt(square(h) + square(max(rho - 0.25, Expr(0.0))));
+  }
   MinkowskiOptions mo;
   mo.tolerance = 1e-3;
   Expr search = minkowskiSum(unionExpr(rHead), ball, 3, Bounds{{-0.3, -0.3, -0.3}, {0.3, 0.3, 0.3}}, mo);
-  std::printf("sum: %s, %zu primitives\n", all.describe().c_str(), rAll.pieces.size());
+  std::printf("sum: %s, %zu primitives\n", all.describe().c_str(), primitives(rAll).size());
 
   GridSpec g = GridSpec::fromBounds({-1.5, -1.5, -1.5}, {1.5, 1.5, 1.5}, res);
   Run ex = runSample(exact, g, -1, -1);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "frep/minkowski_algebra/bidisc.h"
 #include "frep/minkowski_algebra/registry.h"
 
 namespace frep::io {
@@ -57,6 +58,20 @@ std::string pieceText(const Piece& p, double thin) {
       return "torus { " + num(p.radius) + ", " + num(std::max(p.minor, thin / 2)) + turn + " translate " +
              vec(p.base) + " }";
     }
+    case PieceKind::Bicircle: {
+      // POV has no bicircle: its quartic, exactly (inside where it is < 0), in the canonical
+      // frame of bidisc.h, turned onto the piece's axes (matrix rows: where x, y, z go).
+      const double a = p.radius, b = p.minor;
+      std::string t = "polynomial { 4";
+      for (const minkowski::QuarticTerm& q : minkowski::bicircleTerms(a, b))
+        t += ", xyz(" + std::to_string(q.i) + "," + std::to_string(q.j) + "," + std::to_string(q.k) + "): " + num(q.c);
+      t += " sturm bounded_by { box { " + vec({-b, -a, -a - b}) + ", " + vec({b, a, a + b}) + " } } matrix <";
+      const int rows[3] = {p.axis, p.axis2, 3 - p.axis - p.axis2};
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) t += (c == rows[r] ? "1" : "0") + std::string(", ");
+      return t + "0, 0, 0> translate " + vec(p.base) + " }";
+    }
+    case PieceKind::Bidisc: break;  // expanded by minkowski::primitives()
   }
   return "";
 }
@@ -210,9 +225,10 @@ std::string translateTerm(Cursor& c, double thin) {
 }  // namespace
 
 std::string povUnion(const Reduction& r, double thin) {
-  std::string s = "union { // " + r.sum.describe() + ": " + std::to_string(r.pieces.size()) +
+  const std::vector<Piece> prims = minkowski::primitives(r);
+  std::string s = "union { // " + r.sum.describe() + ": " + std::to_string(prims.size()) +
                   " primitives (Roerdink-Minkowski)\n";
-  for (const Piece& p : r.pieces) s += "  " + pieceText(p, thin) + "\n";
+  for (const Piece& p : prims) s += "  " + pieceText(p, thin) + "\n";
   return s + "  " + frameText(r.sum) + "\n}";
 }
 

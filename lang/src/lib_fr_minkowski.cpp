@@ -43,7 +43,7 @@ Expr exactField(const Sum& s, const std::vector<Expr>& xs) {
   if (identityCoords(xs)) {
     ExactTerm t;
     t.sum = s;
-    t.pieces = static_cast<int>(red.pieces.size());
+    t.pieces = static_cast<int>(minkowski::primitives(red).size());
     minkowski::registerExact(f, t);
   }
   return f;

@@ -268,11 +268,69 @@ TEST(MinkowskiAlgebra, PrimitiveCountsMatchThePaper) {
     }
     EXPECT_EQ(holders, 1) << w[0] << " " << w[1] << " " << w[2];
   }
-  // Two disc axes: not reducible here (bicircles), so frMinkowski falls back to the search.
+  // Two disc axes: the closed-form bidisc (minkowski_bidisc_test.cpp).
   Sum bi;
   bi.add(member(ShapeKind::Disc, 0, 0.5));
   bi.add(member(ShapeKind::Disc, 1, 0.5));
-  EXPECT_FALSE(reduce(bi).ok);
+  EXPECT_TRUE(reduce(bi).ok);
+  EXPECT_EQ(primitives(reduce(bi)).size(), 3u);
+}
+
+// §IV.D's ungrouped path for block ⊕ zdisc ⊕ sphere: reduce block ⊕ zdisc (2 blocks, 4
+// cylinders), then each piece ⊕ sphere (a block: 3 blocks, 12 cylinders, 8 spheres; a
+// cylinder, zline ⊕ zdisc ⊕ sphere: 2 tori, 2 cylinders) — the paper's 62 — against the grouped
+// 28, which holds the same points.
+TEST(MinkowskiAlgebra, UngroupedReductionHasThePapers62) {
+  const double lx = 2, ly = 1.5, lz = 1, r = 0.3, s = 0.2;
+  Sum bz;
+  bz.add(member(ShapeKind::Segment, 0, lx));
+  bz.add(member(ShapeKind::Segment, 1, ly));
+  bz.add(member(ShapeKind::Segment, 2, lz));
+  bz.add(member(ShapeKind::Disc, 2, r));
+  std::vector<Reduction> parts;
+  int spheres = 0, blocks = 0, tori = 0, cylinders = 0;
+  for (const Piece& p : reduce(bz).pieces) {
+    Shape m;  // the piece as a basic-set sum: a block, or zline ⊕ zdisc at its base
+    Sum part;
+    if (p.kind == PieceKind::Block) {
+      m.kind = ShapeKind::Block;
+      m.pos = p.lo;
+      for (int i = 0; i < 3; ++i) m.size[i] = p.hi[i] - p.lo[i];
+      part.add(m);
+    } else {
+      ASSERT_EQ(p.kind, PieceKind::Cylinder);
+      m = member(ShapeKind::Segment, p.axis, p.length);
+      m.pos = p.base;
+      part.add(m);
+      part.add(member(ShapeKind::Disc, p.axis, p.radius));
+    }
+    part.add(member(ShapeKind::Sphere, 0, s));
+    parts.push_back(reduce(part));
+    ASSERT_TRUE(parts.back().ok);
+    spheres += parts.back().count(PieceKind::Sphere);
+    blocks += parts.back().count(PieceKind::Block);
+    tori += parts.back().count(PieceKind::Torus);
+    cylinders += parts.back().count(PieceKind::Cylinder);
+  }
+  EXPECT_EQ(spheres, 16);
+  EXPECT_EQ(blocks, 6);
+  EXPECT_EQ(tori, 8);
+  EXPECT_EQ(cylinders, 32);
+  EXPECT_EQ(spheres + blocks + tori + cylinders, 62);
+  Sum all = bz;
+  all.add(member(ShapeKind::Sphere, 0, s));
+  Reduction grouped = reduce(all);
+  EXPECT_EQ(grouped.pieces.size(), 28u);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(-0.6, 2.6);
+  for (int i = 0; i < 5000; ++i) {
+    Vec3 p{u(rng), u(rng) * 0.8, u(rng) * 0.6};
+    double ungrouped = -INFINITY;
+    for (const Reduction& part : parts) ungrouped = std::max(ungrouped, unionValue(part, p));
+    const double g = unionValue(grouped, p);
+    if (g <= 0) EXPECT_NEAR(ungrouped, g, 1e-9);  // both minus the distance outside
+    else EXPECT_GT(ungrouped, 0);
+  }
 }
 
 // Subtraction chains (eq. 19–21) against the certified search of the erosion.

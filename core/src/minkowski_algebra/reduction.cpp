@@ -27,6 +27,8 @@
 // tests/core/minkowski_algebra_test.cpp checks that each of the 4 blocks alone holds such points.
 #include "frep/minkowski_algebra/reduction.h"
 
+#include "frep/minkowski_algebra/bidisc.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -43,6 +45,8 @@ int Piece::dimension() const {
     case PieceKind::Cylinder: return (radius > 0 ? 2 : 0) + (length > 0 ? 1 : 0);
     case PieceKind::Sphere: return radius > 0 ? 3 : 0;
     case PieceKind::Torus: return minor > 0 ? 3 : (radius > 0 ? 1 : 0);
+    case PieceKind::Bidisc:
+    case PieceKind::Bicircle: return radius > 0 && minor > 0 ? 3 : 0;
   }
   return 0;
 }
@@ -63,6 +67,7 @@ bool samePiece(const Piece& a, const Piece& b) {
   for (int i = 0; i < 3; ++i)
     if (!eq(a.lo[i], b.lo[i]) || !eq(a.hi[i], b.hi[i]) || !eq(a.base[i], b.base[i])) return false;
   if (a.kind != PieceKind::Block && a.kind != PieceKind::Sphere && a.axis != b.axis) return false;
+  if ((a.kind == PieceKind::Bidisc || a.kind == PieceKind::Bicircle) && a.axis2 != b.axis2) return false;
   return eq(a.radius, b.radius) && eq(a.length, b.length) && eq(a.minor, b.minor);
 }
 
@@ -102,6 +107,22 @@ T pieceSdf(const Piece& p, const T q[3]) {
       T rho = sqrt(sq(q[b] - T(p.base[b])) + sq(q[c] - T(p.base[c])));
       return sqrt(sq(rho - T(p.radius)) + sq(q[a] - T(p.base[a]))) - T(p.minor);
     }
+    case PieceKind::Bidisc: {
+      // Minus the bidisc gauge at the excess over the block (bidisc.h): 1-Lipschitz, sign-exact.
+      const int i = p.axis, j = p.axis2, k = 3 - i - j;
+      T e[3];
+      for (int c = 0; c < 3; ++c)
+        e[c] = max(abs(q[c] - T(0.5 * (p.lo[c] + p.hi[c]))) - T(0.5 * (p.hi[c] - p.lo[c])), zero);
+      return -bidiscGauge(e[i], e[j], e[k], p.radius, p.minor);
+    }
+    case PieceKind::Bicircle: {
+      // The quartic's sign only (tests of the ray-tracer form; no piece of an F-rep union).
+      const int i = p.axis, j = p.axis2, k = 3 - i - j;
+      const T x = q[i] - T(p.base[i]), y = q[j] - T(p.base[j]), z = q[k] - T(p.base[k]);
+      const double a = p.radius, b = p.minor, c = a * a - b * b;
+      const T quad = x * x - y * y + z * z + T(c);
+      return quad * quad - T(4.0) * z * z * (T(a * a) - y * y);
+    }
   }
   return zero;
 }
@@ -130,6 +151,8 @@ T pieceFarthest(const Piece& p, const T y[3]) {
     case PieceKind::Sphere:
       return sqrt(sq(y[0] - T(p.base[0])) + sq(y[1] - T(p.base[1])) + sq(y[2] - T(p.base[2]))) +
              T(p.radius);
+    case PieceKind::Bidisc:
+    case PieceKind::Bicircle: break;  // no closed form; erosionExpr refuses these
   }
   return T(0.0);
 }
@@ -167,6 +190,17 @@ double pieceSupport(const Piece& p, const Vec3& m) {
       if (p.kind == PieceKind::Torus) return h + p.radius * across + p.minor;
       return h + std::max(0.0, m[p.axis] * p.length) + p.radius * across;
     }
+    case PieceKind::Bidisc:
+    case PieceKind::Bicircle: {
+      // h(block) + a·|m across axis| + b·|m across axis2| (a disc's support, §II.C eq. 10).
+      double h = 0;
+      if (p.kind == PieceKind::Bidisc)
+        for (int i = 0; i < 3; ++i) h += std::max(m[i] * p.lo[i], m[i] * p.hi[i]);
+      else
+        h = m[0] * p.base[0] + m[1] * p.base[1] + m[2] * p.base[2];
+      return h + p.radius * std::sqrt(std::max(0.0, 1.0 - m[p.axis] * m[p.axis])) +
+             p.minor * std::sqrt(std::max(0.0, 1.0 - m[p.axis2] * m[p.axis2]));
+    }
   }
   return 0;
 }
@@ -182,6 +216,12 @@ std::string Piece::describe() const {
     case PieceKind::Sphere: return "sphere r " + num(radius) + " at " + vec(base);
     case PieceKind::Torus:
       return std::string(1, kAxis[axis]) + "torus " + num(radius) + ", " + num(minor) + " at " + vec(base);
+    case PieceKind::Bidisc:
+      return "block " + vec(lo) + " - " + vec(hi) + " + " + kAxis[axis] + "disc(" + num(radius) + ") + " +
+             kAxis[axis2] + "disc(" + num(minor) + ")";
+    case PieceKind::Bicircle:
+      return std::string(1, kAxis[3 - axis - axis2]) + "bicircle " + num(radius) + ", " + num(minor) + " at " +
+             vec(base);
   }
   return "?";
 }
@@ -192,6 +232,106 @@ int Reduction::count(PieceKind k) const {
   return n;
 }
 
+namespace {
+// Drops coincident pieces and pieces of lower dimension than the largest (covered by the others:
+// a closed union covering the relative interior covers its closure).
+std::vector<Piece> keepLargest(const std::vector<Piece>& all) {
+  int top = 0;
+  for (const Piece& p : all) top = std::max(top, p.dimension());
+  std::vector<Piece> kept;
+  for (const Piece& p : all) {
+    if (p.dimension() < top) continue;
+    bool dup = false;
+    for (const Piece& q : kept) dup = dup || samePiece(p, q);
+    if (!dup) kept.push_back(p);
+  }
+  return kept;
+}
+
+// Block [lo, hi] ⊕ xdisc(a) ⊕ ydisc(b) (canonical axes x = p.axis, y = p.axis2) as ray-tracer
+// primitives, by where X's excess e over the block is nonzero (the bidisc is symmetric in the
+// coordinate planes, so e lies in its projection onto those axes):
+//   z only, or none        -> block with z widened by a + b
+//   x and y (and subsets)  -> block widened by b in x and a in y
+//   x and z                -> projection: ydisc(b) ⊕ zline(±a) = block widened (b, 0, a), block
+//                             widened (0, 0, a + b), 4 y-cylinders r b at z = −a, Lz + a
+//   y and z                -> block widened (0, a, b), 4 x-cylinders r a at z = −b, Lz + b
+//   all three              -> a bidisc at each corner: 8 bicircles, and their cylinders merged
+//                             along the edges: 4 x-cylinders r a, 4 y-cylinders r b
+// 4 blocks, 16 cylinders, 8 bicircles; a bidisc alone (L = 0) is 1 bicircle and 2 cylinders.
+std::vector<Piece> bidiscPrimitives(const Piece& bd) {
+  const int perm[3] = {bd.axis, bd.axis2, 3 - bd.axis - bd.axis2};
+  const double a = bd.radius, b = bd.minor;
+  double L[3];
+  for (int c = 0; c < 3; ++c) L[c] = bd.hi[perm[c]] - bd.lo[perm[c]];
+  auto local = [&](const Vec3& c) {
+    Vec3 l{};
+    for (int k = 0; k < 3; ++k) l[perm[k]] = bd.lo[perm[k]] + c[k];
+    return l;
+  };
+  std::vector<Piece> all;
+  auto block = [&](const Vec3& lo, const Vec3& hi) {
+    Piece p;
+    p.kind = PieceKind::Block;
+    p.lo = local(lo);
+    p.hi = local(hi);
+    all.push_back(p);
+  };
+  auto cylinder = [&](int axis, Vec3 base, double radius, double length) {
+    Piece p;
+    p.kind = PieceKind::Cylinder;
+    p.axis = perm[axis];
+    p.base = local(base);
+    p.radius = radius;
+    p.length = length;
+    all.push_back(p);
+  };
+  const double Lx = L[0], Ly = L[1], Lz = L[2];
+  block({0, 0, -a - b}, {Lx, Ly, Lz + a + b});
+  block({-b, -a, 0}, {Lx + b, Ly + a, Lz});
+  block({-b, 0, -a}, {Lx + b, Ly, Lz + a});
+  block({0, -a, -b}, {Lx, Ly + a, Lz + b});
+  for (double x : {0.0, Lx})
+    for (double z : {-a, Lz + a}) cylinder(1, {x, 0, z}, b, Ly);
+  for (double y : {0.0, Ly})
+    for (double z : {-b, Lz + b}) cylinder(0, {0, y, z}, a, Lx);
+  for (double y : {0.0, Ly})
+    for (double z : {0.0, Lz}) cylinder(0, {-b, y, z}, a, Lx + 2 * b);
+  for (double x : {0.0, Lx})
+    for (double z : {0.0, Lz}) cylinder(1, {x, -a, z}, b, Ly + 2 * a);
+  for (double x : {0.0, Lx})
+    for (double y : {0.0, Ly})
+      for (double z : {0.0, Lz}) {
+        Piece p;
+        p.kind = PieceKind::Bicircle;
+        p.axis = bd.axis;
+        p.axis2 = bd.axis2;
+        p.base = local({x, y, z});
+        p.radius = a;
+        p.minor = b;
+        all.push_back(p);
+      }
+  return keepLargest(all);
+}
+}  // namespace
+
+std::vector<Piece> primitives(const Reduction& r) {
+  std::vector<Piece> out;
+  for (const Piece& p : r.pieces) {
+    if (p.kind != PieceKind::Bidisc) {
+      out.push_back(p);
+      continue;
+    }
+    for (const Piece& q : bidiscPrimitives(p)) out.push_back(q);
+  }
+  return out;
+}
+
+bool primitiveHolds(const Piece& p, const Vec3& local) {
+  const double q[3] = {local[0], local[1], local[2]};
+  return pieceSdf(p, q) <= 0;  // a bicircle's quartic is <= 0 on its shell only (bidisc.h)
+}
+
 Reduction reduce(const Sum& sum) {
   Reduction red;
   red.sum = sum;
@@ -199,9 +339,25 @@ Reduction reduce(const Sum& sum) {
     red.reason = "empty sum";
     return red;
   }
-  if (sum.discAxes() > 1) {
-    red.reason = "discs along two or more axes (bidisc/tridisc: bicircle and tricircle surfaces of "
-                 "degree 4 and higher, Theorem 5's R9-R16, have no closed-form distance)";
+  if (sum.discAxes() == 3 || (sum.discAxes() == 2 && sum.ball > 0)) {
+    red.reason = sum.discAxes() == 3
+                     ? "discs along three axes (the tricircle surfaces, Theorem 5's R15-R16, have degree "
+                       "above 4 and no closed form)"
+                     : "a sphere with discs along two axes (the bicircle-sphere surface, Theorem 5's "
+                       "R12-R14, has degree above 4 and no closed form)";
+    return red;
+  }
+  if (sum.discAxes() == 2) {
+    Piece p;
+    p.kind = PieceKind::Bidisc;
+    int found = 0;
+    for (int i = 0; i < 3; ++i)
+      if (sum.disc[i] > 0) (found++ == 0 ? p.axis : p.axis2) = i;
+    p.radius = sum.disc[p.axis];
+    p.minor = sum.disc[p.axis2];
+    p.hi = sum.lengths;
+    red.pieces.push_back(p);
+    red.ok = true;
     return red;
   }
   int d = 2;
@@ -262,14 +418,7 @@ Reduction reduce(const Sum& sum) {
     for (double y : {0.0, Ly})
       for (double z : {0.0, Lz}) torus({x, y, z});
 
-  int top = 0;
-  for (const Piece& p : all) top = std::max(top, p.dimension());
-  for (const Piece& p : all) {
-    if (p.dimension() < top) continue;
-    bool dup = false;
-    for (const Piece& q : red.pieces) dup = dup || samePiece(p, q);
-    if (!dup) red.pieces.push_back(p);
-  }
+  red.pieces = keepLargest(all);
   red.ok = true;
   return red;
 }
@@ -312,6 +461,12 @@ bool erosionExpr(const Sum& c0, const Reduction& r, const std::vector<Expr>& coo
                  std::string* reason) {
   const bool isBlock = c0.discAxes() == 0 && c0.ball == 0;
   const bool isBall = c0.discAxes() == 0 && c0.lengths == Vec3{0, 0, 0};
+  bool bidisc = false;
+  for (const Piece& p : r.pieces) bidisc = bidisc || p.kind == PieceKind::Bidisc;
+  if (r.ok && isBall && c0.ball > 0 && bidisc) {
+    if (reason) *reason = "a sphere eroded by a bidisc sum (the farthest point has no closed form)";
+    return false;
+  }
   if (!r.ok || !(isBlock || isBall)) {
     if (reason)
       *reason = !r.ok ? r.reason

@@ -3,10 +3,12 @@
 //
 // Implemented for sums whose circle part has at most one disc axis (after discs of one axis
 // are added): block ⊕ disc ⊕ sphere and all its degenerate cases (segments, rectangles,
-// blocks, discs, cylinders, discus, rounded blocks, ...), in any frame. Sums of discs along two
-// or three axes need the paper's bicircle / tricircle surfaces (degree 4 and higher, R9–R16),
-// for which no closed-form distance exists; reduce() reports them as not reducible and the
-// caller falls back to the certified extremum search.
+// blocks, discs, cylinders, discus, rounded blocks, ...), in any frame; and for two disc axes
+// without a sphere: block ⊕ bidisc (bidisc.h), one closed-form piece whose ray-tracer form is
+// bicircles, cylinders and blocks (primitives()). A sphere with two disc axes, or three disc
+// axes, needs the bicircle-sphere / tricircle(-sphere) surfaces (degree above 4, R12–R16), for
+// which no closed form exists; reduce() reports them as not reducible and the caller falls back
+// to the certified extremum search.
 //
 // Grouping (§IV.D): the lines form one group (the block), the circles and the sphere another
 // (the core K = disc ⊕ ball), and the pieces are the offset by the ball of the faces, edges and
@@ -21,15 +23,17 @@
 
 namespace frep::minkowski {
 
-enum class PieceKind { Block, Cylinder, Sphere, Torus };
+enum class PieceKind { Block, Cylinder, Sphere, Torus, Bidisc, Bicircle };
 
 // One ray-tracer primitive in the sum's local frame (see Sum): a block [lo, hi]; a cylinder
 // of radius `radius` around the segment from `base` along `axis` of length `length`; a
 // sphere (centre `base`, radius); a torus around `axis` through `base` (major radius `radius`,
-// minor `minor`).
+// minor `minor`); block [lo, hi] ⊕ bidisc (disc of radius `radius` normal to `axis`, disc of
+// radius `minor` normal to `axis2`; an F-rep piece, see bidisc.h); the bicircle solid of that
+// bidisc centred at `base` (a ray-tracer primitive only: a POV quartic).
 struct Piece {
   PieceKind kind = PieceKind::Block;
-  int axis = 0;
+  int axis = 0, axis2 = 1;
   Vec3 lo{0, 0, 0}, hi{0, 0, 0};
   Vec3 base{0, 0, 0};
   double radius = 0, length = 0, minor = 0;
@@ -46,6 +50,14 @@ struct Reduction {
 };
 
 Reduction reduce(const Sum& sum);
+
+// The ray-tracer primitives of the union (Theorem 5's R1–R11): the pieces with each Bidisc
+// expanded into blocks, cylinders and bicircles (4 blocks, 16 cylinders and 8 bicircles for
+// block ⊕ bidisc; bicircle + 2 cylinders for a bidisc alone, §IV.B). Their count is the one the
+// job report and `frep pov` give.
+std::vector<Piece> primitives(const Reduction& r);
+// Whether a local point lies in one primitive (tests: the primitives' union is the sum).
+bool primitiveHolds(const Piece& p, const Vec3& local);
 
 // F-rep of the union (inside >= 0): max over the pieces of minus their exact signed distance,
 // read at the local point R^T (X − offset) of the world coordinates x0, x1, x2. Each piece is
