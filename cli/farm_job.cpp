@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <algorithm>
 #include <fstream>
+#include <thread>
 
 #include "arg_parse.h"
 #include "brick.h"
@@ -28,7 +30,7 @@ farm::JobSpec makeJob(const LoadedModel& m, const std::string& modelPath, const 
 
 farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, const std::string& logLevel, int threads) {
   if (f.workers < -1) throw badArgs("--workers: expected 0 (in-process) or more, got " + std::to_string(f.workers));
-  if (f.brick < 8 || f.brick % 8 != 0)
+  if (f.brick != 0 && (f.brick < 8 || f.brick % 8 != 0))
     throw badArgs("--brick: expected a positive multiple of 8 voxels, got " + std::to_string(f.brick));
   if (f.heartbeatMs < 10) throw badArgs("--heartbeat-ms: expected at least 10, got " + std::to_string(f.heartbeatMs));
   if (!f.listen.empty() && f.listen.rfind("tcp://", 0) != 0)
@@ -49,6 +51,23 @@ farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, cons
   o.logLevel = logLevel == "info" ? "warn" : logLevel;
   o.threads = threads;
   return o;
+}
+
+int chooseBrick(const std::array<int32_t, 3>& dims, int workers, const std::string& listen, int expectWorkers) {
+  int n = !listen.empty() ? expectWorkers
+          : workers < 0   ? int(std::max(1u, std::thread::hardware_concurrency()))
+                          : workers;
+  if (n <= 0) return 64;  // in-process, or a cluster of unknown size: the default brick
+  int brick = 64;
+  auto bricks = [&](int e) {
+    int64_t count = 1;
+    for (int32_t d : dims) count *= (d + e - 1) / e;
+    return count;
+  };
+  // Two bricks per worker at least, so that none idles and a slow one can be backed up; not
+  // below 16 voxels, where a brick's fixed costs (messages, interval pass) start to dominate.
+  while (brick > 16 && bricks(brick) < 2 * int64_t(n)) brick /= 2;
+  return brick;
 }
 
 farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& options) {

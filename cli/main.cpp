@@ -16,49 +16,6 @@ namespace {
 
 using namespace frep::cli;
 
-// Recorded in output metadata: quoted so that it can be pasted back into a shell.
-std::string joinCommandLine(int argc, char** argv) {
-  std::string line;
-  for (int i = 0; i < argc; ++i) {
-    std::string arg = argv[i];
-    bool plain = !arg.empty() && arg.find_first_not_of(
-        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_.,/=:+@%") == std::string::npos;
-    if (!plain) {
-      std::string quoted = "'";
-      for (char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-      arg = quoted + "'";
-    }
-    line += (i ? " " : "") + arg;
-  }
-  return line;
-}
-
-// The command line as recorded in the output, without the options that only choose how the
-// job runs (they never change the result, so outputs of any worker count stay identical).
-std::string recordedCommandLine(int argc, char** argv) {
-  // The output path is left out too: the same grid written anywhere is the same file.
-  static const char* execution[] = {"--workers", "--listen", "--expect-workers", "--heartbeat-ms", "--curve",
-                                    "--threads", "--log-level", "--brick", "-O", "--out"};
-  static const char* flags[] = {"--resume", "--json", "--no-progress"};
-  std::vector<char*> kept;
-  for (int i = 0; i < argc; ++i) {
-    std::string a = argv[i];
-    bool drop = false;
-    for (const char* f : flags) drop = drop || a == f;
-    for (const char* o : execution) {
-      std::string opt = o;
-      if (a == opt) {
-        drop = true;
-        ++i;  // and its value
-      } else if (a.rfind(opt + "=", 0) == 0) {
-        drop = true;
-      }
-    }
-    if (!drop) kept.push_back(argv[i]);
-  }
-  return joinCommandLine(int(kept.size()), kept.data());
-}
-
 void addModelOptions(CLI::App* sub, ModelRequest& m, bool withFieldOptions) {
   sub->add_option("model", m.path, "The HyperFun model (.hf)")->required();
   sub->add_option("-o,--object", m.object, "Object to use (as hfp: default my_model, else the first)");
@@ -83,7 +40,7 @@ void addFarmOptions(CLI::App* sub, FarmRequest& f) {
                   "frep-worker --connect");
   sub->add_option("--expect-workers", f.expectWorkers,
                   "Cluster mode: workers expected; dispatch waits up to 5 s after the first one joins for the rest");
-  sub->add_option("--brick", f.brick, "Brick edge in voxels, a multiple of 8 (default 64; same output)");
+  sub->add_option("--brick", f.brick, "Brick edge in voxels, a multiple of 8 (default: 64, smaller so that every worker gets two; same output)");
   sub->add_option("--heartbeat-ms", f.heartbeatMs, "Heartbeat interval both ways (default 500)");
   sub->add_flag("--resume", f.resume, "Continue a stopped job from OUT.journal");
   sub->add_flag("--json", f.json, "JSON progress events on stdout (batch systems)");
@@ -134,10 +91,13 @@ int main(int argc, char** argv) {
   sliceCmd->add_option("--at", slice.at, "Position of the plane on that axis (default 0)");
 
   SampleRequest sample;
-  CLI::App* sampleCmd = app.add_subcommand("sample", "Narrow-band OpenVDB level set (stores -f) of a model");
+  CLI::App* sampleCmd = app.add_subcommand("sample", "Narrow-band OpenVDB level set (signed distance; -f or fog by --store) of a model");
   addModelOptions(sampleCmd, sample.model, true);
   addRegionOptions(sampleCmd, sample.region, "Output .vdb file", 128);
   sampleCmd->add_option("--band", sample.band, "Band half-width in voxels (default 3)");
+  sampleCmd->add_option("--store", sample.store,
+                        "What the grid holds: sdf (signed distance, default), raw (-f) or fog (density grid)")
+      ->check(CLI::IsMember({"sdf", "raw", "fog"}));
   sampleCmd->add_option("--threads", sample.threads, "Threads of the in-process run, --workers 0 (default 0: all cores)");
   addFarmOptions(sampleCmd, sample.farm);
 
@@ -193,7 +153,6 @@ int main(int argc, char** argv) {
       return runMesh(mesh);
     }
     checkObjectIsNotAFile(sample.model);
-    sample.commandLine = recordedCommandLine(argc, argv);
     sample.logLevel = logLevel;
     return runSample(sample);
   } catch (const CliError& e) {

@@ -112,6 +112,8 @@ int runMesh(const MeshRequest& request) {
     throw badArgs("frep mesh needs a three-dimensional object; '" + m.model.objectName + "' has " +
                   std::to_string(m.dims) + " coordinate(s) (map them with -x)");
   GridSpec grid = makeGrid(box, 3, res);
+  if (request.farm.brick == 0)
+    options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
   for (int a = 0; a < 3; ++a)
     if (grid.dims[a] < 2 || grid.dims[a] >= kMaxMeshGridPoints)
       throw badArgs("--res/-g: the grid needs 2 to " + std::to_string(kMaxMeshGridPoints - 1) + " points per axis");

@@ -18,6 +18,36 @@
 #include "vdb_writer.h"
 
 namespace frep::cli {
+namespace {
+
+std::string exact(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::string baseName(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// The job as resolved (object, bound parameters, iso, axis mapping, world lattice, band, store):
+// the same text however the command was spelt (argv[0], the model's path, option order, -g or
+// --res for the same lattice), so the file's bytes do not depend on the spelling.
+std::string jobDescription(const LoadedModel& m, const GridSpec& g, int band, const std::string& store) {
+  std::string s = "sample object=" + m.model.objectName + " params=";
+  for (size_t i = 0; i < m.spec.params.size(); ++i) s += (i ? "," : "") + exact(m.spec.params[i]);
+  s += " iso=" + exact(m.spec.iso) + " map=";
+  for (size_t i = 0; i < m.spec.axis.size(); ++i)
+    s += (i ? "," : "") + (m.spec.axis[i] >= 0 ? std::string(1, char('X' + m.spec.axis[i])) : exact(m.spec.constant[i]));
+  s += " voxel=" + exact(g.voxel) + " lattice=";
+  for (int a = 0; a < 3; ++a) s += (a ? "," : "") + std::to_string(std::llround(g.origin[a] / g.voxel));
+  s += ":";
+  for (int a = 0; a < 3; ++a) s += (a ? "," : "") + std::to_string(std::llround(g.origin[a] / g.voxel) + g.dims[a] - 1);
+  return s + " band=" + std::to_string(band) + " store=" + store;
+}
+
+}  // namespace
 
 int runSample(const SampleRequest& request) {
   if (request.region.out.empty()) throw badArgs("-O/--out: the output .vdb path is required");
@@ -29,6 +59,8 @@ int runSample(const SampleRequest& request) {
   farm::FarmOptions options = farmOptions(request.farm, request.region.out, request.logLevel, request.threads);
   LoadedModel m = loadModel(request.model, true);
   GridSpec grid = makeGrid(box, 3, res);
+  if (request.farm.brick == 0)
+    options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
 
   AtomicOutput out("-O/--out", request.region.out);
   AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
@@ -42,7 +74,9 @@ int runSample(const SampleRequest& request) {
 
   VdbMetadata meta;
   meta.gridName = m.model.objectName;
-  meta.commandLine = request.commandLine;
+  meta.job = jobDescription(m, grid, request.band, request.store);
+  meta.source = baseName(request.model.path);
+  meta.store = request.store == "raw" ? VdbStore::Raw : request.store == "fog" ? VdbStore::Fog : VdbStore::Sdf;
   meta.params = request.model.params;
   meta.sourceHash = m.model.sourceHash;
   meta.iso = request.model.iso;

@@ -9,7 +9,6 @@ namespace frep::cli {
 
 GridSpec makeGrid(const Box& box, int axes, const Resolution& r) {
   GridSpec g;
-  g.origin = box.lo;
   double voxel = 0.0;
   for (int a = 0; a < axes; ++a) {
     double extent = box.hi[a] - box.lo[a];
@@ -17,11 +16,16 @@ GridSpec makeGrid(const Box& box, int axes, const Resolution& r) {
   }
   g.voxel = voxel;
   for (int a = 0; a < 3; ++a) {
-    if (a >= axes) { g.dims[a] = 1; continue; }
-    // As GridSpec::fromBounds: points stay inside the box; 1e-9 keeps an extent that is a whole
-    // number of voxels up to rounding from losing its last point.
-    double steps = std::floor((box.hi[a] - box.lo[a]) / voxel + 1e-9);
-    g.dims[a] = static_cast<int32_t>(steps) + 1;
+    if (a >= axes) {
+      g.origin[a] = box.lo[a];
+      g.dims[a] = 1;
+      continue;
+    }
+    // The world lattice: points at integer multiples of the voxel, the box rounded outward to it
+    // (1e-9 keeps a bound that is a whole number of voxels up to rounding where it is).
+    const double lo = std::floor(box.lo[a] / voxel + 1e-9), hi = std::ceil(box.hi[a] / voxel - 1e-9);
+    g.origin[a] = lo * voxel;
+    g.dims[a] = static_cast<int32_t>(hi - lo) + 1;
   }
   return g;
 }

@@ -16,7 +16,7 @@ class MeshFarmCli : public FarmTest {
     FarmTest::SetUp();
     write("part.hf", kPartModel);
   }
-  static std::string meshArgs(const std::string& out, int res = 64) {
+  static std::string meshArgs(const std::string& out, int res = 63) {  // -1..1 on the lattice of 1/31: 63 points
     return "mesh part.hf -b 1 --res " + std::to_string(res) + " --no-progress --heartbeat-ms 100 -O " + out;
   }
 };
@@ -57,8 +57,8 @@ TEST_F(MeshFarmCli, SameBytesForAnyWorkerCountAndBrickSize) {
 }
 
 TEST_F(MeshFarmCli, SigtermStopsTheMasterWhichResumesLater) {
-  ASSERT_EQ(run(meshArgs("ref.ply", 96) + " --workers 0 --brick 32").code, 0);
-  pid_t master = start(meshArgs("out.ply", 96) + " --workers 2 --brick 32", "FREP_TEST_SLOW_MS=150");
+  ASSERT_EQ(run(meshArgs("ref.ply", 95) + " --workers 0 --brick 32").code, 0);
+  pid_t master = start(meshArgs("out.ply", 95) + " --workers 2 --brick 32", "FREP_TEST_SLOW_MS=150");
   for (int i = 0; i < 200 && journalRecords("out.ply.journal") < 3; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(25));
   kill(master, SIGTERM);
@@ -69,7 +69,7 @@ TEST_F(MeshFarmCli, SigtermStopsTheMasterWhichResumesLater) {
   size_t journaled = journalRecords("out.ply.journal");
   ASSERT_GE(journaled, 3u);
   ASSERT_LT(journaled, 27u);
-  RunResult resumed = run(meshArgs("out.ply", 96) + " --workers 2 --brick 32 --resume");
+  RunResult resumed = run(meshArgs("out.ply", 95) + " --workers 2 --brick 32 --resume");
   ASSERT_EQ(resumed.code, 0) << resumed.err;
   std::string report = readText(path("out.ply.report.json"));
   EXPECT_EQ(jsonNumber(report, "from_journal"), long(journaled)) << report;
@@ -83,7 +83,7 @@ TEST_F(MeshFarmCli, PoisonedBrickExitsFiveAndIsNamed) {
   int status = std::system(full.c_str());
   EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 5);
   std::string err = readText(path(".err"));
-  EXPECT_NE(err.find("brick 2 voxels [0,32,0)-(32,64,32)"), std::string::npos) << err;
+  EXPECT_NE(err.find("brick 2 voxels [0,32,0)-(32,63,32)"), std::string::npos) << err;
   EXPECT_FALSE(fileExists(path("out.ply")));
   EXPECT_TRUE(fileExists(path("out.ply.journal")));
   EXPECT_TRUE(fileExists(path("out.ply.report.json")));

@@ -47,7 +47,7 @@ void expectClosedSphere(const ReadMesh& m, double volume, double volumeTolerance
 
 TEST_F(FrepTest, MeshFromVdbIsWatertightAndAgreesWithTheModelMesh) {
   write("s.hf", kSphere);  // radius 1
-  ASSERT_EQ(run("sample s.hf -b 1.5 --res 48 -O s.vdb").code, 0);
+  ASSERT_EQ(run("sample s.hf -b 1.5 --res 48 --store raw -O s.vdb").code, 0);
   RunResult r = run("mesh s.vdb -O v.ply");
   ASSERT_EQ(r.code, 0) << r.err;
   ReadMesh v = readPly(readText(path("v.ply")));
@@ -99,14 +99,14 @@ TEST_F(FrepTest, MeshFromVdbIsWatertightAndAgreesWithTheModelMesh) {
   // A sample with the narrowest band (1 voxel) still has every crossed cell's corners active:
   // the same vertices and triangles (normals differ where a central difference reaches past the
   // band and uses an inactive voxel's +-band value).
-  ASSERT_EQ(run("sample s.hf -b 1.5 --res 48 --band 1 -O b1.vdb").code, 0);
+  ASSERT_EQ(run("sample s.hf -b 1.5 --res 48 --band 1 --store raw -O b1.vdb").code, 0);
   RunResult b = run("mesh b1.vdb -O b1.ply");
   ASSERT_EQ(b.code, 0) << b.err;
   EXPECT_TRUE(contains(b.out, "left out 0")) << b.out;
   ReadMesh b1 = readPly(readText(path("b1.ply")));
   EXPECT_TRUE(b1.positions == v.positions);
   EXPECT_TRUE(b1.triangles == v.triangles);
-  for (size_t i = 0; i < b1.normals.size(); ++i) ASSERT_GT(mc::dot(b1.normals[i], v.normals[i]), 0.9) << i;
+  for (size_t i = 0; i < b1.normals.size(); ++i) ASSERT_GT(mc::dot(b1.normals[i], v.normals[i]), 0.85) << i;
 }
 
 TEST_F(FrepTest, MeshFromVdbFollowsTheGridTransform) {

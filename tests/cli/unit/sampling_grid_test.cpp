@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "exit_codes.h"
 
 using namespace frep::cli;
@@ -46,12 +48,17 @@ TEST(SamplingGrid, ResolutionErrors) {
   }
 }
 
-TEST(SamplingGrid, ResMatchesTheCoreGridAndStaysInsideTheBox) {
+TEST(SamplingGrid, TheBoxIsRoundedOutwardToTheWorldLattice) {
   Box box = parseBounds("-b", "0,0,0,1,0.35,0.3");
   frep::GridSpec g = makeGrid(box, 3, resolutionFrom(11, "", 128));
-  frep::GridSpec core = frep::GridSpec::fromBounds(box.lo, box.hi, 11);
-  EXPECT_EQ(g.dims, core.dims);
-  EXPECT_EQ(g.voxel, core.voxel);
-  EXPECT_EQ(g.origin, core.origin);
-  EXPECT_EQ(g.dims, (std::array<int32_t, 3>{11, 4, 4}));  // 0.35 / 0.1 -> 3 steps; 0.3 / 0.1 -> 3
+  EXPECT_DOUBLE_EQ(g.voxel, 0.1);
+  EXPECT_EQ(g.dims, (std::array<int32_t, 3>{11, 5, 4}));  // 0.35 -> 0.4; 0.3 is on the lattice
+  EXPECT_EQ(g.origin, (std::array<double, 3>{0, 0, 0}));
+  // Off the lattice below: -0.05 -> -0.1; every origin is a whole number of voxels.
+  frep::GridSpec h = makeGrid(parseBounds("-b", "-0.05,-0.2,0.13,0.95,0.2,0.5"), 3, resolutionFrom(11, "", 128));
+  EXPECT_DOUBLE_EQ(h.voxel, 0.1);
+  EXPECT_EQ(h.dims, (std::array<int32_t, 3>{12, 5, 5}));
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(h.origin[a] / h.voxel, std::round(h.origin[a] / h.voxel), 1e-9) << a;
+  EXPECT_NEAR(h.origin[0], -0.1, 1e-15);
+  EXPECT_NEAR(h.origin[2], 0.1, 1e-15);
 }
