@@ -39,7 +39,7 @@ struct FarmRequest {
   int workers = -1;          // local workers; -1 one per core, 0 in-process
   std::string listen;        // cluster mode endpoint
   int expectWorkers = 0;
-  int brick = 0;             // brick edge in voxels; 0: chooseBrick (grid and workers)
+  int brick = -1;            // brick edge in voxels; -1 (not given): chooseBrick (grid and workers)
   int heartbeatMs = 500;
   bool resume = false;
   bool json = false;         // JSON progress events on stdout

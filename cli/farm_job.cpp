@@ -30,7 +30,7 @@ farm::JobSpec makeJob(const LoadedModel& m, const std::string& modelPath, const 
 
 farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, const std::string& logLevel, int threads) {
   if (f.workers < -1) throw badArgs("--workers: expected 0 (in-process) or more, got " + std::to_string(f.workers));
-  if (f.brick != 0 && (f.brick < 8 || f.brick % 8 != 0))
+  if (f.brick != -1 && (f.brick < 8 || f.brick % 8 != 0))
     throw badArgs("--brick: expected a positive multiple of 8 voxels, got " + std::to_string(f.brick));
   if (f.heartbeatMs < 10) throw badArgs("--heartbeat-ms: expected at least 10, got " + std::to_string(f.heartbeatMs));
   if (!f.listen.empty() && f.listen.rfind("tcp://", 0) != 0)

@@ -112,7 +112,7 @@ int runMesh(const MeshRequest& request) {
     throw badArgs("frep mesh needs a three-dimensional object; '" + m.model.objectName + "' has " +
                   std::to_string(m.dims) + " coordinate(s) (map them with -x)");
   GridSpec grid = makeGrid(box, 3, res);
-  if (request.farm.brick == 0)
+  if (request.farm.brick == -1)
     options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
   for (int a = 0; a < 3; ++a)
     if (grid.dims[a] < 2 || grid.dims[a] >= kMaxMeshGridPoints)

@@ -59,7 +59,7 @@ int runSample(const SampleRequest& request) {
   farm::FarmOptions options = farmOptions(request.farm, request.region.out, request.logLevel, request.threads);
   LoadedModel m = loadModel(request.model, true);
   GridSpec grid = makeGrid(box, 3, res);
-  if (request.farm.brick == 0)
+  if (request.farm.brick == -1)
     options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
 
   AtomicOutput out("-O/--out", request.region.out);
