@@ -1,7 +1,7 @@
 // Meshing throughput and accuracy: frepfarm's mesher (core meshGrid, marching tetrahedra on the
 // Kuhn grid, vertices by root finding on the model) against OpenVDB's tools::volumeToMesh on the
 // same model sampled by frep::sample (band 1) and converted to a FloatGrid by the same code as
-// `frep sample` (cli/vdb_grid.h), measured in this run; plus the farm master's peak memory for
+// `frep sample` (frep/io/vdb_grid.h), measured in this run; plus the farm master's peak memory for
 // `frep mesh` of the same model (the frep binary run as a child, its report's peak_rss_bytes).
 //
 // Model (libfive's benchmark shape, here defined concretely):
@@ -47,7 +47,7 @@
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/sampling/sample.h"
 #include "frep/expressions/tape.h"
-#include "vdb_grid.h"
+#include "frep/io/vdb_grid.h"
 
 using namespace frep;
 
@@ -454,7 +454,7 @@ void runSize(const TapePtr& tape, int n, int cores) {
     SampleResult s = sample(tape, grid, so);
     const double tSample = seconds(t0);
     auto t1 = Clock::now();
-    openvdb::FloatGrid::Ptr vdb = frep::cli::levelSetGrid(s);
+    openvdb::FloatGrid::Ptr vdb = frep::io::levelSetGrid(s);
     const double tConvert = seconds(t1);
     const double c2 = cpuSeconds();
     std::vector<LeafBlock>().swap(s.leaves);

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "frep/io/format_number.h"
+
 namespace frep::cli {
 
 struct Box {
@@ -37,7 +39,6 @@ struct AxisMapping {
 };
 AxisMapping parseMapping(const std::string& field, const std::string& text);
 
-// Shortest text that reads back as the same double (what the parsers above accept).
-std::string formatNumber(double v);
+using io::formatNumber;  // shortest text that reads back as the same double
 
 }  // namespace frep::cli

@@ -8,8 +8,9 @@
 
 namespace frep::cli {
 
-// frep check: diagnostics and the list of objects.
-int runCheck(const ModelRequest& model);
+// frep check: diagnostics and the list of objects; warnings when the model is NaN or a domain
+// error at every point of a small grid over `bounds` (-b text, "" = hfp's ±10).
+int runCheck(const ModelRequest& model, const std::string& bounds = "");
 
 struct EvalRequest {
   ModelRequest model;
@@ -26,11 +27,22 @@ struct RegionRequest {
   std::string out;     // -O/--out
 };
 
+// frep relate A B: intersection and inclusion certified over a box, point membership.
+struct RelateRequest {
+  ModelRequest a, b;
+  std::string bounds;      // -b text; "" = hfp's ±10
+  double minSize = 0;      // smallest box edge of the subdivision; 0 = 1e-4 of the box
+  std::string at;          // --at X,Y,Z: also classify this point
+  double tolerance = 1e-9; // |f| <= tolerance: on the surface
+};
+int runRelate(const RelateRequest& request);
+
 struct SliceRequest {
   ModelRequest model;
   RegionRequest region;
   std::string axis;  // "" = z (3D objects); ignored for 2D objects
   double at = 0.0;   // position of the slicing plane on that axis
+  bool mask = false; // inside/outside only (white/black): tiles an interval decides are not evaluated
 };
 int runSlice(const SliceRequest& request);
 
@@ -45,6 +57,7 @@ struct FarmRequest {
   bool json = false;         // JSON progress events on stdout
   bool noProgress = false;
   std::string curveDir;
+  bool insecure = false;     // --listen on the network without --curve
 };
 
 struct SampleRequest {
@@ -72,5 +85,15 @@ struct MeshRequest {
 int runMesh(const MeshRequest& request);
 
 int runKeygen(const std::string& dir);
+
+// frep pov: a scene with `$ ... <+> ... $` Minkowski terms, or a .hf model built from the basic
+// set, as POV-Ray text (Roerdink's preprocessor; docs/pov.md).
+struct PovRequest {
+  std::string input;   // scene text (any extension) or .hf model
+  std::string object;  // -o for a .hf model
+  std::string out;     // -O
+  double thin = 0.01;  // thickness of pieces without interior (segments, discs, rectangles)
+};
+int runPov(const PovRequest& request);
 
 }  // namespace frep::cli

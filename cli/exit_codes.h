@@ -1,37 +1,12 @@
-// The frep command's exit codes (documented in docs/cli.md and `frep --help`) and the error
-// type commands throw to end with one of them.
+// The frep command's exit codes and error type: the io library's (frep/io/error.h), which the
+// readers and writers throw. Commands see the io library's names unqualified.
 #pragma once
 
-#include <stdexcept>
-#include <string>
+#include "frep/io/error.h"
 
 namespace frep::cli {
 
-enum ExitCode : int {
-  kExitOk = 0,
-  kExitModelError = 1,  // the model has errors (diagnostics were printed)
-  kExitBadArgs = 2,     // a command-line argument is missing or malformed
-  kExitIoError = 3,     // a file could not be read or written
-  kExitInternal = 4,    // a bug or an unexpected failure inside frep
-  kExitPoisoned = 5,    // some bricks failed 3 times (named on stderr); no output, journal kept
-  kExitInterrupted = 6, // SIGTERM/SIGINT: journal flushed, continue with --resume
-  kExitFarmError = 7,   // the farm could not run (bind failed, no worker alive, CURVE keys, journal)
-};
-
-// What a user reads after "frep --help".
-inline const char* exitCodeHelp() {
-  return "Exit codes: 0 ok, 1 model error (diagnostics printed), 2 bad arguments, "
-         "3 I/O error, 4 internal error, 5 bricks poisoned (named), 6 interrupted (use --resume), "
-         "7 farm error.";
-}
-
-// Thrown anywhere in a command; main prints what() and exits with code.
-struct CliError : std::runtime_error {
-  int code;
-  CliError(int c, const std::string& message) : std::runtime_error(message), code(c) {}
-};
-
-inline CliError badArgs(const std::string& message) { return {kExitBadArgs, message}; }
-inline CliError ioError(const std::string& message) { return {kExitIoError, message}; }
+using namespace frep::io;
+using CliError = io::Error;
 
 }  // namespace frep::cli

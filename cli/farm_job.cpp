@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <fstream>
 #include <thread>
+#include <zmq.hpp>
 
 #include "arg_parse.h"
 #include "brick.h"
 #include "exit_codes.h"
+#include "journal.h"
 
 namespace frep::cli {
 
@@ -28,15 +30,70 @@ farm::JobSpec makeJob(const LoadedModel& m, const std::string& modelPath, const 
   return job;
 }
 
+namespace {
+
+void requireRange(const char* option, long value, long lo, long hi, const std::string& what = "") {
+  if (value < lo || value > hi)
+    throw badArgs(std::string(option) + ": expected an integer from " + std::to_string(lo) + " to " +
+                  std::to_string(hi) + what + ", got " + std::to_string(value));
+}
+
+// tcp://HOST:PORT with PORT 1..65535 (or * for any), HOST * or a name/address; then a trial bind
+// (released at once), so that a bad endpoint fails now and not after the model is planned.
+void checkListen(const std::string& ep) {
+  const std::string usage = "--listen: expected tcp://HOST:PORT (e.g. tcp://*:5555), got '" + ep + "'";
+  if (ep.rfind("tcp://", 0) != 0) throw badArgs(usage);
+  const size_t colon = ep.rfind(':');
+  const std::string host = ep.substr(6, colon == std::string::npos || colon < 6 ? 0 : colon - 6);
+  const std::string port = colon == std::string::npos || colon < 6 ? "" : ep.substr(colon + 1);
+  bool portOk = port == "*" || (!port.empty() && port.size() <= 5 && port.find_first_not_of("0123456789") == std::string::npos &&
+                                std::stol(port) >= 1 && std::stol(port) <= 65535);
+  if (host.empty() || host.find_first_of(" \t/") != std::string::npos || !portOk)
+    throw badArgs(usage + " (HOST is * or an address, PORT 1 to 65535)");
+  try {
+    zmq::context_t ctx(1);
+    zmq::socket_t probe(ctx, zmq::socket_type::router);
+    probe.set(zmq::sockopt::linger, 0);
+    probe.bind(ep);
+  } catch (const zmq::error_t& e) {
+    if (e.num() == EADDRINUSE || e.num() == EACCES)
+      throw CliError(kExitFarmError, "--listen: cannot bind '" + ep + "': " + e.what());
+    throw badArgs(usage + ": " + e.what());
+  }
+}
+
+}  // namespace
+
+void checkJobSize(const GridSpec& grid, int brick) {
+  uint64_t bricks = 1, voxels = 1;
+  for (int a = 0; a < 3; ++a) {
+    bricks *= uint64_t(grid.dims[a] + brick - 1) / uint64_t(brick);
+    voxels *= uint64_t(grid.dims[a]);
+  }
+  if (bricks <= kMaxBricks) return;
+  char dense[32];
+  std::snprintf(dense, sizeof dense, "%.3g", double(voxels));
+  throw badArgs("--res/-g/--brick: the grid of " + std::to_string(grid.dims[0]) + "x" + std::to_string(grid.dims[1]) +
+                "x" + std::to_string(grid.dims[2]) + " points (" + dense + " voxels) in bricks of " +
+                std::to_string(brick) + "^3 makes " + std::to_string(bricks) + " bricks (~" +
+                std::to_string(bricks * kPlannedBytesPerBrick >> 20) + " MiB to plan before any work); the farm plans at most " +
+                std::to_string(kMaxBricks) + ": use a larger --brick (up to " + std::to_string(kMaxBrick) +
+                ") or a smaller --res/-g");
+}
+
 farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, const std::string& logLevel, int threads) {
-  if (f.workers < -1) throw badArgs("--workers: expected 0 (in-process) or more, got " + std::to_string(f.workers));
-  if (f.brick != -1 && (f.brick < 8 || f.brick % 8 != 0))
-    throw badArgs("--brick: expected a positive multiple of 8 voxels, got " + std::to_string(f.brick));
-  if (f.heartbeatMs < 10) throw badArgs("--heartbeat-ms: expected at least 10, got " + std::to_string(f.heartbeatMs));
-  if (!f.listen.empty() && f.listen.rfind("tcp://", 0) != 0)
-    throw badArgs("--listen: expected tcp://HOST:PORT (e.g. tcp://*:5555), got '" + f.listen + "'");
-  if (f.expectWorkers < 0)
-    throw badArgs("--expect-workers: expected 0 or more, got " + std::to_string(f.expectWorkers));
+  requireRange("--workers", f.workers, -1, kMaxProcesses, " (0: in-process)");
+  if (f.brick != -1 && (f.brick < 8 || f.brick > kMaxBrick || f.brick % 8 != 0))  // -1: not given (chooseBrick)
+    throw badArgs("--brick: expected a multiple of 8 voxels from 8 to " + std::to_string(kMaxBrick) + ", got " +
+                  std::to_string(f.brick));
+  requireRange("--heartbeat-ms", f.heartbeatMs, 10, 600000);
+  requireRange("--expect-workers", f.expectWorkers, 0, kMaxProcesses);
+  requireRange("--threads", threads, 0, kMaxProcesses, " (0: all cores)");
+  if (!f.listen.empty()) checkListen(f.listen);
+  if (!f.listen.empty() && f.curveDir.empty() && !f.insecure && !farm::isLoopbackEndpoint(f.listen))
+    throw badArgs("--listen " + f.listen +
+                  ": without --curve anyone who can reach this address can join the farm and forge results; add "
+                  "--curve DIR (see frep keygen) or, on a trusted network, --insecure");
   farm::FarmOptions o;
   o.workers = f.workers;
   o.listen = f.listen;
@@ -44,6 +101,7 @@ farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, cons
   o.brickVoxels = f.brick;
   o.heartbeatMs = f.heartbeatMs;
   o.curveDir = f.curveDir;
+  o.insecure = f.insecure;
   o.resume = f.resume;
   o.progressJson = f.json;
   o.progressBar = !f.json && !f.noProgress && ::isatty(2);
@@ -75,12 +133,16 @@ farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& 
     return farm::runJob(job, options);
   } catch (const std::invalid_argument& e) {
     throw badArgs(e.what());
+  } catch (const farm::JournalIoError& e) {
+    throw ioError(e.what());  // a full disk under the journal is an I/O error, as for the output
+  } catch (const std::bad_alloc&) {
+    throw CliError(kExitInternal, "out of memory while running the job (a larger machine, or a smaller --res)");
   } catch (const std::runtime_error& e) {
     throw CliError(kExitFarmError, e.what());
   }
 }
 
-void writeReport(AtomicOutput& reportOut, const farm::FarmReport& report) {
+void writeReport(io::AtomicOutput& reportOut, const farm::FarmReport& report) {
   {
     farm::FarmReport final = report;
     final.peakRssBytes = farm::peakRssBytes();  // after the output was written
@@ -102,7 +164,7 @@ std::string poisonedMessage(const farm::FarmReport& report) {
 }
 }  // namespace
 
-void requireComplete(AtomicOutput& reportOut, const farm::FarmReport& report) {
+void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report) {
   if (!report.interrupted && report.poisoned.empty()) return;
   writeReport(reportOut, report);
   if (report.interrupted)

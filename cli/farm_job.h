@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "atomic_output.h"
+#include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "farm_master.h"
 #include "frep/sampling/sample.h"
@@ -17,6 +17,16 @@ namespace frep::cli {
 // options (band, mesh spec).
 farm::JobSpec makeJob(const LoadedModel& m, const std::string& modelPath, const GridSpec& grid,
                       const std::string& operation);
+
+// Limits of the integer options (docs/cli.md lists every one).
+constexpr int kMaxBrick = 1024;             // --brick: voxels per brick edge
+constexpr int kMaxProcesses = 4096;         // --workers, --expect-workers, --threads
+constexpr uint64_t kMaxBricks = uint64_t(1) << 21;  // bricks the master plans (128^3)
+constexpr uint64_t kPlannedBytesPerBrick = 256;     // the master's state per planned brick, about
+
+// Refuses (exit 2, with the brick count and an estimate of the planning memory) a grid that
+// makes more than kMaxBricks bricks of `brick`^3 voxels: checked before planning anything.
+void checkJobSize(const GridSpec& grid, int brick);
 
 // Validates the farm options (throws CliError(kExitBadArgs) naming the option). The journal is
 // OUT.journal; `threads` is the in-process run's thread count (--workers 0).
@@ -32,11 +42,11 @@ farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& 
 
 // Writes report.toJson(), with peak_rss_bytes refreshed (after the output was written), to the
 // report's temporary file and commits it.
-void writeReport(AtomicOutput& reportOut, const farm::FarmReport& report);
+void writeReport(io::AtomicOutput& reportOut, const farm::FarmReport& report);
 
 // An interrupted or poisoned job: writes the report and throws CliError with exit 6 (resume) or
 // 5 (the poisoned bricks named). Returns when the job is complete.
-void requireComplete(AtomicOutput& reportOut, const farm::FarmReport& report);
+void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report);
 
 // "bricks N (C computed, J from the journal), workers W, retries R, T s" for the summary.
 std::string bricksSummary(const farm::FarmReport& report);

@@ -46,6 +46,8 @@ void addFarmOptions(CLI::App* sub, FarmRequest& f) {
   sub->add_flag("--json", f.json, "JSON progress events on stdout (batch systems)");
   sub->add_flag("--no-progress", f.noProgress, "No progress bar");
   sub->add_option("--curve", f.curveDir, "Require CURVE keys from DIR (see frep keygen)");
+  sub->add_flag("--insecure", f.insecure,
+                "Allow --listen on a non-loopback address without --curve (anyone who reaches it can join)");
 }
 
 void checkObjectIsNotAFile(const ModelRequest& m) {
@@ -76,6 +78,8 @@ int main(int argc, char** argv) {
   ModelRequest checkModel;
   CLI::App* check = app.add_subcommand("check", "Compile a model: print diagnostics and list its objects");
   addModelOptions(check, checkModel, false);
+  std::string checkBounds;
+  check->add_option("-b,--bounds", checkBounds, "Box sampled for the empty-model warnings (default 10)");
 
   EvalRequest eval;
   CLI::App* evalCmd = app.add_subcommand("eval", "Value, in/on/out and gradient of f at one point");
@@ -89,6 +93,7 @@ int main(int argc, char** argv) {
   addRegionOptions(sliceCmd, slice.region, "Output PNG file", 512);
   sliceCmd->add_option("--axis", slice.axis, "Axis normal to the plane: x, y or z (default z; not for 2D objects)");
   sliceCmd->add_option("--at", slice.at, "Position of the plane on that axis (default 0)");
+  sliceCmd->add_flag("--mask", slice.mask, "Inside white, outside black: only pixels near the boundary are evaluated");
 
   SampleRequest sample;
   CLI::App* sampleCmd = app.add_subcommand("sample", "Narrow-band OpenVDB level set (signed distance; -f or fog by --store) of a model");
@@ -115,11 +120,28 @@ int main(int argc, char** argv) {
   meshCmd->add_flag("--no-sharp", mesh.noSharp,
                     "Keep merged vertices on the mesher's vertices instead of the model's edges and corners");
 
+  PovRequest pov;
+  CLI::App* povCmd = app.add_subcommand("pov", "POV-Ray scene of Minkowski terms: $ ... <+> ... $ in a scene, or a .hf "
+                                             "model built from the basic set (docs/pov.md)");
+  povCmd->add_option("input", pov.input, "Scene text with $ ... $ terms, or a .hf model")->required();
+  povCmd->add_option("-o,--object", pov.object, "Object of a .hf model (as hfp: default my_model, else the first)");
+  povCmd->add_option("-O,--out", pov.out, "Output POV-Ray file (required)");
+  povCmd->add_option("--thin", pov.thin, "Thickness of pieces without interior: segments, discs (default 0.01)");
+  RelateRequest relate;
+  CLI::App* relateCmd = app.add_subcommand("relate", "Certified relations of two models: intersection, inclusion, point membership");
+  relateCmd->add_option("a", relate.a.path, "Model A (.hf)")->required();
+  relateCmd->add_option("b", relate.b.path, "Model B (.hf)")->required();
+  relateCmd->add_option("--object-a", relate.a.object, "Object of A (default my_model, else the first)");
+  relateCmd->add_option("--object-b", relate.b.object, "Object of B");
+  relateCmd->add_option("-b,--bounds", relate.bounds, "Box searched (default 10)");
+  relateCmd->add_option("--min-size", relate.minSize, "Smallest box edge of the subdivision (default 1e-4 of the box)");
+  relateCmd->add_option("--at", relate.at, "Also classify the point X,Y,Z against both");
+
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
   keygenCmd->add_option("dir", keygenDir, "Directory for the keys")->required();
 
-  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd}) sub->fallthrough();
+  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, povCmd}) sub->fallthrough();
 
   try {
     app.parse(argc, argv);
@@ -127,7 +149,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh and keygen";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov, relate and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
@@ -136,7 +158,7 @@ int main(int argc, char** argv) {
   try {
     if (check->parsed()) {
       checkObjectIsNotAFile(checkModel);
-      return runCheck(checkModel);
+      return runCheck(checkModel, checkBounds);
     }
     if (evalCmd->parsed()) {
       checkObjectIsNotAFile(eval.model);
@@ -147,6 +169,8 @@ int main(int argc, char** argv) {
       return runSlice(slice);
     }
     if (keygenCmd->parsed()) return runKeygen(keygenDir);
+    if (povCmd->parsed()) return runPov(pov);
+    if (relateCmd->parsed()) return runRelate(relate);
     if (meshCmd->parsed()) {
       checkObjectIsNotAFile(mesh.model);
       mesh.logLevel = logLevel;

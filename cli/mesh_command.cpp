@@ -11,16 +11,16 @@
 #include <iostream>
 
 #include "arg_parse.h"
-#include "atomic_output.h"
+#include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "exit_codes.h"
 #include "farm_job.h"
 #include "frep/meshing/mesh.h"
 #include "frep/meshing/mesh_simplify.h"
-#include "mesh_writer.h"
+#include "frep/io/mesh_writer.h"
 #include "frep/meshing/mesh_grid.h"
 #include "sampling_grid.h"
-#include "vdb_reader.h"
+#include "frep/io/vdb_reader.h"
 
 namespace frep::cli {
 
@@ -38,7 +38,7 @@ bool hasVdbExtension(const std::string& path) {
 // by the core's meshSamples, the same marching tetrahedra as the model mesher (docs/mesh.md).
 int runMeshVdb(const MeshRequest& request) {
   if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj or .stl) is required");
-  MeshFormat format = meshFormatFromPath("-O/--out", request.region.out);
+  io::MeshFormat format = io::meshFormatFromPath("-O/--out", request.region.out);
   if (request.threads < 0) throw badArgs("--threads: expected 0 (all cores) or more, got " + std::to_string(request.threads));
   // The grid's extent and transform are the file's; the model options have nothing to act on.
   const std::string input = "'" + request.model.path + "' is a .vdb: its grid and transform are used as stored";
@@ -53,9 +53,9 @@ int runMeshVdb(const MeshRequest& request) {
       !request.farm.curveDir.empty())
     throw badArgs("--listen/--expect-workers/--resume/--curve: a .vdb is meshed in-process (use --threads)");
 
-  AtomicOutput out("-O/--out", request.region.out);
+  io::AtomicOutput out("-O/--out", request.region.out);
   const auto start = std::chrono::steady_clock::now();
-  SampledVdb vdb = readSampledVdb(request.model.path, request.model.object);
+  io::SampledVdb vdb = io::readSampledVdb(request.model.path, request.model.object);
   const double readSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   spdlog::info("meshing grid '{}' of {}: {} leaves, {}", vdb.gridName, request.model.path, vdb.samples.leaves.size(),
                vdb.transformDescription);
@@ -74,13 +74,13 @@ int runMeshVdb(const MeshRequest& request) {
   if (mesh.triangles.empty()) spdlog::warn("grid '{}' has no sign change between active voxels: the mesh is empty", vdb.gridName);
   std::string comment = "frep mesh of grid '" + vdb.gridName + "' in " + request.model.path +
                         " (sampled values); normals point outward (decreasing f)";
-  writeMesh(out.tempPath(), mesh, format, comment);
+  io::writeMesh(out.tempPath(), mesh, format, comment);
   out.commit();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   const MeshStats& s = mesh.stats;
   std::ostream& text = request.farm.json ? std::cerr : std::cout;
-  text << "wrote " << request.region.out << " (" << meshFormatName(format) << "): " << mesh.positions.size()
+  text << "wrote " << request.region.out << " (" << io::meshFormatName(format) << "): " << mesh.positions.size()
        << " vertices, " << mesh.triangles.size() << " triangles\n"
        << "  from grid '" << vdb.gridName << "' of " << request.model.path << ": " << leaves << " leaves, "
        << vdb.transformDescription << "\n"
@@ -99,7 +99,7 @@ int runMeshVdb(const MeshRequest& request) {
 int runMesh(const MeshRequest& request) {
   if (hasVdbExtension(request.model.path)) return runMeshVdb(request);
   if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj or .stl) is required");
-  MeshFormat format = meshFormatFromPath("-O/--out", request.region.out);
+  io::MeshFormat format = io::meshFormatFromPath("-O/--out", request.region.out);
   if (request.threads < 0) throw badArgs("--threads: expected 0 (all cores) or more, got " + std::to_string(request.threads));
   if (request.tolerance < 0 && request.tolerance != -1)
     throw badArgs("--tolerance: expected 0 (no simplification) or more voxels, got " + formatNumber(request.tolerance));
@@ -108,18 +108,21 @@ int runMesh(const MeshRequest& request) {
   Box box = request.region.bounds.empty() ? Box{} : parseBounds("-b/--bounds", request.region.bounds);
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);
   LoadedModel m = loadModel(request.model, true);
-  if (m.dims != 3)
-    throw badArgs("frep mesh needs a three-dimensional object; '" + m.model.objectName + "' has " +
-                  std::to_string(m.dims) + " coordinate(s) (map them with -x)");
+  // A 1D or 2D object is meshed as frep sample samples it: the slab or prism it is in 3D
+  // (constant along the missing axes), cut by the box.
+  if (m.dims > 3)
+    throw badArgs("frep mesh needs at most three coordinates; '" + m.model.objectName + "' has " +
+                  std::to_string(m.dims) + " (map them with -x, e.g. -x X,Y,Z,0.5)");
   GridSpec grid = makeGrid(box, 3, res);
   if (request.farm.brick == -1)
     options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
   for (int a = 0; a < 3; ++a)
     if (grid.dims[a] < 2 || grid.dims[a] >= kMaxMeshGridPoints)
       throw badArgs("--res/-g: the grid needs 2 to " + std::to_string(kMaxMeshGridPoints - 1) + " points per axis");
+  checkJobSize(grid, options.brickVoxels);
 
-  AtomicOutput out("-O/--out", request.region.out);
-  AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
+  io::AtomicOutput out("-O/--out", request.region.out);
+  io::AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
   // Adaptive simplification: each worker does the blocks inside its brick, the master the rest
   // (deterministic, so the file still does not depend on the split; docs/mesh.md).
   // Not by default for models with extremum nodes: every check would run searches.
@@ -157,7 +160,7 @@ int runMesh(const MeshRequest& request) {
   std::string comment = "frep mesh of '" + m.model.objectName + "', grid " + std::to_string(grid.dims[0]) + "x" +
                         std::to_string(grid.dims[1]) + "x" + std::to_string(grid.dims[2]) + " voxel " +
                         formatNumber(grid.voxel) + "; normals point outward (decreasing f)";
-  writeMesh(out.tempPath(), mesh, format, comment);
+  io::writeMesh(out.tempPath(), mesh, format, comment);
   out.commit();
   writeReport(reportOut, report);
   std::remove(options.journalPath.c_str());  // the output is complete: nothing to resume
@@ -166,7 +169,7 @@ int runMesh(const MeshRequest& request) {
   const MeshStats& s = mesh.stats;
   const double dense = double(grid.dims[0] - 1) * double(grid.dims[1] - 1) * double(grid.dims[2] - 1);
   std::ostream& text = request.farm.json ? std::cerr : std::cout;
-  text << "wrote " << request.region.out << " (" << meshFormatName(format) << "): " << mesh.positions.size()
+  text << "wrote " << request.region.out << " (" << io::meshFormatName(format) << "): " << mesh.positions.size()
        << " vertices, " << mesh.triangles.size() << " triangles\n"
        << "  grid " << grid.dims[0] << "x" << grid.dims[1] << "x" << grid.dims[2] << " points of "
        << formatNumber(grid.voxel) << ", cells examined " << s.cellsVisited << " ("
@@ -179,6 +182,12 @@ int runMesh(const MeshRequest& request) {
                             : std::string())
        << "  evaluations: grid points " << s.samplePointEvals << ", root finding " << s.rootEvals << ", gradients "
        << s.gradientEvals << "\n"
+       << "  NaN values " << report.nanValues << (report.nanValues ? " (domain errors, taken as outside)" : "")
+       << ", domain errors " << report.domainErrors.total()
+       << (report.domainErrors.total()
+               ? " (" + report.domainErrors.describe() + "; documented values used, see docs/language.md)"
+               : "")
+       << "\n"
        << "  time " << formatNumber(std::round(meshSeconds * 1000) / 1000) << " s meshing, "
        << formatNumber(std::round(seconds * 1000) / 1000) << " s in all\n"
        << "  " << bricksSummary(report) << "\n"

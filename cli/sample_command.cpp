@@ -8,14 +8,14 @@
 #include <iostream>
 
 #include "arg_parse.h"
-#include "atomic_output.h"
+#include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "curve.h"
 #include "exit_codes.h"
 #include "farm_job.h"
 #include "farm_master.h"
 #include "sampling_grid.h"
-#include "vdb_writer.h"
+#include "frep/io/vdb_writer.h"
 
 namespace frep::cli {
 namespace {
@@ -57,13 +57,14 @@ int runSample(const SampleRequest& request) {
   Box box = request.region.bounds.empty() ? Box{} : parseBounds("-b/--bounds", request.region.bounds);
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);
   farm::FarmOptions options = farmOptions(request.farm, request.region.out, request.logLevel, request.threads);
-  LoadedModel m = loadModel(request.model, true);
-  GridSpec grid = makeGrid(box, 3, res);
+  GridSpec grid = makeWorldLatticeGrid(box, res);
   if (request.farm.brick == -1)
     options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
+  checkJobSize(grid, options.brickVoxels);  // before the model is even read: refused at once
+  LoadedModel m = loadModel(request.model, true);
 
-  AtomicOutput out("-O/--out", request.region.out);
-  AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
+  io::AtomicOutput out("-O/--out", request.region.out);
+  io::AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
   farm::JobSpec job = makeJob(m, request.model.path, grid, "sample");
   job.set_band(request.band);
   spdlog::info("sampling '{}' on {}x{}x{} voxels of {}", m.model.objectName, grid.dims[0], grid.dims[1],
@@ -72,15 +73,15 @@ int runSample(const SampleRequest& request) {
   const farm::FarmReport& report = outcome.report;
   requireComplete(reportOut, report);
 
-  VdbMetadata meta;
+  io::VdbMetadata meta;
   meta.gridName = m.model.objectName;
   meta.job = jobDescription(m, grid, request.band, request.store);
   meta.source = baseName(request.model.path);
-  meta.store = request.store == "raw" ? VdbStore::Raw : request.store == "fog" ? VdbStore::Fog : VdbStore::Sdf;
+  meta.store = request.store == "raw" ? io::VdbStore::Raw : request.store == "fog" ? io::VdbStore::Fog : io::VdbStore::Sdf;
   meta.params = request.model.params;
   meta.sourceHash = m.model.sourceHash;
   meta.iso = request.model.iso;
-  writeLevelSet(out.tempPath(), outcome.result, meta);
+  io::writeLevelSet(out.tempPath(), outcome.result, meta);
   out.commit();
   writeReport(reportOut, report);
   std::remove(options.journalPath.c_str());  // the output is complete: nothing to resume

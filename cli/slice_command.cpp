@@ -2,16 +2,18 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <iostream>
 
 #include "arg_parse.h"
-#include "atomic_output.h"
+#include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "exit_codes.h"
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/tape.h"
-#include "heatmap.h"
+#include "frep/sampling/plane.h"
+#include "frep/io/heatmap.h"
 #include "sampling_grid.h"
 
 namespace frep::cli {
@@ -57,33 +59,28 @@ int runSlice(const SliceRequest& request) {
     throw badArgs("--res/-g: the image would be " + std::to_string(width) + "x" + std::to_string(height) +
                   " pixels; the limit is " + std::to_string(kMaxSide) + " per side");
 
-  AtomicOutput out("-O/--out", request.region.out);
+  io::AtomicOutput out("-O/--out", request.region.out);
   const uint32_t vars = uint32_t(std::max(m.dims, plane.normal < 0 ? 2 : 3));
   TapePtr tape = Tape::compile(m.field, vars);
-  BatchEvaluator<double> eval;
-  eval.reserve(*tape);
-  std::vector<double> values(size_t(width) * size_t(height));
-  constexpr int kBatch = int(BatchEvaluator<double>::kBatch);
-  for (int row = 0; row < height; ++row) {
-    const double v = grid.origin[1] + double(height - 1 - row) * grid.voxel;  // top row = max
-    for (int c0 = 0; c0 < width; c0 += kBatch) {
-      const int n = std::min(kBatch, width - c0);
-      for (int k = 0; k < n; ++k) {
-        eval.in(uint32_t(plane.u))[k] = grid.origin[0] + double(c0 + k) * grid.voxel;
-        eval.in(uint32_t(plane.v))[k] = v;
-        if (plane.normal >= 0) eval.in(uint32_t(plane.normal))[k] = request.at;
-      }
-      const double* f = eval.eval(*tape, size_t(n));
-      std::copy(f, f + n, values.begin() + long(size_t(row) * size_t(width) + size_t(c0)));
-    }
-  }
+  PlaneLattice lattice;
+  lattice.u = uint32_t(plane.u), lattice.v = uint32_t(plane.v);
+  lattice.normal = plane.normal, lattice.at = request.at;
+  lattice.origin[0] = grid.origin[0], lattice.origin[1] = grid.origin[1];
+  lattice.step = grid.voxel, lattice.width = width, lattice.height = height;
+  PlaneOptions options;
+  options.signOnly = request.mask;
+  PlaneStats stats;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<double> values = evaluatePlane(tape, lattice, options, &stats);
+  const double evalMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
-  writePng(out.tempPath(), renderHeatmap(values, width, height));
+  io::writePng(out.tempPath(), request.mask ? io::renderMask(values, width, height) : io::renderHeatmap(values, width, height));
   out.commit();
   double lo = INFINITY, hi = -INFINITY;
   size_t nans = 0;
   for (double f : values) {
     if (std::isnan(f)) { ++nans; continue; }
+    if (std::isinf(f)) continue;  // --mask: a tile decided the sign, the pixel was not evaluated
     lo = std::min(lo, f), hi = std::max(hi, f);
   }
   std::cout << "wrote " << request.region.out << ": " << width << "x" << height << " pixels";
@@ -91,6 +88,10 @@ int runSlice(const SliceRequest& request) {
   std::cout << ", pixel " << formatNumber(grid.voxel) << ", f in [" << formatNumber(lo) << ", "
             << formatNumber(hi) << "]";
   if (nans) std::cout << ", " << nans << " NaN pixels (grey)";
+  std::cout << "; evaluated " << stats.pointEvals << " of " << values.size() << " pixels ("
+            << formatNumber(stats.tapeBatches ? double(stats.tapeInstrs) / double(stats.tapeBatches) : 0.0)
+            << " of " << tape->size() << " instructions on average) in " << formatNumber(std::round(evalMs * 10) / 10)
+            << " ms";
   std::cout << "\n";
   return kExitOk;
 }

@@ -9,6 +9,8 @@ packages=(
   libprotobuf-dev protobuf-compiler
   libspdlog-dev libtbb-dev libcli11-dev nlohmann-json3-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
+  povray  # frep pov scenes are rendered in tests (docs/pov.md)
+  clang libclang-rt-14-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -4,3 +4,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ./deploy/build.sh
 cd build && ctest --output-on-failure -j"$(nproc)"
+cd .. && ./tests/fuzz/run_fuzz.sh build-fuzz  # bounded ASan+UBSan fuzz run (tests/fuzz), about 40 s

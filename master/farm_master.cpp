@@ -51,6 +51,16 @@ struct SignalScope {
 
 constexpr size_t kMaxEnvelopeBytes = 1 << 20;  // a task or result header is a few KB at most
 constexpr int kCredit = 2;                     // bricks in flight per worker (hides latency)
+// Hostile peers (docs/farm.md, "Threat model"): an un-welcomed routing id may send only a
+// hello, checked before parsing; garbage bans its routing id. The ban list and the welcomed
+// workers are bounded so strangers cannot grow the master's state without limit.
+constexpr size_t kMaxHelloBytes = 64 << 10;
+constexpr size_t kMaxBanned = 1024;     // banned routing ids remembered (oldest forgotten)
+constexpr size_t kMaxPeers = 4096;      // welcomed workers at once; a hello beyond is refused
+constexpr size_t kMaxAliases = 4096;    // routing ids of workers that reconnected
+constexpr int kRouterRcvHwm = 64;       // queued messages per connection (ZMQ_RCVHWM)
+
+enum class Departure { Left, Dead, Dropped };
 
 enum class BrickPhase { Pending, Leased, Done, Poisoned };
 
@@ -58,7 +68,14 @@ struct Brick {
   uint64_t id = 0;
   std::array<int32_t, 3> lo{}, hi{};
   BrickPhase phase = BrickPhase::Pending;
-  int failures = 0;  // failed attempts and worker deaths while holding it
+  int failures = 0;  // failed attempts reported by its holder (and corrupt results from it)
+  // Worker deaths (docs/farm.md, "Faults"): the first death of a worker computing it makes it
+  // suspect; a suspect is leased only alone to a worker that has shown it is alive, and each
+  // such worker that dies with it counts; killers.size() >= maxAttempts poisons it.
+  bool suspect = false;
+  Clock::time_point suspectSince{};
+  std::set<std::string> killers;      // fresh workers (nothing finished) that died with it alone
+  std::set<std::string> weakKillers;  // workers that had finished other bricks
   uint32_t attempts = 0;
   std::map<std::string, Clock::time_point> holders;  // routing id -> lease start
   Clock::time_point firstLease{};
@@ -72,6 +89,10 @@ struct Peer {
   uint32_t threads = 1;
   Clock::time_point expiry;
   std::set<uint64_t> inflight;
+  std::set<uint64_t> everHeld;  // a later copy from a former holder is a duplicate, not foreign
+  bool proven = false;          // sent something after its hello (it lives past a task)
+  bool unreachable = false;     // no route to it: no more tasks (sendTask)
+  uint64_t finished = 0;        // bricks it computed that were merged
 };
 
 class Master {
@@ -80,6 +101,10 @@ class Master {
       : job_(job), opt_(opt), jobId_(jobIdOf(job)), grid_(gridOf(job)), op_(operationOf(job)) {
     if (opt.brickVoxels < 8 || opt.brickVoxels % 8 != 0)
       throw std::invalid_argument("--brick must be a positive multiple of 8 voxels");
+    if (!opt.listen.empty() && opt.curveDir.empty() && !opt.insecure && !isLoopbackEndpoint(opt.listen))
+      throw std::invalid_argument("--listen " + opt.listen +
+                                  ": without --curve anyone who can reach this address can join the farm and forge "
+                                  "results; add --curve DIR (see frep keygen) or, on a trusted network, --insecure");
     plan();
   }
 
@@ -145,6 +170,8 @@ class Master {
   void commit(uint64_t id, BrickOutput&& out, const std::string& who, bool computed) {
     Brick& b = bricks_[id];
     b.phase = BrickPhase::Done;
+    for (auto& [rid, t] : b.holders)  // cancelled copies no longer take a worker's credit
+      if (auto p = peers_.find(rid); p != peers_.end()) p->second.inflight.erase(id);
     b.holders.clear();
     leased_.erase(id);
     ++done_;
@@ -160,6 +187,8 @@ class Master {
       report_.domainErrors.add(out.stats.domainErrors);
       report_.extremumSearches += out.extremumSearches;
       report_.extremumUncertified += out.extremumUncertified;
+      for (auto& [rid, p] : peers_)
+        if (p.workerId == who) ++p.finished;
       auto& share = report_.perWorker[who];
       ++share.bricks;
       share.pointEvals += out.stats.pointEvals;
@@ -170,6 +199,7 @@ class Master {
   void runInProcess() {
     TapePtr tape = compileJobModel(job_);
     describeErrorBounds(*tape, &report_.errorBounds);
+    for (const std::string& line : describeExactTerms(job_)) report_.errorBounds.push_back(line);
     for (Brick& b : bricks_) {
       if (b.phase == BrickPhase::Done) continue;
       if (gStop) {
@@ -190,6 +220,7 @@ class Master {
   void runFarm() {
     // Compile once here too: a model that does not compile fails before any worker starts.
     describeErrorBounds(*compileJobModel(job_), &report_.errorBounds);
+    for (const std::string& line : describeExactTerms(job_)) report_.errorBounds.push_back(line);
     zmq::context_t ctx(1);
     std::unique_ptr<ZapAuthenticator> zap;
     CurveKeys keys;
@@ -200,7 +231,12 @@ class Master {
     zmq::socket_t router(ctx, zmq::socket_type::router);
     router.set(zmq::sockopt::linger, 0);
     router.set(zmq::sockopt::router_mandatory, 1);
-    router.set(zmq::sockopt::maxmsgsize, int64_t(256) << 20);
+    // ZMQ_MAXMSGSIZE is socket-wide (every peer, welcomed or not) and per frame: the largest
+    // frame this job can need. A bigger frame makes ZeroMQ close that connection before it
+    // allocates the frame. ZMQ_RCVHWM bounds the frames queued per connection; the per-peer
+    // hello limit is ours (frameLimit), checked before parsing.
+    router.set(zmq::sockopt::maxmsgsize, int64_t(std::min<size_t>(std::max(kMaxEnvelopeBytes, payloadLimit_), 256u << 20)));
+    router.set(zmq::sockopt::rcvhwm, kRouterRcvHwm);
     if (zap) applyCurveServer(router, keys);
     std::string endpoint = opt_.listen.empty() ? "tcp://127.0.0.1:*" : opt_.listen;
     router.bind(endpoint);
@@ -221,11 +257,22 @@ class Master {
       local = std::make_unique<LocalWorkers>(opt_.workerExecutable, args);
       local->spawn(wanted);
     }
-    int respawnBudget = 3 * std::max(wanted, 1) + 3 * opt_.maxAttempts;
+    // Local workers that die are replaced with back-off: the delay doubles (100 ms .. 2 s)
+    // while no brick finishes and resets when one does; once more workers than
+    // futileLimit have been started since the last brick finished, none can: fail fast.
+    const int futileLimit = wanted + 2 * (opt_.maxAttempts + 1);
+    int futileSpawns = wanted, respawnDelayMs = 0;
+    size_t progressAtSpawn = done_ + poisoned_;
+    auto nextSpawn = Clock::now();
 
     auto lastBeat = Clock::now();
     auto lastAlive = Clock::now();
+    auto lastTurn = Clock::now();
     const auto hb = std::chrono::milliseconds(opt_.heartbeatMs);
+    const auto window = std::chrono::milliseconds(opt_.heartbeatMs * opt_.liveness);
+    const FrameLimit frameLimit = [this](const std::string& rid) {
+      return peers_.count(rid) || aliases_.count(rid) ? kMaxEnvelopeBytes + payloadLimit_ : kMaxHelloBytes;
+    };
     while (done_ + poisoned_ < bricks_.size()) {
       zmq::pollitem_t item{static_cast<void*>(router), 0, ZMQ_POLLIN, 0};
       try {
@@ -242,18 +289,42 @@ class Master {
       for (int n = 0; n < 256; ++n) {
         Incoming in;
         std::string err;
-        if (!receive(router, true, in, &err)) break;
+        if (!receive(router, true, in, &err, frameLimit)) break;
         handle(router, in, err);
       }
       auto now = Clock::now();
+      // The master's own stall (SIGSTOP, swapping, a slow disk): a turn is at most a poll
+      // (a quarter beat) and a bounded drain, so a gap longer than the liveness window means
+      // the master was deaf, not its peers silent. Refresh every peer instead of counting them
+      // dead, and move the lease timers on (steady clock: wall-clock jumps do not count).
+      if (now - lastTurn > window) {
+        ++report_.masterStalls;
+        auto gap = now - lastTurn;
+        spdlog::warn("the master stalled for {:.1f} s (longer than the liveness window): its workers are not counted dead",
+                     std::chrono::duration<double>(gap).count());
+        for (auto& [rid, p] : peers_) p.expiry = std::max(p.expiry, now + window);
+        for (uint64_t id : leased_) bricks_[id].firstLease += gap;
+        lastAlive = now;
+      }
+      lastTurn = now;
       expireDeadPeers(now);
       if (local) {
-        int exited = local->reap();
+        local->reap();
+        if (done_ + poisoned_ > progressAtSpawn) {
+          progressAtSpawn = done_ + poisoned_;
+          futileSpawns = 0;
+          respawnDelayMs = 0;
+        }
         int missing = wanted - local->running();
-        if (exited && missing > 0 && respawnBudget > 0 && done_ + poisoned_ < bricks_.size()) {
-          int n = std::min(missing, respawnBudget);
-          respawnBudget -= n;
-          local->spawn(n);
+        if (missing > 0 && now >= nextSpawn && done_ + poisoned_ < bricks_.size()) {
+          if (futileSpawns + missing > futileLimit)
+            throw std::runtime_error("local workers keep dying: " + std::to_string(futileSpawns) +
+                                     " started since the last brick finished (last one " + local->lastExit() +
+                                     "); run with --log-level info, or --workers 0 to compute in-process");
+          futileSpawns += missing;
+          local->spawn(missing);
+          respawnDelayMs = std::min(2000, respawnDelayMs ? 2 * respawnDelayMs : 100);
+          nextSpawn = now + std::chrono::milliseconds(respawnDelayMs);
         }
       }
       reissueOverdue(now);
@@ -287,15 +358,23 @@ class Master {
   }
 
   void handle(zmq::socket_t& router, Incoming& in, const std::string& err) {
+    if (banned_.count(in.routingId)) return;  // dropped for garbage before: ignored
+    // A worker that reconnected speaks under its new routing id; late frames on the old one
+    // are its frames too.
+    if (!peers_.count(in.routingId))
+      if (auto a = aliases_.find(in.routingId); a != aliases_.end() && peers_.count(a->second))
+        in.routingId = a->second;
     if (!err.empty()) {
-      ++report_.malformed;
+      ++(in.oversized ? report_.oversized : report_.malformed);
       spdlog::warn("dropped a malformed message from {}: {}", printable(in.routingId), err);
+      ban(router, in.routingId, err);
       return;
     }
     const Envelope& e = in.envelope;
     if (e.ByteSizeLong() > kMaxEnvelopeBytes || (in.payload && in.payload->size() > payloadLimit())) {
       ++report_.oversized;
       spdlog::warn("dropped an oversized message from {}", printable(in.routingId));
+      ban(router, in.routingId, "oversized message");
       return;
     }
     if (e.proto_major() != kProtoMajor) {
@@ -311,8 +390,17 @@ class Master {
     auto now = Clock::now();
     auto it = peers_.find(in.routingId);
     if (e.body_case() == Envelope::kHello) {
+      const std::string wid = e.hello().worker_id().empty() ? printable(in.routingId) : e.hello().worker_id();
+      if (it == peers_.end() && !adoptReconnected(wid, in.routingId) && peers_.size() >= kMaxPeers) {
+        ++report_.refused;
+        Envelope r;
+        r.mutable_reject()->set_reason("the farm is full (" + std::to_string(kMaxPeers) + " workers)");
+        send(router, in.routingId, r);
+        return;
+      }
       Peer& p = peers_[in.routingId];
-      p.workerId = e.hello().worker_id().empty() ? printable(in.routingId) : e.hello().worker_id();
+      p.workerId = wid;
+      p.unreachable = false;  // a new connection
       p.threads = std::max(1u, e.hello().threads());
       p.expiry = now + std::chrono::milliseconds(opt_.heartbeatMs * opt_.liveness);
       ++report_.workersSeen;
@@ -334,18 +422,19 @@ class Master {
     }
     Peer& p = it->second;
     p.expiry = now + std::chrono::milliseconds(opt_.heartbeatMs * opt_.liveness);
+    p.proven = true;
     switch (e.body_case()) {
       case Envelope::kHeartbeat:
         break;
       case Envelope::kResult:
-        onResult(in, p);
+        onResult(router, in, p);
         break;
       case Envelope::kFailed:
         onFailed(e, in.routingId, p);
         break;
       case Envelope::kBye:
         spdlog::info("worker {} left: {}", p.workerId, e.bye().reason());
-        dropPeer(in.routingId, false);
+        dropPeer(in.routingId, Departure::Left);
         break;
       default:
         ++report_.malformed;
@@ -353,7 +442,58 @@ class Master {
     }
   }
 
+  // A hello with the worker id of a peer under another routing id: the worker reconnected
+  // (its master went silent, e.g. stopped). It keeps its leases and what it computes.
+  bool adoptReconnected(const std::string& workerId, const std::string& rid) {
+    auto old = std::find_if(peers_.begin(), peers_.end(), [&](auto& kv) { return kv.second.workerId == workerId; });
+    if (old == peers_.end()) return false;
+    std::string oldRid = old->first;
+    Peer moved = std::move(old->second);
+    peers_.erase(old);
+    for (uint64_t id : moved.inflight) {
+      auto& h = bricks_[id].holders;
+      if (auto node = h.extract(oldRid)) {
+        node.key() = rid;
+        h.insert(std::move(node));
+      }
+    }
+    peers_[rid] = std::move(moved);
+    // What it sent on the old connection while the master was deaf may be lost (it closed
+    // that connection): its leases are issued once more elsewhere, whichever copy comes first.
+    for (uint64_t id : peers_[rid].inflight)
+      if (Brick& b = bricks_[id]; b.phase == BrickPhase::Leased && !b.leaseReissued) {
+        b.leaseReissued = true;
+        reissue_.push_back(id);
+      }
+    if (aliases_.size() >= kMaxAliases) aliases_.clear();
+    aliases_[oldRid] = rid;
+    ++report_.reconnects;
+    spdlog::info("worker {} reconnected: it keeps its {} lease(s)", workerId, peers_[rid].inflight.size());
+    return true;
+  }
+
+  // A peer that sent garbage: a welcomed one is told bye and its bricks go back to the queue,
+  // not charged; its routing id is ignored from now on (bounded list, oldest forgotten).
+  void ban(zmq::socket_t& router, const std::string& rid, const std::string& why) {
+    if (peers_.count(rid)) {
+      Envelope bye;
+      bye.set_job_id(jobId_);
+      bye.mutable_bye()->set_reason("dropped by the master: " + why);
+      send(router, rid, bye);
+      spdlog::warn("worker {} dropped: {}", peers_[rid].workerId, why);
+      dropPeer(rid, Departure::Dropped);
+    }
+    if (!banned_.insert(rid).second) return;
+    ++report_.bannedPeers;
+    bannedOrder_.push_back(rid);
+    if (bannedOrder_.size() > kMaxBanned) {
+      banned_.erase(bannedOrder_.front());
+      bannedOrder_.pop_front();
+    }
+  }
+
   size_t payloadLimit() const { return payloadLimit_; }
+  Clock::duration liveWindow() const { return std::chrono::milliseconds(opt_.heartbeatMs * opt_.liveness); }
 
   static std::string printable(const std::string& rid) {
     std::string s;
@@ -361,7 +501,20 @@ class Master {
     return s.empty() ? "?" : s;
   }
 
-  void onResult(Incoming& in, Peer& p) {
+  // Only the brick's leaseholder may answer for it: anything else is foreign and dropped.
+  // Returns whether `rid` holds the brick; counts a foreign message otherwise.
+  bool holds(const Brick& b, const std::string& rid, const Peer& p, const char* what) {
+    if (b.holders.count(rid)) return true;
+    if (p.everHeld.count(b.id)) {
+      ++report_.duplicates;  // a former holder's late copy (cancelled, re-leased or done)
+      return false;
+    }
+    ++report_.foreignResults;
+    spdlog::warn("dropped a {} for brick {} from {}, which does not hold it", what, b.id, p.workerId);
+    return false;
+  }
+
+  void onResult(zmq::socket_t& router, Incoming& in, Peer& p) {
     const Envelope& e = in.envelope;
     const Result& r = e.result();
     uint64_t id = r.brick_id();
@@ -370,8 +523,9 @@ class Master {
       spdlog::warn("dropped a result for an unknown job or brick from {}", p.workerId);
       return;
     }
-    p.inflight.erase(id);
     Brick& b = bricks_[id];
+    if (!holds(b, in.routingId, p, "result")) return;
+    p.inflight.erase(id);
     b.holders.erase(in.routingId);
     if (b.phase == BrickPhase::Done || b.phase == BrickPhase::Poisoned) {
       ++report_.duplicates;
@@ -383,9 +537,14 @@ class Master {
     bool ok = crc32Of(payload.data(), payload.size()) == r.payload_crc32() &&
               decodePayload(op_, payload.data(), payload.size(), out, &err) && insideBrick(out, b);
     if (!ok) {
+      // The holder's own brick came back corrupt: it counts as a failure of the brick (a brick
+      // that breaks every worker's encoder is poisoned like one that fails), and the peer,
+      // which sent garbage, is dropped.
       ++report_.malformed;
-      spdlog::warn("dropped a corrupt result for brick {} from {}: {}", id, p.workerId, err.empty() ? "crc or bounds" : err);
-      if (b.holders.empty()) requeue(b, "corrupt result", true);
+      std::string why = "corrupt result from " + p.workerId + ": " + (err.empty() ? "crc or bounds" : err);
+      spdlog::warn("dropped a {}", why);
+      if (b.holders.empty()) requeue(b, why, true);
+      ban(router, in.routingId, "corrupt result for brick " + std::to_string(id));
       return;
     }
     out.stats.pointEvals = r.point_evals();
@@ -402,7 +561,7 @@ class Master {
     for (auto& [rid, t] : b.holders) {
       Envelope c;
       c.mutable_cancel()->set_brick_id(id);
-      send(*routerForCancel_, rid, c);
+      send(router, rid, c);
     }
     commit(id, std::move(out), p.workerId, true);
   }
@@ -434,8 +593,9 @@ class Master {
       ++report_.malformed;
       return;
     }
-    p.inflight.erase(id);
     Brick& b = bricks_[id];
+    if (!holds(b, rid, p, "failure")) return;
+    p.inflight.erase(id);
     b.holders.erase(rid);
     if (b.phase != BrickPhase::Leased || !b.holders.empty()) return;
     if (e.failed().handed_back()) {
@@ -447,32 +607,72 @@ class Master {
     }
   }
 
+  void poison(Brick& b, const std::string& why, const std::string& count) {
+    b.phase = BrickPhase::Poisoned;
+    ++poisoned_;
+    report_.poisoned.push_back(PoisonedBrick{b.id, b.lo, b.hi, why});
+    spdlog::error("brick {} [{},{},{})-({},{},{}) poisoned after {}: {}", b.id, b.lo[0], b.lo[1], b.lo[2], b.hi[0],
+                  b.hi[1], b.hi[2], count, why);
+  }
+
+  // Back to the queue; `counts`: a failure its holder reported (poisons at maxAttempts).
   void requeue(Brick& b, const std::string& why, bool counts) {
     b.lastError = why;
     leased_.erase(b.id);
-    if (counts && ++b.failures >= opt_.maxAttempts) {
-      b.phase = BrickPhase::Poisoned;
-      ++poisoned_;
-      report_.poisoned.push_back(PoisonedBrick{b.id, b.lo, b.hi, why});
-      spdlog::error("brick {} [{},{},{})-({},{},{}) poisoned after {} failures: {}", b.id, b.lo[0], b.lo[1], b.lo[2],
-                    b.hi[0], b.hi[1], b.hi[2], b.failures, why);
-      return;
-    }
+    if (counts && ++b.failures >= opt_.maxAttempts) return poison(b, why, std::to_string(b.failures) + " failures");
     ++report_.retries;
     b.phase = BrickPhase::Pending;
     b.backupIssued = b.leaseReissued = false;
-    pending_.push_front(b.id);  // retry soon: it may be the last one
+    (b.suspect ? suspects_ : pending_).push_front(b.id);  // retry soon: it may be the last one
   }
 
-  void dropPeer(const std::string& rid, bool dead) {
+  // A worker died computing b. Churn (workers that die anyway) must not poison it, a brick
+  // that kills its workers must be: the first death only makes b suspect; a suspect is then
+  // leased alone to a worker that has shown it is alive, preferably a fresh one that has
+  // finished nothing yet (dispatch), so when that worker dies b is the common factor and the
+  // death counts: maxAttempts distinct fresh workers, or twice as many workers in all, so
+  // killed poison it. A worker that dies on its n-th brick whatever it is (churn) finishes a
+  // suspect given to it fresh. Hello-and-vanish peers never count: they hold no suspect (they
+  // never proved alive) and their first death is not charged.
+  void onDeath(Brick& b, const Peer& p) {
+    const std::string why = "worker " + p.workerId + " died while computing it";
+    if (b.suspect && p.proven && p.inflight.size() == 1) {
+      (p.finished == 0 ? b.killers : b.weakKillers).insert(p.workerId);
+      if (int(b.killers.size()) >= opt_.maxAttempts ||
+          int(b.killers.size() + b.weakKillers.size()) >= 2 * opt_.maxAttempts) {
+        b.lastError = why;
+        leased_.erase(b.id);
+        return poison(b, why, std::to_string(b.killers.size() + b.weakKillers.size()) +
+                                  " workers died computing it alone");
+      }
+    } else if (!b.suspect) {
+      b.suspect = true;
+      b.suspectSince = Clock::now();
+      ++report_.suspectBricks;
+    }
+    requeue(b, why, false);
+  }
+
+  void dropPeer(const std::string& rid, Departure how) {
     auto it = peers_.find(rid);
     if (it == peers_.end()) return;
-    for (uint64_t id : it->second.inflight) {
-      Brick& b = bricks_[id];
-      b.holders.erase(rid);
-      if (b.phase == BrickPhase::Leased && b.holders.empty())
-        requeue(b, dead ? "worker " + it->second.workerId + " died while computing it" : "worker left", dead);
+    const Peer& p = it->second;
+    // The brick it was computing: its oldest lease (a worker computes its bricks in the order
+    // they were leased; the younger ones were queued behind it).
+    std::optional<uint64_t> computing;
+    for (uint64_t id : p.inflight) {
+      auto h = bricks_[id].holders.find(rid);
+      if (h != bricks_[id].holders.end() && (!computing || h->second < bricks_[*computing].holders.at(rid)))
+        computing = id;
     }
+    for (uint64_t id : p.inflight) {
+      Brick& b = bricks_[id];
+      if (how == Departure::Dead && id == computing && b.phase == BrickPhase::Leased && b.holders.size() == 1)
+        onDeath(b, p);
+      else if (b.holders.erase(rid), b.phase == BrickPhase::Leased && b.holders.empty())
+        requeue(b, how == Departure::Left ? "worker left" : "worker " + p.workerId + " dropped", false);
+    }
+    if (computing) bricks_[*computing].holders.erase(rid);
     peers_.erase(it);
   }
 
@@ -484,7 +684,7 @@ class Master {
       ++report_.deadWorkers;
       spdlog::warn("worker {} silent past its liveness window: dead, its bricks go back to the queue",
                    peers_[rid].workerId);
-      dropPeer(rid, true);
+      dropPeer(rid, Departure::Dead);
     }
   }
 
@@ -527,13 +727,14 @@ class Master {
       // off pending_: put it back, or no one would lease it again and the job would never end
       // (the loop keeps waiting while the other workers heartbeat). A reissued or backup copy
       // stays leased to its other holders and goes back to the reissue queue (it was due).
-      if (b.phase == BrickPhase::Pending) pending_.push_front(b.id);
+      if (b.phase == BrickPhase::Pending) (b.suspect ? suspects_ : pending_).push_front(b.id);
       else reissue_.push_back(b.id);
-      // A dead peer, as if silent past its liveness window: its bricks count a failure, so a
-      // brick that kills its workers is poisoned whichever way the death is noticed first.
-      ++report_.deadWorkers;
-      spdlog::warn("worker {} unreachable: dead, its bricks go back to the queue", p.workerId);
-      dropPeer(rid, true);
+      // The peer gets nothing more; it keeps its leases until its liveness window runs out
+      // (then it is dead, expireDeadPeers) or it says hello again under a new connection (a
+      // worker whose master was stalled reconnects: adoptReconnected), so one death is
+      // judged one way, whichever way it is noticed first.
+      if (!p.unreachable) spdlog::info("worker {} unreachable: no more bricks for it", p.workerId);
+      p.unreachable = true;
       return;
     }
     if (b.phase != BrickPhase::Leased) b.firstLease = now;
@@ -541,10 +742,10 @@ class Master {
     leased_.insert(b.id);
     b.holders[rid] = now;
     p.inflight.insert(b.id);
+    p.everHeld.insert(b.id);
   }
 
   void dispatch(zmq::socket_t& router, Clock::time_point now) {
-    routerForCancel_ = &router;
     // Cluster mode: give the expected workers a short grace period to join, so that the first
     // bricks spread over the whole farm instead of queuing on the earliest worker.
     if (opt_.expectWorkers > 0 && int(peers_.size()) < opt_.expectWorkers) {
@@ -555,16 +756,36 @@ class Master {
     // Peers in routing-id order: dispatch order never changes the output, only the schedule.
     std::vector<std::string> rids;
     for (auto& [rid, p] : peers_) rids.push_back(rid);
+    auto holdsSuspect = [&](const Peer& p) {
+      return std::any_of(p.inflight.begin(), p.inflight.end(), [&](uint64_t id) { return bricks_[id].suspect; });
+    };
     for (int round = 0; round < kCredit; ++round)
       for (auto& rid : rids) {
         auto it = peers_.find(rid);
-        if (it == peers_.end() || int(it->second.inflight.size()) > round) continue;
+        if (it == peers_.end() || it->second.unreachable || int(it->second.inflight.size()) > round ||
+            holdsSuspect(it->second))
+          continue;
+        // A suspect brick goes only alone to a worker that has shown it is alive, a fresh one
+        // unless it has waited two liveness windows for one (onDeath).
+        const Peer& cand = it->second;
+        const bool isolates = cand.proven && cand.inflight.empty() &&
+                              (cand.finished == 0 || suspects_.empty() ||
+                               now - bricks_[suspects_.front()].suspectSince > 2 * liveWindow());
         std::optional<uint64_t> next;
+        while (isolates && !suspects_.empty() && !next) {
+          uint64_t id = suspects_.front();
+          suspects_.pop_front();
+          if (bricks_[id].phase == BrickPhase::Pending) next = id;
+        }
+        std::vector<uint64_t> notHere;  // suspect copies due again, for an isolating worker
         while (!reissue_.empty() && !next) {
           uint64_t id = reissue_.front();
           reissue_.pop_front();
-          if (bricks_[id].phase == BrickPhase::Leased && !bricks_[id].holders.count(rid)) next = id;
+          if (bricks_[id].phase != BrickPhase::Leased || bricks_[id].holders.count(rid)) continue;
+          if (bricks_[id].suspect && !isolates) notHere.push_back(id);
+          else next = id;
         }
+        reissue_.insert(reissue_.begin(), notHere.begin(), notHere.end());
         while (!pending_.empty() && !next) {
           uint64_t id = pending_.front();
           pending_.pop_front();
@@ -574,14 +795,14 @@ class Master {
         sendTask(router, rid, it->second, bricks_[*next], now);
       }
     // Stragglers: nothing queued and a worker idle -> the oldest long-running brick, once more.
-    if (!pending_.empty()) return;
+    if (!pending_.empty() || !suspects_.empty()) return;
     double threshold = std::max(1.0, 2 * medianBrickSeconds());
     for (auto& rid : rids) {
       auto it = peers_.find(rid);
-      if (it == peers_.end() || !it->second.inflight.empty()) continue;
+      if (it == peers_.end() || it->second.unreachable || !it->second.inflight.empty()) continue;
       Brick* oldest = nullptr;
       for (uint64_t id : leased_)
-        if (Brick& b = bricks_[id]; !b.backupIssued && !b.holders.count(rid) &&
+        if (Brick& b = bricks_[id]; !b.backupIssued && !b.suspect && !b.holders.count(rid) &&
             std::chrono::duration<double>(now - b.firstLease).count() > threshold &&
             (!oldest || b.firstLease < oldest->firstLease))
           oldest = &b;
@@ -641,6 +862,10 @@ class Master {
   Operation op_;
   std::vector<Brick> bricks_;
   std::deque<uint64_t> pending_, reissue_;
+  std::deque<uint64_t> suspects_;  // pending suspect bricks (onDeath), leased only alone
+  std::set<std::string> banned_;   // routing ids that sent garbage
+  std::deque<std::string> bannedOrder_;
+  std::map<std::string, std::string> aliases_;  // old routing id -> new, of reconnected workers
   std::vector<BrickOutput> outputs_;
   std::map<std::string, Peer> peers_;
   std::vector<double> brickSeconds_;
@@ -650,7 +875,6 @@ class Master {
   FarmReport report_;
   std::unique_ptr<Journal> journal_;
   std::unique_ptr<Progress> progress_;
-  zmq::socket_t* routerForCancel_ = nullptr;
   std::optional<Clock::time_point> firstJoin_;
   Clock::time_point start_;
 };
@@ -689,7 +913,9 @@ std::string FarmReport::toJson() const {
                  {"oversized", oversized},       {"dead_workers", deadWorkers},
                  {"handed_back", handedBack},    {"straggler_reissues", stragglerReissues},
                  {"lease_reissues", leaseReissues}, {"refused", refused},
-                 {"curve_rejected", curveRejected}};
+                 {"curve_rejected", curveRejected}, {"foreign_results", foreignResults},
+                 {"banned_peers", bannedPeers},  {"suspect_bricks", suspectBricks},
+                 {"reconnects", reconnects},     {"master_stalls", masterStalls}};
   j["workers_seen"] = workersSeen;
   nlohmann::json w = nlohmann::json::object();
   for (auto& [id, s] : perWorker)
@@ -707,6 +933,13 @@ std::string FarmReport::toJson() const {
 }
 
 FarmOutcome runJob(const JobSpec& job, const FarmOptions& options) { return Master(job, options).run(); }
+
+bool isLoopbackEndpoint(const std::string& endpoint) {
+  if (endpoint.rfind("tcp://", 0) != 0) return false;
+  std::string host = endpoint.substr(6, endpoint.rfind(':') == std::string::npos ? std::string::npos : endpoint.rfind(':') - 6);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
 
 uint64_t peakRssBytes() {
   struct rusage ru {};

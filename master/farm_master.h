@@ -24,10 +24,11 @@ struct FarmOptions {
   int brickVoxels = 64;          // brick edge, a multiple of 8
   int heartbeatMs = 500;         // both ways
   int liveness = 6;              // missed beats before a peer counts as dead
-  int maxAttempts = 3;           // failures or worker deaths before a brick is poisoned
+  int maxAttempts = 3;           // holder failures, or distinct workers dying with it alone, that poison a brick
   double leaseSeconds = 0;       // re-issue a brick running longer; 0: max(30 s, 10 x median)
   int noWorkerTimeoutSec = 120;  // give up when no worker is alive for this long
   std::string curveDir;          // require CURVE keys (frep keygen)
+  bool insecure = false;         // allow --listen on a non-loopback address without curveDir
   std::string journalPath;       // empty: no journal
   bool resume = false;
   bool progressJson = false;     // JSON progress events on stdout
@@ -70,6 +71,12 @@ struct FarmReport {
   uint64_t retries = 0, duplicates = 0, lateResults = 0, malformed = 0, oversized = 0;
   uint64_t deadWorkers = 0, handedBack = 0, stragglerReissues = 0, leaseReissues = 0, refused = 0;
   uint64_t curveRejected = 0;
+  // Hostile or broken peers and faults (docs/farm.md, "Threat model" and "Faults"):
+  uint64_t foreignResults = 0;  // results or failures for a brick the sender does not hold
+  uint64_t bannedPeers = 0;     // peers dropped for garbage (their bricks not charged)
+  uint64_t suspectBricks = 0;   // bricks whose worker died computing them (then retried alone)
+  uint64_t reconnects = 0;      // workers back under a new connection, leases kept
+  uint64_t masterStalls = 0;    // the master's own loop stopped longer than the liveness window
   uint64_t extremumSearches = 0, extremumUncertified = 0;
   std::vector<std::string> errorBounds;  // one line per extremum node of the model
   int workersSeen = 0;
@@ -89,8 +96,12 @@ struct FarmOutcome {
 
 // Runs a job ("sample" or "mesh"): one scheduling loop; only the final merge depends on the
 // operation. Throws std::invalid_argument for a bad job or options (unknown operation, brick
-// size) and std::runtime_error for setup failures (bind, journal, keys).
+// size, --listen on a non-loopback address without CURVE or insecure) and std::runtime_error
+// for setup failures (bind, journal, keys, local workers that keep dying).
 FarmOutcome runJob(const JobSpec& job, const FarmOptions& options);
+
+// True if a tcp:// endpoint binds only the loopback interface (127.*, ::1, localhost).
+bool isLoopbackEndpoint(const std::string& endpoint);
 
 // Peak resident set of the calling process in bytes (getrusage RUSAGE_SELF; 0 if unavailable).
 uint64_t peakRssBytes();

@@ -12,7 +12,9 @@ namespace frep::farm {
 
 namespace {
 constexpr char kMagic[4] = {'F', 'R', 'J', '1'};
-constexpr uint64_t kMaxRecord = uint64_t(1) << 34;  // 16 GiB: anything larger is corruption
+// A record is one brick's payload: never more than a frame the master accepts from a worker.
+constexpr uint64_t kMaxRecord = kMaxJournalRecord;
+constexpr long kRecordHeader = 8 + 4 + 8;  // brick, crc, size
 }  // namespace
 
 Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
@@ -35,12 +37,17 @@ Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
                                  "remove it or run without --resume");
       }
       goodEnd = std::ftell(in);
+      std::fseek(in, 0, SEEK_END);
+      const long fileSize = std::ftell(in);
+      std::fseek(in, goodEnd, SEEK_SET);
       for (;;) {
         uint64_t brick = 0, size = 0;
         uint32_t crc = 0;
         if (std::fread(&brick, sizeof brick, 1, in) != 1 || std::fread(&crc, sizeof crc, 1, in) != 1 ||
-            std::fread(&size, sizeof size, 1, in) != 1 || size > kMaxRecord)
+            std::fread(&size, sizeof size, 1, in) != 1)
           break;
+        // A damaged length is never trusted with an allocation: it must fit in what is left.
+        if (size > kMaxRecord || size > uint64_t(fileSize - goodEnd - kRecordHeader)) break;
         std::string payload(size, '\0');
         if (std::fread(payload.data(), 1, size, in) != size) break;
         if (crc32Of(payload.data(), payload.size()) != crc) break;
@@ -51,7 +58,8 @@ Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
     }
   }
   if (goodEnd > 0) {
-    if (::truncate(path.c_str(), goodEnd) != 0) throw std::runtime_error("cannot truncate journal " + path);
+    if (::truncate(path.c_str(), goodEnd) != 0)
+      throw JournalIoError("cannot truncate journal " + path + ": " + std::strerror(errno));
     file_ = std::fopen(path.c_str(), "ab");
   } else {
     file_ = std::fopen(path.c_str(), "wb");
@@ -60,7 +68,9 @@ Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
       std::fwrite(&jobId, sizeof jobId, 1, file_);
     }
   }
-  if (!file_) throw std::runtime_error("cannot open journal " + path + ": " + std::strerror(errno));
+  if (!file_) throw JournalIoError("cannot open journal " + path + ": " + std::strerror(errno));
+  if (std::fflush(file_) != 0 || std::ferror(file_))
+    throw JournalIoError("cannot write journal " + path + ": " + std::strerror(errno));
   flush();
 }
 
@@ -75,7 +85,7 @@ void Journal::append(uint64_t brick, const std::string& payload) {
             std::fwrite(&size, sizeof size, 1, file_) == 1 &&
             std::fwrite(payload.data(), 1, payload.size(), file_) == payload.size();
   // Hand the record to the kernel now: a killed master loses nothing that was merged.
-  if (!ok || std::fflush(file_) != 0) throw std::runtime_error("cannot write journal " + path_ + ": " + std::strerror(errno));
+  if (!ok || std::fflush(file_) != 0) throw JournalIoError("cannot write journal " + path_ + ": " + std::strerror(errno));
 }
 
 void Journal::flush() {

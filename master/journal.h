@@ -6,9 +6,20 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <stdexcept>
 #include <string>
 
 namespace frep::farm {
+
+// The largest record replayed (a brick's payload); a longer length field is corruption, and so is
+// one longer than what remains of the file: the record and everything after it are dropped.
+constexpr uint64_t kMaxJournalRecord = uint64_t(256) << 20;
+
+// The journal's file cannot be opened, written or truncated (a full disk, EFBIG, EIO): an I/O
+// error (frep exit 3), not a farm error.
+struct JournalIoError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 class Journal {
  public:

@@ -54,6 +54,8 @@ int LocalWorkers::reap() {
   for (auto it = pids_.begin(); it != pids_.end();) {
     int status = 0;
     if (::waitpid(*it, &status, WNOHANG) == *it) {
+      lastExit_ = WIFSIGNALED(status) ? "killed by signal " + std::to_string(WTERMSIG(status))
+                                      : "exited with " + std::to_string(WEXITSTATUS(status));
       if (WIFSIGNALED(status))
         spdlog::warn("local worker pid {} killed by signal {}", *it, WTERMSIG(status));
       else

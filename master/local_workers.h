@@ -17,6 +17,8 @@ class LocalWorkers {
   // Reaps exited workers; returns how many exited since the last call.
   int reap();
   int running() const { return int(pids_.size()); }
+  // How the last reaped worker ended ("killed by signal 6", "exited with 2"), for messages.
+  const std::string& lastExit() const { return lastExit_; }
   void terminateAll();
   const std::string& executable() const { return exe_; }
 
@@ -24,6 +26,7 @@ class LocalWorkers {
   std::string exe_;
   std::vector<std::string> args_;
   std::vector<pid_t> pids_;
+  std::string lastExit_ = "still running";
 };
 
 // Path of a program installed next to the running one (build/bin/frep -> build/bin/NAME).

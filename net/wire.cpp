@@ -4,7 +4,7 @@
 
 namespace frep::farm {
 
-bool receive(zmq::socket_t& socket, bool router, Incoming& in, std::string* error) {
+bool receive(zmq::socket_t& socket, bool router, Incoming& in, std::string* error, const FrameLimit& limit) {
   std::vector<zmq::message_t> frames;
   auto n = zmq::recv_multipart(socket, std::back_inserter(frames), zmq::recv_flags::dontwait);
   if (!n) return false;
@@ -15,6 +15,12 @@ bool receive(zmq::socket_t& socket, bool router, Incoming& in, std::string* erro
     first = 1;
   }
   size_t count = frames.size() - first;
+  for (size_t f = first; f < frames.size(); ++f) in.bytes += frames[f].size();
+  if (limit && in.bytes > limit(in.routingId)) {
+    in.oversized = true;
+    if (error) *error = "oversized message (" + std::to_string(in.bytes) + " bytes)";
+    return true;
+  }
   if (count < 1 || count > 2) {
     if (error) *error = "wrong frame count " + std::to_string(count);
     return true;

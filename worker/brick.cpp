@@ -1,7 +1,5 @@
 #include "brick.h"
 
-#include <zlib.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -9,6 +7,7 @@
 
 #include "frep/extremum/extremum.h"
 #include "frep/meshing/mesh_simplify.h"
+#include "frep/minkowski_algebra/registry.h"
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 
@@ -47,7 +46,8 @@ uint64_t jobIdOf(const JobSpec& job) {
   return h;
 }
 
-TapePtr compileJobModel(const JobSpec& job) {
+namespace {
+Expr jobField(const JobSpec& job, uint32_t* dimsOut) {
   lang::CompileOptions opt;
   opt.object = job.object();
   lang::CompileResult r = lang::compile(job.model_source(), job.model_name(), opt);
@@ -67,7 +67,20 @@ TapePtr compileJobModel(const JobSpec& job) {
   if (frep::numVars(f) > 3)
     throw std::runtime_error("the field has " + std::to_string(frep::numVars(f)) +
                              " coordinates: map x[4..] to constants (-x)");
+  *dimsOut = dims;
+  return f;
+}
+}  // namespace
+
+TapePtr compileJobModel(const JobSpec& job) {
+  uint32_t dims = 0;
+  Expr f = jobField(job, &dims);
   return Tape::compile(f, std::min(dims, 3u));
+}
+
+std::vector<std::string> describeExactTerms(const JobSpec& job) {
+  uint32_t dims = 0;
+  return minkowski::describeExact(jobField(job, &dims));
 }
 
 TapePtr ModelCache::get(const JobSpec& job, uint64_t jobId) {
@@ -116,6 +129,9 @@ BrickOutput computeBrickOnce(const TapePtr& tape, const JobSpec& job, const std:
     const GridSpec grid = gridOf(job);
     out.piece = meshRegion(tape, grid, lo, hi, mo);
     out.stats.pointEvals = meshPointEvals(out.piece.stats);
+    out.stats.intervalEvals = out.piece.stats.sampleIntervalEvals;
+    out.stats.nanValues = out.piece.stats.nanValues;
+    out.stats.domainErrors = out.piece.stats.domainErrors;
     if (job.mesh().tolerance() > 0) {
       SimplifyOptions so;
       so.tolerance = job.mesh().tolerance();
@@ -453,18 +469,6 @@ bool decodePayload(Operation op, const void* data, size_t size, BrickOutput& out
   if (!decodeMeshPiece(data, size, out.piece, error)) return false;
   out.stats.pointEvals = meshPointEvals(out.piece.stats);
   return true;
-}
-
-uint32_t crc32Of(const void* data, size_t size) {
-  uLong c = crc32(0L, Z_NULL, 0);
-  const Bytef* p = static_cast<const Bytef*>(data);
-  while (size > 0) {
-    uInt n = size > (1u << 30) ? (1u << 30) : uInt(size);
-    c = crc32(c, p, n);
-    p += n;
-    size -= n;
-  }
-  return uint32_t(c);
 }
 
 }  // namespace frep::farm

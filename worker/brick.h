@@ -42,6 +42,9 @@ uint64_t jobIdOf(const JobSpec& job);
 // Compiles a job's model (HyperFun source, object, params, iso) to a tape. Throws
 // std::runtime_error with the diagnostics when the model does not compile.
 TapePtr compileJobModel(const JobSpec& job);
+// One line per exact Minkowski algebra term of the model (Roerdink: no search, error bound 0),
+// for the report next to describeErrorBounds' lines.
+std::vector<std::string> describeExactTerms(const JobSpec& job);
 
 // Compiled models by job id, so a worker compiles each model once.
 class ModelCache {

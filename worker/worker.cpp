@@ -122,6 +122,21 @@ class ComputeThread {
     // Test hook (documented in docs/farm.md): crash on a chosen brick to exercise poisoning.
     if (const char* crash = std::getenv("FREP_TEST_CRASH_BRICK"))
       if (std::strtoull(crash, nullptr, 10) == task.brick_id()) std::abort();
+    // Test hook: churn, a worker that dies on whatever brick comes after its first N.
+    // It dies once its earlier results are out (handed to the I/O thread and given time to
+    // leave the socket), so that the bricks it finished count as finished.
+    if (const char* n = std::getenv("FREP_TEST_DIE_AFTER"))
+      if (++started_ > std::strtoull(n, nullptr, 10)) {
+        for (int i = 0; i < 300; ++i) {
+          {
+            std::lock_guard<std::mutex> l(mutex_);
+            if (done_.empty()) break;
+          }
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        std::abort();
+      }
     if (const char* slow = std::getenv("FREP_TEST_SLOW_MS"))
       std::this_thread::sleep_for(std::chrono::milliseconds(std::atoi(slow)));
     try {
@@ -159,6 +174,7 @@ class ComputeThread {
   }
 
   int threads_;
+  uint64_t started_ = 0;  // bricks this worker started (FREP_TEST_DIE_AFTER)
   zmq::socket_t wakeSend_;
   ModelCache cache_;
   std::mutex mutex_;

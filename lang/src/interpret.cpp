@@ -96,6 +96,16 @@ class Run {
     return static_cast<size_t>(r) - 1;
   }
 
+  // A read clamps as the compiled select chain does for an index that depends on x (a constant
+  // index out of range is a compile error, so it never gets here): below 1 the first element,
+  // above n or NaN the last (docs/language.md).
+  size_t readIndex(const AstExpr& e, const std::vector<double>& arr) {
+    double v = eval(e);
+    if (std::isnan(v) || v >= static_cast<double>(arr.size()) + 0.5) return arr.size() - 1;
+    double r = hfRound(v);
+    return r < 1 ? 0 : static_cast<size_t>(r) - 1;
+  }
+
   void stmt(const Stmt& s) {
     switch (s.kind) {
       case Stmt::Kind::Assign: frame_->scalars[s.name] = eval(*s.value); return;
@@ -133,7 +143,7 @@ class Run {
       }
       case AstExpr::Kind::Index: {
         auto& arr = array(e.name);
-        return arr[index(*e.args[0], arr)];
+        return arr[readIndex(*e.args[0], arr)];
       }
       case AstExpr::Kind::Call: return call(e);
       case AstExpr::Kind::Unary: {

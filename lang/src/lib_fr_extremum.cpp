@@ -21,6 +21,7 @@
 #include "frep/extremum/extremum.h"
 #include "frep/evaluators/interval.h"
 #include "frep/expressions/tape.h"
+#include "lib_fr_minkowski.h"
 #include "lib_hf_util.h"
 
 namespace frep::lang {
@@ -230,13 +231,50 @@ Expr objectPair(const char* fn, std::vector<Arg>& a, Build build) {
   return through(r, xs, n);
 }
 
+// Basic-set operands (Roerdink-Minkowski, lib_fr_minkowski.h) take the exact algebra instead of
+// the search; the options then do not apply (there is nothing to search).
+bool exactPair(std::vector<Arg>& a, bool diff, Expr* out) {
+  if (a.size() < 3 || !a[1].isObject || !a[2].isObject || !a[0].isArray || !a[0].array) return false;
+  return diff ? exactMinkowskiDiff(a[1], a[2], *a[0].array, out)
+              : exactMinkowskiSum({&a[1], &a[2]}, *a[0].array, out);
+}
+
 Expr frMinkowski(std::vector<Arg>& a) {
+  Expr exact;
+  if (exactPair(a, false, &exact)) return exact;
   return objectPair("frMinkowski", a, [](const Expr& A, const Expr& B, uint32_t n, const Bounds& bb, const Options& o) {
     return minkowskiSum(A, B, n, bb, minkowskiOptions(o));
   });
 }
 
+// frMinkowskiSum(x, A1, A2, ..., Ak [, options]): A1 ⊕ ... ⊕ Ak; exact when every Ai is in the
+// basic set, otherwise folded left by the search ((A1 ⊕ A2) ⊕ A3 ..., nested extremum nodes).
+Expr frMinkowskiSum(std::vector<Arg>& a) {
+  const char* fn = "frMinkowskiSum";
+  const bool opts = !a.empty() && a.back().isArray && a.size() >= 4;
+  const size_t end = a.size() - (opts ? 1 : 0);
+  if (end < 3) throw LibraryError("frMinkowskiSum takes (x, A1, A2, ... [, options])");
+  std::vector<const Arg*> ops;
+  for (size_t i = 1; i < end; ++i) ops.push_back(&objectArg(fn, a, static_cast<int>(i), "an operand"));
+  for (size_t i = 1; i < ops.size(); ++i) pairDims(fn, *ops[0], *ops[i]);
+  const size_t n = static_cast<size_t>(ops[0]->objectDims);
+  std::vector<Expr>& xs = coordArg(fn, a, n);
+  Expr exact;
+  if (exactMinkowskiSum(ops, xs, &exact)) return exact;
+  Options o = parseOptions(fn, a, static_cast<int>(end), n);
+  if (o.hasBox) throw LibraryError("frMinkowskiSum: the options take no box (each operand's is computed)",
+                                   static_cast<int>(end));
+  Expr r = ops[0]->value;
+  for (size_t i = 1; i < ops.size(); ++i) {
+    Bounds bb = autoBox(fn, *ops[i], static_cast<int>(i + 1));
+    r = guarded(fn, -1, [&] { return minkowskiSum(r, ops[i]->value, static_cast<uint32_t>(n), bb, minkowskiOptions(o)); });
+  }
+  return through(r, xs, n);
+}
+
 Expr frMinkowskiDiff(std::vector<Arg>& a) {
+  Expr exact;
+  if (exactPair(a, true, &exact)) return exact;
   return objectPair("frMinkowskiDiff", a,
                     [](const Expr& A, const Expr& B, uint32_t n, const Bounds& bb, const Options& o) {
                       return minkowskiDifference(A, B, n, bb, o.search);
@@ -494,6 +532,7 @@ Expr frSweepKeys(std::vector<Arg>& a) {
 
 const bool registered = registerAll({
     {"frMinkowski", "*", "A + B: max over u in box(B) of A(X - u) & B(u)", frMinkowski},
+    {"frMinkowskiSum", "*", "A1 + A2 + ... + Ak: exact algebra for basic-set operands, else folded searches", frMinkowskiSum},
     {"frMinkowskiDiff", "*", "A - B: min over u in box(B) of max(A(X + u), -B(u))", frMinkowskiDiff},
     {"frOffsetR", "*", "r > 0: max over |u| <= r of A(X + u); r < 0: min", frOffsetR},
     {"frMorphMinkowski", "*", "((1 - t) A) + (t B), t in [0, 1] constant", frMorphMinkowski},

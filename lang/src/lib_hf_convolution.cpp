@@ -1,6 +1,9 @@
 // HyperFun's convolution surfaces with the Cauchy kernel k(r) = 1 / (1 + S^2 r^2)^2
 // (McCormack and Sherstyuk 1998): the field is the kernel integrated over a skeleton, minus a
 // threshold T. Sums over skeleton elements unroll (array sizes are known at compile time).
+// Scales as hfp's library has them (checked against its formulas): segments integrate over the
+// length, triangles give S^3 times the area integral, arcs integrate over the angle (the arc
+// length integral divided by the radius).
 #include <string>
 
 #include "lib_hf_util.h"
@@ -127,7 +130,7 @@ Expr convTriangle(std::vector<Arg>& a) {
   Expr sum = 0.0;
   for (size_t i = 0; i < S.size(); ++i) {
     Vec3 tri[3] = {at(v, 9 * i), at(v, 9 * i + 3), at(v, 9 * i + 6)};
-    sum = sum + triangle(x, tri, S[i]);
+    sum = sum + S[i] * S[i] * S[i] * triangle(x, tri, S[i]);
   }
   return sum - scalarArg(fn, a, 3);
 }
@@ -158,7 +161,7 @@ Expr convMesh(std::vector<Arg>& a) {
                            2);
       corners[k] = at(v, 3 * (n - 1));
     }
-    sum = sum + triangle(x, corners, S[i]);
+    sum = sum + S[i] * S[i] * S[i] * triangle(x, corners, S[i]);
   }
   return sum - scalarArg(fn, a, 4);
 }
@@ -166,6 +169,10 @@ Expr convMesh(std::vector<Arg>& a) {
 // Arcs: centre c, radius, opening theta (degrees, from the local x axis counter-clockwise), in
 // the local xy-plane, then turned by `angle` degrees about `axis` (through the centre, right-hand
 // rule). The point is taken into the arc's frame by the inverse rotation (Rodrigues).
+// hfp's quirks, kept for value-for-value agreement: degrees convert with pi = 3.141592, every
+// axis component and the angle get + 1e-6 (EPS) before use, theta is capped at 360. (hfp also
+// writes angle + 1e-6 and a theta over 180 back into the arrays, so its later points see other
+// arcs; frepfarm gives every point the first call's value, docs/language.md.)
 Expr convArc(std::vector<Arg>& a) {
   const char* fn = "hfConvArc";
   Vec3 x = at(coords(fn, a), 0);
@@ -178,18 +185,19 @@ Expr convArc(std::vector<Arg>& a) {
   auto& theta = arrayExactly(fn, a, 3, n, per);
   auto& axis = arrayExactly(fn, a, 4, 3 * n, per3);
   auto& angle = arrayExactly(fn, a, 5, n, per);
-  const double deg = kPi / 180.0;
+  const double deg = 3.141592 / 180.0, eps = 1e-6;
   Expr sum = 0.0;
   for (size_t i = 0; i < n; ++i) {
     Vec3 p = minus(x, at(c, 3 * i)), ax = at(axis, 3 * i);
-    Expr len = sqrt(norm2(ax));
+    ax = {ax.x + eps, ax.y + eps, ax.z + eps};
+    Expr len = max(sqrt(norm2(ax)), eps);
     Vec3 u = {ax.x / len, ax.y / len, ax.z / len};
-    Expr cb = cos(angle[i] * deg), sb = sin(angle[i] * deg);
+    Expr cb = cos((angle[i] + eps) * deg), sb = sin((angle[i] + eps) * deg);
     Vec3 uxp = cross(u, p);
     Expr up = dot3(u, p) * (1.0 - cb);
     Vec3 local = {p.x * cb - uxp.x * sb + u.x * up, p.y * cb - uxp.y * sb + u.y * up,
                   p.z * cb - uxp.z * sb + u.z * up};
-    sum = sum + arc(local, radius[i], theta[i] * deg, S[i]);
+    sum = sum + arc(local, radius[i], min(theta[i], 360.0) * deg, S[i]) / radius[i];
   }
   return sum - scalarArg(fn, a, 7);
 }
@@ -225,6 +233,32 @@ Expr convLineR(std::vector<Arg>& a) {
   return min(sum, 1.0) - T;
 }
 
+// frConvPlane(x, p, n, S, T): planes through p_i with normals n_i (Vyatkin-Perturbation lists
+// the plane among the Cauchy kernel's primitives, eq. 7). The kernel over a plane at distance h,
+// in polar coordinates about the foot: 2 pi int rho / (1 + S^2 h^2 + S^2 rho^2)^2 d rho =
+// pi / (S^2 (1 + S^2 h^2)). At hfConvTriangle's scale (S^3 times the area integral) that is
+// pi S / (1 + S^2 h^2): the limit of a growing hfConvTriangle, so the two mix.
+Expr convPlane(std::vector<Arg>& a) {
+  const char* fn = "frConvPlane";
+  Vec3 x = at(coords(fn, a), 0);
+  auto& S = arrayArg(fn, a, 3);
+  std::string per3 = " (3 per element of " + argName(a, 3, "S") + ")";
+  auto& p = arrayExactly(fn, a, 1, 3 * S.size(), per3);
+  auto& n = arrayExactly(fn, a, 2, 3 * S.size(), per3);
+  Expr sum = 0.0;
+  for (size_t i = 0; i < S.size(); ++i) {
+    Vec3 nv = at(n, 3 * i);
+    Expr len2 = norm2(nv);
+    if (len2.isConst() && len2.constValue() == 0.0)
+      throw LibraryError(std::string(fn) + ": normal " + std::to_string(i + 1) + " of " +
+                             argName(a, 2, "n") + " is zero",
+                         2);
+    Expr h = dot3(minus(x, at(p, 3 * i)), nv) / sqrt(len2);
+    sum = sum + kPi * S[i] / (1.0 + S[i] * S[i] * h * h);
+  }
+  return sum - scalarArg(fn, a, 4);
+}
+
 const bool registered = registerAll({
     {"hfConvPoint", "AAAS", "sum 1/(1 + S_i^2 r_i^2)^2 - T", convPoint},
     {"hfConvLine", "AAAAS", "sum of Cauchy kernel integrals over segments b_i -> e_i - T",
@@ -235,6 +269,8 @@ const bool registered = registerAll({
     {"hfConvArc", "AAAAAAAS", "sum of Cauchy kernel integrals over arcs - T", convArc},
     {"hfConvMesh", "AAAAS", "sum of Cauchy kernel integrals over indexed triangles - T",
      convMesh},
+    {"frConvPlane", "AAAAS", "sum pi S_i / (1 + S_i^2 h_i^2) - T: Cauchy kernel over planes",
+     convPlane},
     {"hfConvLineR", "AAAS",
      "min(1, sum of segment integrals, S = 1/R if R < 1 else 1) - field at distance R",
      convLineR},

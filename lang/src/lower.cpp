@@ -40,6 +40,10 @@ std::string fmtNumber(double v) {
 void ObjectLowering::unknownName(const AstExpr& e, bool asFunction) {
   if (!asFunction && assigned_.count(e.name))
     throw CompileError{e.loc, "'" + e.spelling + "' is used before it is assigned"};
+  if (asFunction && e.name == "hfr")
+    throw CompileError{e.loc, "'" + e.spelling + "' is not supported: in the R package hyperfun "
+                              "it calls back an R function at every point, which exists only "
+                              "inside R; write the function in HyperFun instead"};
   throw CompileError{e.loc, std::string(asFunction ? "unknown function '" : "unknown name '") +
                                 e.spelling + "'" + suggestion(e.spelling, asFunction)};
 }

@@ -4,7 +4,10 @@
 namespace frep::lang::detail {
 
 size_t ObjectLowering::constIndex(const AstExpr& e, const Value& arr) {
-  Expr i = lower(e);
+  return constIndex(e, lower(e), arr);
+}
+
+size_t ObjectLowering::constIndex(const AstExpr& e, const Expr& i, const Value& arr) {
   if (!i.isConst())
     throw CompileError{e.loc, std::string("array index must be known at compile time; this "
                                           "one depends on ") +
@@ -110,9 +113,32 @@ Value& ObjectLowering::arrayNamed(const AstExpr& e) {
   return it->second;
 }
 
+// An index that depends on x (or a[]), e.g. h[floor(u) + 1]: hfp rounds it per point (ties
+// up) and reads that element. Compiled as a select chain on the rounded index, whose interval
+// bound is the hull of the elements the index interval can reach (select's own bound). Out of
+// range, hfp stops with an error and keeps a stale value; frepfarm clamps to the first or last
+// element (docs/language.md).
+Expr ObjectLowering::readVaryingElement(const AstExpr& e, Value& arr, const Expr& index) {
+  const size_t n = arr.elems.size();
+  for (size_t k = 0; k < n; ++k)
+    if (arr.elemState[k] != Def::Defined && arr.elemState[k] != Def::Poisoned)
+      throw CompileError{e.loc, "element " + e.spelling + "[" + std::to_string(k + 1) +
+                                    "] is not assigned, and this index depends on x, so it may "
+                                    "read any element: assign them all first"};
+  auto elem = [&](size_t k) { return arr.elemState[k] == Def::Defined ? arr.elems[k] : Expr(0.0); };
+  // Rounding ties up, round(i) <= k exactly when i < k + 0.5: compare the index itself (one
+  // comparison per element, no rounding node to widen the interval).
+  Expr v = elem(n - 1);
+  for (size_t k = n - 1; k-- > 0;) v = select(lt(index, double(k) + 1.5), elem(k), v);
+  return v;
+}
+
 Expr ObjectLowering::readElement(const AstExpr& e) {
-  Value& arr = arrayNamed(e);
-  size_t i = constIndex(*e.args[0], arr);
+  arrayNamed(e);  // the name's errors first
+  Expr index = lower(*e.args[0]);
+  Value& arr = arrayNamed(e);  // re-found: lowering may run library calls
+  if (!index.isConst()) return readVaryingElement(e, arr, index);
+  size_t i = constIndex(*e.args[0], index, arr);
   switch (arr.elemState[i]) {
     case Def::Defined: return arr.elems[i];
     case Def::Poisoned: return Expr(0.0);

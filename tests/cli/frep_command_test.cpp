@@ -149,7 +149,7 @@ TEST_F(FrepTest, BadArgumentsNameTheField) {
       {"slice s.hf --res 16", "frep: error: -O/--out: the output PNG path is required"},
       {"sample s.hf --band 0 -O s.vdb", "frep: error: --band: expected an integer from 1 to 64 (voxels), got 0"},
       {"eval s.hf", "--at is required"},
-      {"frob s.hf", "frep: error: unknown verb 'frob'; the verbs are check, eval, slice, sample, mesh and keygen"},
+      {"frob s.hf", "frep: error: unknown verb 'frob'; the verbs are check, eval, slice, sample, mesh, pov, relate and keygen"},
       {"eval s.hf --at 0,0,0 --log-level loud", "--log-level"},
   };
   for (const Case& c : cases) {
@@ -166,30 +166,29 @@ TEST_F(FrepTest, UnwritableOutputIsAnIoErrorAndLeavesNothing) {
   RunResult r = run("slice s.hf --res 16 -O plain/s.png");
   EXPECT_EQ(r.code, 3);
   EXPECT_TRUE(contains(r.err, "frep: error: -O/--out: cannot write 'plain/s.png': Not a directory")) << r.err;
-  // The output is a directory: the image is computed, the final rename fails, the temp goes.
+  // The output is a directory: refused before any work (docs/cli.md: -O is new or a regular file).
   ASSERT_EQ(::mkdir(path("adir").c_str(), 0755), 0);
   RunResult dir = run("sample s.hf --res 16 -O adir");
   EXPECT_EQ(dir.code, 3) << dir.err;
-  EXPECT_TRUE(contains(dir.err, "cannot rename")) << dir.err;
-  // The computed bricks stay in the journal, so that --resume writes the output without work.
-  EXPECT_EQ(listing(), "adir adir.journal plain s.hf");
+  EXPECT_TRUE(contains(dir.err, "'adir' is a directory")) << dir.err;
+  EXPECT_EQ(listing(), "adir plain s.hf");
 }
 
 TEST_F(FrepTest, SliceWritesAHeatMapOfTheRequestedSize) {
   write("s.hf", kSphere);
-  RunResult r = run("slice s.hf -b 2 --res 65 -O s.png");  // voxel 1/16: -2..2 on the lattice
+  RunResult r = run("slice s.hf -b 2 --res 64 -O s.png");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_TRUE(contains(r.out, "wrote s.png: 65x65 pixels at z = 0")) << r.out;
+  EXPECT_TRUE(contains(r.out, "wrote s.png: 64x64 pixels at z = 0")) << r.out;
   EXPECT_EQ(listing(), "s.hf s.png");
   Png png = readPng(path("s.png"));
-  ASSERT_EQ(png.width, 65u);
-  ASSERT_EQ(png.height, 65u);
+  ASSERT_EQ(png.width, 64u);
+  ASSERT_EQ(png.height, 64u);
   EXPECT_TRUE(warm(png.at(32, 32)));  // the centre is inside
   EXPECT_TRUE(cool(png.at(0, 0)));    // a corner is outside
   // Along the middle row the contour is crossed once on each side of the centre: |x| = 1 lies
-  // at pixels 16 and 48 (x = -1 and 1).
+  // between pixels 15 (x = -1.047) and 16 (x = -0.984); 16 is nearer to the surface.
   int blackCount = 0;
-  for (unsigned c = 0; c < 65; ++c) blackCount += black(png.at(c, 32));
+  for (unsigned c = 0; c < 64; ++c) blackCount += black(png.at(c, 32));
   EXPECT_EQ(blackCount, 2);
   EXPECT_TRUE(black(png.at(16, 32)));
 }
@@ -265,7 +264,7 @@ TEST_F(FrepTest, DomainErrorsAreReportedNotFatal) {
   EXPECT_TRUE(contains(r.out, "value: nan\nstatus: out (NaN: a domain error, counted as outside)\n")) << r.out;
   RunResult s = run("slice n.hf -b 1 --res 16 -O n.png");
   ASSERT_EQ(s.code, 0) << s.err;
-  EXPECT_TRUE(contains(s.out, ", 136 NaN pixels (grey)\n")) << s.out;  // columns 0..7 of 17 rows (-1..1 rounded out to the lattice of 2/15)
+  EXPECT_TRUE(contains(s.out, ", 128 NaN pixels (grey); evaluated 256 of 256 pixels")) << s.out;  // columns 0..7 of 16 rows
   Png png = readPng(path("n.png"));
   EXPECT_EQ(png.at(3, 3)[0], 128);
   EXPECT_EQ(png.at(3, 3)[2], 128);

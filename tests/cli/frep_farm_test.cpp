@@ -112,6 +112,11 @@ TEST_F(FarmCli, BadFarmArgumentsAreNamed) {
   r = run(sampleArgs("x.vdb") + " --listen localhost:5");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--listen"), std::string::npos);
+  // An open farm on the network needs --curve or an explicit --insecure (loopback is fine).
+  r = run(sampleArgs("x.vdb") + " --listen 'tcp://*:5'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--insecure"), std::string::npos) << r.err;
+  EXPECT_FALSE(fileExists(path("x.vdb")));
 }
 
 TEST_F(FarmCli, JsonProgressEventsForBatchSystems) {

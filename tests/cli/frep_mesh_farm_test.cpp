@@ -16,7 +16,7 @@ class MeshFarmCli : public FarmTest {
     FarmTest::SetUp();
     write("part.hf", kPartModel);
   }
-  static std::string meshArgs(const std::string& out, int res = 63) {  // -1..1 on the lattice of 1/31: 63 points
+  static std::string meshArgs(const std::string& out, int res = 64) {
     return "mesh part.hf -b 1 --res " + std::to_string(res) + " --no-progress --heartbeat-ms 100 -O " + out;
   }
 };
@@ -57,8 +57,8 @@ TEST_F(MeshFarmCli, SameBytesForAnyWorkerCountAndBrickSize) {
 }
 
 TEST_F(MeshFarmCli, SigtermStopsTheMasterWhichResumesLater) {
-  ASSERT_EQ(run(meshArgs("ref.ply", 95) + " --workers 0 --brick 32").code, 0);
-  pid_t master = start(meshArgs("out.ply", 95) + " --workers 2 --brick 32", "FREP_TEST_SLOW_MS=150");
+  ASSERT_EQ(run(meshArgs("ref.ply", 96) + " --workers 0 --brick 32").code, 0);
+  pid_t master = start(meshArgs("out.ply", 96) + " --workers 2 --brick 32", "FREP_TEST_SLOW_MS=150");
   for (int i = 0; i < 200 && journalRecords("out.ply.journal") < 3; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(25));
   kill(master, SIGTERM);
@@ -69,7 +69,7 @@ TEST_F(MeshFarmCli, SigtermStopsTheMasterWhichResumesLater) {
   size_t journaled = journalRecords("out.ply.journal");
   ASSERT_GE(journaled, 3u);
   ASSERT_LT(journaled, 27u);
-  RunResult resumed = run(meshArgs("out.ply", 95) + " --workers 2 --brick 32 --resume");
+  RunResult resumed = run(meshArgs("out.ply", 96) + " --workers 2 --brick 32 --resume");
   ASSERT_EQ(resumed.code, 0) << resumed.err;
   std::string report = readText(path("out.ply.report.json"));
   EXPECT_EQ(jsonNumber(report, "from_journal"), long(journaled)) << report;
@@ -83,7 +83,7 @@ TEST_F(MeshFarmCli, PoisonedBrickExitsFiveAndIsNamed) {
   int status = std::system(full.c_str());
   EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 5);
   std::string err = readText(path(".err"));
-  EXPECT_NE(err.find("brick 2 voxels [0,32,0)-(32,63,32)"), std::string::npos) << err;
+  EXPECT_NE(err.find("brick 2 voxels [0,32,0)-(32,64,32)"), std::string::npos) << err;
   EXPECT_FALSE(fileExists(path("out.ply")));
   EXPECT_TRUE(fileExists(path("out.ply.journal")));
   EXPECT_TRUE(fileExists(path("out.ply.report.json")));
@@ -103,12 +103,12 @@ TEST_F(MeshFarmCli, BadFarmArgumentsAreNamed) {
     const char* args;
     const char* message;
   } cases[] = {
-      {" --brick 12", "--brick: expected a positive multiple of 8"},
-      {" --brick 0", "--brick: expected a positive multiple of 8"},
-      {" --workers -2", "--workers: expected 0"},
+      {" --brick 12", "--brick: expected a multiple of 8 voxels from 8 to 1024"},
+      {" --brick 0", "--brick: expected a multiple of 8 voxels from 8 to 1024"},
+      {" --workers -2", "--workers: expected an integer from -1 to 4096"},
       {" --listen localhost:5", "--listen: expected tcp://"},
       {" --threads -1", "--threads: expected 0"},
-      {" --expect-workers -1", "--expect-workers: expected 0"},
+      {" --expect-workers -1", "--expect-workers: expected an integer from 0 to 4096"},
   };
   for (const Case& c : cases) {
     RunResult r = run(meshArgs("x.ply") + c.args);
@@ -117,7 +117,7 @@ TEST_F(MeshFarmCli, BadFarmArgumentsAreNamed) {
   }
   RunResult r = run("mesh part.hf -b 1 --res 64 -O x.ply --heartbeat-ms 5");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--heartbeat-ms: expected at least 10"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--heartbeat-ms: expected an integer from 10 to 600000"), std::string::npos) << r.err;
   EXPECT_EQ(listing(), "part.hf");  // nothing written, not even a report
   EXPECT_EQ(run(meshArgs("x.ply") + " --workers 2 --curve missing").code, 7);  // farm error: no keys
   EXPECT_FALSE(fileExists(path("x.ply")));

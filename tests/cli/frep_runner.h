@@ -46,8 +46,11 @@ class FrepTest : public ::testing::Test {
   void write(const std::string& name, const std::string& text) const { std::ofstream(path(name)) << text; }
 
   // args are appended to the binary's path; the working directory is the test's directory.
-  RunResult run(const std::string& args) const {
-    std::string cmd = "cd '" + dir_ + "' && '" FREP_BINARY "' " + args + " >" + path(".out") + " 2>" + path(".err");
+  RunResult run(const std::string& args) const { return capture("'" FREP_BINARY "' " + args); }
+
+  // A shell command run in the test's directory, its exit code and output captured.
+  RunResult capture(const std::string& command) const {
+    std::string cmd = "cd '" + dir_ + "' && " + command + " >" + path(".out") + " 2>" + path(".err");
     int status = std::system(cmd.c_str());
     RunResult r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -333,3 +333,35 @@ TEST(MeshSimplify, SphereKeepsItsShapeWithinTheTolerance) {
   EXPECT_LT(r.mesh.triangles.size(), r.rawTriangles);
   EXPECT_NEAR(r.volume, 4 * kPi / 3, 5e-3 * 4 * kPi / 3);
 }
+
+// A cone cut by the grid's box ends in an open rim on the box's bottom face. The rim must stay
+// exactly the mesher's: no rim vertex may leave the face (a collapse that moved one cut notches
+// into the rim, up to many voxels deep at larger tolerances).
+TEST(MeshSimplify, OpenRimOnTheBoxStaysOnTheBox) {
+  const Expr X = Expr::x(0), Y = Expr::x(1), Z = Expr::x(2);
+  const Expr cone = 0.5 * (1.0 - Z) - sqrt(square(X) + square(Y));
+  const GridSpec g = GridSpec::fromBounds({-1, -1, -0.5}, {1, 1, 1.2}, 96);
+  TapePtr tape = Tape::compile(cone, 3);
+  Mesh m = meshGrid(tape, g, {}, 0);
+  auto rim = [](const Mesh& mesh) {
+    std::set<std::pair<uint32_t, uint32_t>> directed;
+    for (const auto& t : mesh.triangles)
+      for (int c = 0; c < 3; ++c) directed.insert({t[c], t[(c + 1) % 3]});
+    std::set<std::array<double, 3>> points;
+    for (const auto& [a, b] : directed)
+      if (!directed.count({b, a})) points.insert(mesh.positions[a]), points.insert(mesh.positions[b]);
+    return points;
+  };
+  const auto rawRim = rim(m);
+  ASSERT_GT(rawRim.size(), 100u);
+  for (double tol : {0.1, 1.0}) {
+    Mesh s = m;
+    SimplifyOptions so;
+    so.tolerance = tol;
+    simplifyMesh(s, tape, g, so);
+    EXPECT_LT(s.triangles.size(), m.triangles.size() / 10);
+    const auto simplifiedRim = rim(s);
+    EXPECT_EQ(simplifiedRim, rawRim) << "tolerance " << tol;
+    for (const auto& p : simplifiedRim) EXPECT_EQ(p[2], g.origin[2]);
+  }
+}

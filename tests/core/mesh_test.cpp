@@ -288,9 +288,10 @@ TEST(Mesh, RejectsBadRegions) {
   EXPECT_TRUE(empty.triangles.empty());
 }
 
-TEST(Mesh, ExtremumModelIsSplitInvariant) {
-  // Offset of a block by a ball of radius 0.2 (max over u in the ball of block(X - u)):
-  // evaluated by branch and bound, which the root finder runs lane by lane.
+// Offset of a block by a ball of radius 0.2 (max over u in the ball of block(X - u)):
+// evaluated by branch and bound, which the root finder runs lane by lane.
+namespace {
+Expr roundedBlock() {
   Expr body = remap(blockAt(0, 0, 0, 0.3, 0.3, 0.3), {Expr::x(0) - Expr::x(3), Expr::x(1) - Expr::x(4), Expr::x(2) - Expr::x(5)});
   ExtremumSpec spec;
   spec.body = body;
@@ -299,8 +300,12 @@ TEST(Mesh, ExtremumModelIsSplitInvariant) {
   spec.domain = DomainKind::Ball;
   spec.radius = 0.2;
   spec.tolerance = 1e-3;
-  Expr m = extremum(spec);
-  TapePtr tape = Tape::compile(m, 3);
+  return extremum(spec);
+}
+}  // namespace
+
+TEST(Mesh, ExtremumModelIsSplitInvariant) {
+  TapePtr tape = Tape::compile(roundedBlock(), 3);
   GridSpec g = cubeGrid(0.8, 15);
   Mesh whole = meshGrid(tape, g, {}, 0);
   ASSERT_GT(whole.triangles.size(), 100u);
@@ -311,6 +316,25 @@ TEST(Mesh, ExtremumModelIsSplitInvariant) {
   const double a = 0.6, r = 0.2;
   const double vol = a * a * a + 6 * a * a * r + 3 * kPi * r * r * a + 4.0 / 3.0 * kPi * r * r * r;
   EXPECT_NEAR(mc::enclosedVolume(whole.positions, whole.triangles), vol, 0.03 * vol);
+}
+
+TEST(Mesh, ExtremumRootsStopAtTheSearchesPrecision) {
+  // Same rounded block: the roots stop once |f| is below 1% of the search's tolerance (the
+  // default), or run every Illinois step (rootStopValue = 0). The same vertices (edge keys)
+  // within a hundredth of a voxel, as many triangles (a quad's diagonal follows the vertices'
+  // positions), far fewer searches.
+  TapePtr tape = Tape::compile(roundedBlock(), 3);
+  GridSpec g = cubeGrid(0.8, 15);
+  MeshOptions full;
+  full.rootStopValue = 0.0;
+  Mesh a = meshGrid(tape, g, {}, 0), b = meshGrid(tape, g, full, 0);
+  ASSERT_EQ(a.keys, b.keys);
+  EXPECT_EQ(a.triangles.size(), b.triangles.size());
+  double worst = 0;
+  for (size_t v = 0; v < a.positions.size(); ++v)
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::fabs(a.positions[v][c] - b.positions[v][c]));
+  EXPECT_LT(worst, 0.01 * g.voxel);
+  EXPECT_LT(double(a.stats.rootEvals), 0.8 * double(b.stats.rootEvals));
 }
 
 TEST(Mesh, SelfIntersectionCheckFindsCrossings) {

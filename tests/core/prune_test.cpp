@@ -9,45 +9,14 @@
 
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/expr.h"
+#include "core/random_csg.h"
 
 using namespace frep;
+using frep::testing::randomCsg;
+using frep::testing::ringOfSpheres;
+using frep::testing::sphere;
 
 namespace {
-
-Expr sphere(double cx, double cy, double cz, double r) {
-  Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
-  return r * r - square(x - cx) - square(y - cy) - square(z - cz);
-}
-
-// Union of n spheres on a ring of radius 1.5 in the z = 0 plane (radius 0.4 each).
-Expr ringOfSpheres(int n) {
-  Expr u = sphere(1.5, 0.0, 0.0, 0.4);
-  for (int i = 1; i < n; ++i) {
-    double t = 2 * 3.141592653589793 * i / n;
-    u = max(u, sphere(1.5 * std::cos(t), 1.5 * std::sin(t), 0.0, 0.4));
-  }
-  return u;
-}
-
-// Random CSG tree: union max, intersection min, difference min(a, -b) (Pasko-Survey, R-functions
-// with a = 1) and a select on a half-space.
-Expr randomCsg(std::mt19937_64& rng, int depth) {
-  std::uniform_real_distribution<double> u(-1.5, 1.5);
-  if (depth == 0 || rng() % 6 == 0) {
-    if (rng() % 4 == 0) {  // plane n.x <= d
-      double nx = u(rng), ny = u(rng), nz = u(rng);
-      return 0.3 * u(rng) - nx * Expr::x(0) - ny * Expr::x(1) - nz * Expr::x(2);
-    }
-    return sphere(u(rng), u(rng), u(rng), 0.2 + 0.3 * std::fabs(u(rng)));
-  }
-  Expr a = randomCsg(rng, depth - 1), b = randomCsg(rng, depth - 1);
-  switch (rng() % 4) {
-    case 0: return max(a, b);
-    case 1: return min(a, b);
-    case 2: return min(a, -b);
-    default: return select(gt(Expr::x(int(rng() % 3)), u(rng)), a, b);
-  }
-}
 
 double randomIn(const Interval& r, std::mt19937_64& rng) {
   double v = r.lo + std::uniform_real_distribution<double>(0.0, 1.0)(rng) * r.width();
@@ -219,4 +188,26 @@ TEST(Prune, SixteenSpheresShrinkOnSmallBoxes) {
   std::printf("16 spheres: full tape %zu instrs, average pruned/full %.3f over %d boxes of 0.1^3\n", t->size(),
               avg, n);
   EXPECT_LT(avg, 0.2);
+}
+
+// A decided min/max becomes a copy of its kept input; copies are propagated to their readers, so
+// a union of spheres decided to one sphere is that sphere's instructions alone, no copy left.
+TEST(Prune, DecidedChoicesLeaveNoCopies) {
+  TapePtr t = Tape::compile(ringOfSpheres(32), 3);
+  IntervalEvaluator ie;
+  Interval box[3] = {{1.45, 1.55}, {-0.05, 0.05}, {-0.05, 0.05}};
+  ie.eval(*t, box);
+  TapePtr p = ie.pruned(t);
+  size_t copies = 0;
+  for (const Instr& ins : p->code()) copies += ins.op == Op::Copy;
+  EXPECT_EQ(copies, 0u);
+  TapePtr single = Tape::compile(sphere(1.5, 0.0, 0.0, 0.4), 3);
+  EXPECT_LE(p->size(), single->size());
+  PointEvaluator pe;
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 200; ++i) {
+    double x[3] = {randomIn(box[0], rng), randomIn(box[1], rng), randomIn(box[2], rng)};
+    const double a = pe.eval(*t, x), b = pe.eval(*p, x);
+    EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0);
+  }
 }

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <fstream>
@@ -17,8 +18,11 @@
 #include <thread>
 #include <vector>
 
+#include <zmq.hpp>
+
 #include "brick.h"
 #include "farm_master.h"
+#include "wire.h"
 
 extern char** environ;
 
@@ -126,6 +130,7 @@ struct WorkerProcess {
 struct MasterThread {
   FarmOutcome outcome;
   std::string error;
+  std::atomic<bool> finished{false};
   std::thread thread;
   std::promise<std::string> bound;
   std::shared_future<std::string> boundFuture = bound.get_future().share();
@@ -139,10 +144,26 @@ struct MasterThread {
         error = e.what();
         if (boundFuture.wait_for(std::chrono::seconds(0)) != std::future_status::ready) bound.set_value("");
       }
+      finished = true;
     });
   }
   std::string endpoint() { return boundFuture.get(); }
   void join() { thread.join(); }
 };
+
+// The envelopes of one kind a scripted peer receives within `ms`, or until `count` of them arrived.
+inline std::vector<Envelope> collectEnvelopes(zmq::socket_t& s, Envelope::BodyCase kind, size_t count, int ms) {
+  std::vector<Envelope> got;
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+  while (got.size() < count && std::chrono::steady_clock::now() < deadline) {
+    zmq::pollitem_t item{static_cast<void*>(s), 0, ZMQ_POLLIN, 0};
+    zmq::poll(&item, 1, std::chrono::milliseconds(20));
+    Incoming in;
+    std::string err;
+    while (got.size() < count && receive(s, false, in, &err))
+      if (err.empty() && in.envelope.body_case() == kind) got.push_back(in.envelope);
+  }
+  return got;
+}
 
 }  // namespace farmtest

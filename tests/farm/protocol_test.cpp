@@ -54,23 +54,30 @@ TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
   const std::string ep = master.endpoint();
 
   zmq::context_t ctx(1);
-  zmq::socket_t rogue(ctx, zmq::socket_type::dealer);
-  rogue.set(zmq::sockopt::linger, 0);
-  rogue.connect(ep);
+  // One connection per kind of garbage: the first garbage bans a routing id (the rest of what
+  // it sends is ignored, uncounted).
+  std::vector<zmq::socket_t> rogues;
+  auto rogueSocket = [&]() -> zmq::socket_t& {
+    rogues.emplace_back(ctx, zmq::socket_type::dealer);
+    rogues.back().set(zmq::sockopt::linger, 0);
+    rogues.back().connect(ep);
+    return rogues.back();
+  };
   std::mt19937 rng(7);
   std::string junk(300, '\0');
   for (auto& c : junk) c = char(rng());
-  rogue.send(zmq::buffer(junk));  // random bytes
+  rogues.reserve(8);
+  rogueSocket().send(zmq::buffer(junk));  // random bytes
   Envelope hello;
   hello.set_proto_major(kProtoMajor);
   hello.mutable_hello()->set_worker_id("rogue");
   std::string bytes;
   hello.SerializeToString(&bytes);
-  rogue.send(zmq::buffer(bytes.substr(0, bytes.size() - 3)));  // truncated protobuf
+  rogueSocket().send(zmq::buffer(bytes.substr(0, bytes.size() - 3)));  // truncated protobuf
   std::vector<zmq::const_buffer> three{zmq::buffer(bytes), zmq::str_buffer("a"), zmq::str_buffer("b")};
-  zmq::send_multipart(rogue, three);  // wrong frame count
+  zmq::send_multipart(rogueSocket(), three);  // wrong frame count
   std::string huge(2 << 20, 'x');
-  rogue.send(zmq::buffer(huge));  // oversized frame
+  rogueSocket().send(zmq::buffer(huge));  // oversized frame
   // A forged result for a brick the rogue never leased, with a bad payload.
   Envelope forged;
   forged.set_proto_major(kProtoMajor);
@@ -78,7 +85,7 @@ TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
   forged.mutable_result()->set_brick_id(1);
   forged.SerializeToString(&bytes);
   std::vector<zmq::const_buffer> withPayload{zmq::buffer(bytes), zmq::str_buffer("garbage")};
-  zmq::send_multipart(rogue, withPayload);
+  zmq::send_multipart(rogueSocket(), withPayload);
 
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   EXPECT_EQ(runWorker(ep), 0);  // a real worker finishes the job
@@ -148,19 +155,8 @@ TEST(Protocol, BrickForAPeerThatVanishedGoesBackToTheQueue) {
     send(s, "", hello);
     return s;
   };
-  // The envelopes of one kind received within `ms`, or until `count` of them arrived.
-  auto collect = [](zmq::socket_t& s, Envelope::BodyCase kind, size_t count, int ms = 10000) {
-    std::vector<Envelope> got;
-    auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
-    while (got.size() < count && std::chrono::steady_clock::now() < deadline) {
-      zmq::pollitem_t item{static_cast<void*>(s), 0, ZMQ_POLLIN, 0};
-      zmq::poll(&item, 1, std::chrono::milliseconds(20));
-      Incoming in;
-      std::string err;
-      while (got.size() < count && receive(s, false, in, &err))
-        if (err.empty() && in.envelope.body_case() == kind) got.push_back(in.envelope);
-    }
-    return got;
+  auto collect = [](zmq::socket_t& s, Envelope::BodyCase kind, size_t count) {
+    return collectEnvelopes(s, kind, count, 10000);
   };
   // "y" leases both bricks (two in flight per worker): nothing is pending.
   zmq::socket_t y = peer("y");

@@ -137,13 +137,29 @@ TEST(HfLibConvolution, TriangleMatchesNumericalIntegral) {
   auto v = vals({0, 0, 0, 2, 0, 0, 0, 1, 0.5}), S = vals({1.2});
   Expr f = call("hfConvTriangle", {arr(x), arr(v), arr(S), sc(0.3)});
   for (P3 p : {P3{0.5, 0.3, 0.6}, P3{3, -1, 1}, P3{-0.5, 0.5, -0.7}, P3{0.6, 0.2, 0.1}}) {
-    double expect = triangleIntegral(p, {0, 0, 0}, {2, 0, 0}, {0, 1, 0.5}, 1.2) - 0.3;
+    // hfp's scale: S^3 times the integral over the area.
+    double expect = std::pow(1.2, 3) * triangleIntegral(p, {0, 0, 0}, {2, 0, 0}, {0, 1, 0.5}, 1.2) - 0.3;
     expectClose(at(f, p.x, p.y, p.z), expect);
   }
   // Orientation does not matter.
   auto rev = vals({0, 1, 0.5, 2, 0, 0, 0, 0, 0});
   Expr g = call("hfConvTriangle", {arr(x), arr(rev), arr(S), sc(0.3)});
   expectClose(at(g, 3, -1, 1), at(f, 3, -1, 1));
+}
+
+// Values of hfp's own triangle formula (hfConvTriangle.c: edge-fan arctangents after sorting the
+// longest edge first, re-evaluated outside the project), which differ from the area integral by
+// the factor S^3.
+TEST(HfLibConvolution, TriangleAgreesWithHfpsFormula) {
+  auto x = xyz();
+  auto v = vals({0, 0, 0, 2, 0.3, 0, 0.5, 1.7, 0.4});
+  struct Case { P3 p; double S, hfp; };
+  for (Case c : {Case{{0.3, 0.4, 0.8}, 0.7, 0.257805386220661}, Case{{1, 1, -0.5}, 1.3, 0.6785274084178758},
+                 Case{{2, 2, 2}, 2.0, 0.018292663904778184}}) {
+    auto S = vals({c.S});
+    Expr f = call("hfConvTriangle", {arr(x), arr(v), arr(S), sc(0)});
+    expectClose(at(f, c.p.x, c.p.y, c.p.z), c.hfp);
+  }
 }
 
 TEST(HfLibConvolution, MeshSumsIndexedTriangles) {
@@ -153,7 +169,7 @@ TEST(HfLibConvolution, MeshSumsIndexedTriangles) {
   Expr f = call("hfConvMesh", {arr(x), arr(v), arr(tri), arr(S), sc(0.2)});
   P3 p = {0.2, 0.4, 0.9};
   double expect = triangleIntegral(p, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 1) +
-                  triangleIntegral(p, {1, 0, 0}, {1, 1, 1}, {0, 1, 0}, 2) - 0.2;
+                  8 * triangleIntegral(p, {1, 0, 0}, {1, 1, 1}, {0, 1, 0}, 2) - 0.2;
   expectClose(at(f, p.x, p.y, p.z), expect);
   auto badTri = vals({1, 2, 5, 2, 4, 3});
   auto err = errorOf("hfConvMesh", {arr(x), arr(v), arr(badTri), arr(S), sc(0.2)});
@@ -168,15 +184,23 @@ TEST(HfLibConvolution, ArcMatchesNumericalIntegral) {
   auto c = vals({1, 0, 0, 0, 0, 3}), rad = vals({2, 1}), th = vals({270, 360}),
        ax = vals({1, 0, 0, 0, 1, 0}), ang = vals({90, 0}), S = vals({1.1, 0.8});
   Expr f = call("hfConvArc", {arr(x), arr(c), arr(rad), arr(th), arr(ax), arr(ang), arr(S), sc(0.3)});
+  // hfp's scale and quirks: the integral over the angle (arc length integral / r), degrees with
+  // pi = 3.141592, axis components and angle + 1e-6.
+  const double deg = 3.141592 / 180, e = 1e-6;
+  auto unit = [](P3 u) {
+    double l = std::sqrt(u.x * u.x + u.y * u.y + u.z * u.z);
+    return P3{u.x / l, u.y / l, u.z / l};
+  };
+  auto arc1 = [&](P3 p) {
+    return arcIntegral(p, {1, 0, 0}, 2, 270 * deg, unit({1 + e, e, e}), (90 + e) * deg, 1.1) / 2;
+  };
   for (P3 p : {P3{1, 0.5, 1.5}, P3{-1, -0.5, 0.2}, P3{0.3, 0.2, 3.1}, P3{2.5, 1, -1}}) {
-    double expect = arcIntegral(p, {1, 0, 0}, 2, 1.5 * kPi, {1, 0, 0}, kPi / 2, 1.1) +
-                    arcIntegral(p, {0, 0, 3}, 1, 2 * kPi, {0, 1, 0}, 0, 0.8) - 0.3;
+    double expect = arc1(p) + arcIntegral(p, {0, 0, 3}, 1, 360 * deg, unit({e, 1 + e, e}), e * deg, 0.8) - 0.3;
     expectClose(at(f, p.x, p.y, p.z), expect);
   }
-  // On the axis of the full circle the integrand is constant: 2 pi r / (1 + S^2 (r^2 + h^2))^2.
-  double onAxis = 2 * kPi / std::pow(1 + 0.64 * (1 + 4), 2);
-  expectClose(at(f, 0, 0, 5), onAxis + arcIntegral({0, 0, 5}, {1, 0, 0}, 2, 1.5 * kPi,
-                                                    {1, 0, 0}, kPi / 2, 1.1) - 0.3);
+  // On the axis of the full circle the integrand is constant: 2 pi / (1 + S^2 (r^2 + h^2))^2.
+  double onAxis = 360 * deg / std::pow(1 + 0.64 * (1 + 4), 2);
+  expectClose(at(f, 0, 0, 5), onAxis + arc1({0, 0, 5}) - 0.3);
   auto shortTheta = vals({270});
   auto err = errorOf("hfConvArc", {arr(x), arr(c), arr(rad), arr(shortTheta, "th"), arr(ax),
                                    arr(ang), arr(S, "s"), sc(0.3)});
@@ -251,3 +275,25 @@ TEST(HfLibConvolution, LineRFromHyperFunSource) {
               std::min(1.0, lineIntegral({1, 0.7, 0.2}, {0, 0, 0}, {2, 0, 0}, 2)) - T);
   EXPECT_NEAR(frep::lang::testing::evalModel(m, {0, 0, 0.5}), 0.0, 1e-12);
 }
+
+namespace {
+
+// The plane is the limit of a growing triangle: hfConvTriangle over a triangle reaching 1e5
+// around the foot of the point (the tail beyond is below pi / (S R^2) ~ 1e-10).
+TEST(HfLibConvolution, PlaneIsTheLimitOfAGrowingTriangle) {
+  auto x = xyz();
+  auto p = vals({0.3, -0.2, 0.5}), n = vals({0, 0, 2}), S = vals({0.9});
+  Expr f = call("frConvPlane", {arr(x), arr(p), arr(n), arr(S), sc(0.1)});
+  auto big = vals({-1e5, -1e5, 0.5, 3e5, -1e5, 0.5, -1e5, 3e5, 0.5});
+  Expr g = call("hfConvTriangle", {arr(x), arr(big), arr(S), sc(0.1)});
+  for (P3 q : {P3{0, 0, 0.5}, P3{1, 2, 1.7}, P3{-3, 0.4, -0.8}}) {
+    double h = q.z - 0.5;
+    EXPECT_NEAR(at(f, q.x, q.y, q.z), kPi * 0.9 / (1 + 0.81 * h * h) - 0.1, 1e-12);
+    EXPECT_NEAR(at(f, q.x, q.y, q.z), at(g, q.x, q.y, q.z), 1e-7);
+  }
+  auto zero = vals({0, 0, 0});
+  auto err = errorOf("frConvPlane", {arr(x), arr(p), arr(zero, "n"), arr(S), sc(0.1)});
+  EXPECT_EQ(err.first, "frConvPlane: normal 1 of n is zero");
+}
+
+}  // namespace

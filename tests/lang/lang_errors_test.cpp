@@ -85,10 +85,14 @@ const ErrorCase kCases[] = {
      "index 4 is out of range for 'x' (elements 1 to 3)"},
     {"IndexRoundsOutOfRange", "m(x[3], a[1]) {\n  m = x[0.4];\n}", 2, 9,
      "index 0.4 is out of range for 'x' (elements 1 to 3)"},
-    {"IndexOnX", "m(x[3], a[1]) {\n  m = x[x[1]];\n}", 2, 9,
+    // Reads at an x-dependent index compile (a select chain); assignments do not.
+    {"IndexOnX", "m(x[3], a[1]) {\n  array v[2];\n  v[x[1]] = 1;\n  m = 1;\n}", 3, 5,
      "array index must be known at compile time; this one depends on x"},
-    {"IndexOnParameter", "m(x[3], a[1]) {\n  m = x[a[1]];\n}", 2, 9,
+    {"IndexOnParameter", "m(x[3], a[1]) {\n  array v[2];\n  v[a[1]] = 1;\n  m = 1;\n}", 3, 5,
      "array index must be known at compile time; this one depends on the parameters a[]"},
+    {"VaryingIndexUnassigned", "m(x[3], a[1]) {\n  array v[2];\n  v[1] = 1;\n  m = v[x[1]];\n}", 4, 7,
+     "element v[2] is not assigned, and this index depends on x, so it may read any element: "
+     "assign them all first"},
     {"LiteralSize", "m(x[3], a[1]) {\n  array v[2];\n  v = [1, 2, 3];\n  m = 1;\n}", 3, 3,
      "array 'v' has 2 elements but the literal has 3"},
     {"UnassignedElement", "m(x[3], a[1]) {\n  array v[2];\n  m = v[2];\n}", 3, 7,

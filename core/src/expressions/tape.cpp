@@ -165,53 +165,136 @@ TapePtr Tape::compile(const Expr& e, uint32_t nvars) {
   return tape;
 }
 
+// Tape::prune in one forward and one backward pass over reused per-thread buffers (interval
+// subdivision prunes once per box, so this runs millions of times).
+//
+// Forward: a decided min/max/select is a copy of its kept input, and later readers of its output
+// read the copy's source directly, as long as the source register still holds that value.
+// Registers are reused, so a copy is only postponed: just before an instruction overwrites a
+// source register, the copies still depending on it are emitted (and an extremum's input
+// registers, which its shared table names, always get their values first).
+// Backward: instructions whose results are no longer read are dropped; walking backwards with
+// the set of registers still needed is exact even with register reuse, because every
+// instruction's write kills the register's previous value.
+namespace {
+struct PruneScratch {
+  // Per register, valid only where its stamp equals the current prune's (no O(registers) reset
+  // per prune: a tape may have thousands of registers and a pruned one a few dozen instructions).
+  std::vector<uint32_t> alias;   // register whose value r holds (else r itself)
+  std::vector<int32_t> head;     // first node of r's dependents list (else none)
+  std::vector<uint32_t> stamp;   // alias/head valid
+  std::vector<uint32_t> needed;  // == stamp value: still read by a later kept instruction
+  uint32_t gen = 0;
+  std::vector<std::pair<uint32_t, int32_t>> nodes;  // (dependent, next); stale entries skipped
+  std::vector<Instr> fwd, kept;
+
+  void reserve(uint32_t numRegs) {
+    if (stamp.size() < numRegs)
+      alias.resize(numRegs), head.resize(numRegs), stamp.resize(numRegs, 0), needed.resize(numRegs, 0);
+  }
+  // A new stamp: everything stamped before reads as unset.
+  uint32_t fresh() {
+    if (++gen == 0) {  // wrapped: clear once every 2^32 stamps
+      std::fill(stamp.begin(), stamp.end(), 0u), std::fill(needed.begin(), needed.end(), 0u);
+      gen = 1;
+    }
+    return gen;
+  }
+  uint32_t aliasOf(uint32_t r) const { return stamp[r] == gen ? alias[r] : r; }
+  int32_t headOf(uint32_t r) const { return stamp[r] == gen ? head[r] : -1; }
+  void set(uint32_t r, uint32_t a, int32_t h) { stamp[r] = gen, alias[r] = a, head[r] = h; }
+};
+}  // namespace
+
 TapePtr Tape::prune(const std::vector<Choice>& choices, const TapePtr& self) const {
   if (choices.size() != code_.size()) throw std::invalid_argument("Tape::prune: choice count");
   bool any = false;
-  for (size_t i = 0; i < code_.size(); ++i)
-    if (choices[i] != Choice::Both && isChoiceOp(code_[i].op)) any = true;
+  for (size_t i = 0; i < code_.size() && !any; ++i)
+    any = choices[i] != Choice::Both && isChoiceOp(code_[i].op);
   if (!any) return self;
 
-  // Rewrite decided instructions into copies, then drop what is no longer read. Walking
-  // backwards with the set of registers still needed is exact even with register reuse,
-  // because every instruction's write kills the register's previous value.
-  std::vector<Instr> code = code_;
-  for (size_t i = 0; i < code.size(); ++i) {
-    Instr& ins = code[i];
-    if (!isChoiceOp(ins.op) || choices[i] == Choice::Both) continue;
-    uint32_t src;
-    if (ins.op == Op::Select) src = choices[i] == Choice::KeepA ? ins.b : ins.c;
-    else src = choices[i] == Choice::KeepA ? ins.a : ins.b;
-    ins = Instr{Op::Copy, ins.out, src, 0, 0, 0.0};
+  thread_local PruneScratch sc;
+  sc.reserve(numRegs_);
+
+  // Backward: keep what the result still reads (into `to`, in order); `from` is read in reverse.
+  auto dropDead = [&](const std::vector<Instr>& from, std::vector<Instr>& to, uint32_t result) {
+    const uint32_t need = sc.fresh();  // needed[r] == need: read by a later kept instruction
+    sc.needed[result] = need;
+    to.clear();
+    for (size_t i = from.size(); i-- > 0;) {
+      const Instr& ins = from[i];
+      if (sc.needed[ins.out] != need) continue;
+      sc.needed[ins.out] = 0;
+      if (ins.op == Op::Extremum) {
+        for (uint32_t r : (*extrema_)[ins.a].inputRegs) sc.needed[r] = need;
+      } else {
+        const int arity = opArity(ins.op);
+        if (arity > 0) sc.needed[ins.a] = need;
+        if (arity > 1) sc.needed[ins.b] = need;
+        if (arity > 2) sc.needed[ins.c] = need;
+      }
+      to.push_back(ins);
+    }
+    std::reverse(to.begin(), to.end());
+  };
+
+  // 1. Decided choices become copies of their kept input; drop what is no longer read.
+  sc.fwd.clear();
+  for (size_t i = 0; i < code_.size(); ++i) {
+    Instr ins = code_[i];
+    if (isChoiceOp(ins.op) && choices[i] != Choice::Both) {
+      uint32_t src;
+      if (ins.op == Op::Select) src = choices[i] == Choice::KeepA ? ins.b : ins.c;
+      else src = choices[i] == Choice::KeepA ? ins.a : ins.b;
+      ins = Instr{Op::Copy, ins.out, src, 0, 0, 0.0};
+    }
+    sc.fwd.push_back(ins);
   }
-  std::vector<char> needed(numRegs_, 0);
-  needed[result_] = 1;
-  std::vector<Instr> kept;
-  kept.reserve(code.size());
-  for (size_t i = code.size(); i-- > 0;) {
-    const Instr& ins = code[i];
-    if (!needed[ins.out]) continue;
-    needed[ins.out] = 0;
+  dropDead(sc.fwd, sc.kept, result_);
+
+  // 2. Forward the copies to their readers.
+  sc.fresh();
+  sc.nodes.clear();
+  bool settled = false;
+  auto settle = [&](uint32_t x) {  // x gets its own value
+    const uint32_t a = sc.aliasOf(x);
+    if (a == x) return;
+    sc.fwd.push_back(Instr{Op::Copy, x, a, 0, 0, 0.0});
+    sc.set(x, x, sc.headOf(x));
+    settled = true;
+  };
+  auto overwrite = [&](uint32_t r) {  // r is about to be written
+    for (int32_t n = sc.headOf(r); n >= 0; n = sc.nodes[size_t(n)].second)
+      if (sc.aliasOf(sc.nodes[size_t(n)].first) == r) settle(sc.nodes[size_t(n)].first);
+    sc.set(r, r, -1);  // whatever r aliased, it now gets a value of its own
+  };
+  sc.fwd.clear();
+  for (Instr ins : sc.kept) {
     if (ins.op == Op::Extremum) {
-      for (uint32_t r : (*extrema_)[ins.a].inputRegs) needed[r] = 1;
-      kept.push_back(ins);
+      for (uint32_t r : (*extrema_)[ins.a].inputRegs) settle(r);
+      overwrite(ins.out);
+      sc.fwd.push_back(ins);
       continue;
     }
-    int arity = opArity(ins.op);
-    if (arity > 0) needed[ins.a] = 1;
-    if (arity > 1) needed[ins.b] = 1;
-    if (arity > 2) needed[ins.c] = 1;
-    kept.push_back(ins);
+    const int arity = opArity(ins.op);
+    if (arity > 0) ins.a = sc.aliasOf(ins.a);
+    if (arity > 1) ins.b = sc.aliasOf(ins.b);
+    if (arity > 2) ins.c = sc.aliasOf(ins.c);
+    overwrite(ins.out);
+    if (ins.op == Op::Copy) {
+      if (ins.a != ins.out) {
+        sc.alias[ins.out] = ins.a;  // stamped by overwrite
+        sc.nodes.emplace_back(ins.out, sc.headOf(ins.a));
+        sc.set(ins.a, sc.aliasOf(ins.a), int32_t(sc.nodes.size() - 1));
+      }
+      continue;
+    }
+    sc.fwd.push_back(ins);
   }
-  std::reverse(kept.begin(), kept.end());
-
-  // A copy into the result register at the very end can be folded away by redirecting the
-  // result (saves one pass over the batch).
-  uint32_t result = result_;
-  while (!kept.empty() && kept.back().op == Op::Copy && kept.back().out == result) {
-    result = kept.back().a;
-    kept.pop_back();
-  }
+  const uint32_t result = sc.aliasOf(result_);
+  // 3. A copy emitted because its source was about to be overwritten may not be read again.
+  if (settled) dropDead(sc.fwd, sc.kept, result);
+  else sc.kept.swap(sc.fwd);
 
   TapePtr out = TapeBuilder::make();
   Tape& t = TapeBuilder::mut(out);
@@ -220,7 +303,7 @@ TapePtr Tape::prune(const std::vector<Choice>& choices, const TapePtr& self) con
   t.uniforms_ = uniforms_;
   t.extrema_ = extrema_;
   t.result_ = result;
-  t.code_ = std::move(kept);
+  t.code_ = sc.kept;
   for (auto& ins : t.code_)
     if (isChoiceOp(ins.op)) ++t.numChoices_;
   t.sinCos_ = planSinCos(t.code_, t.numRegs_);

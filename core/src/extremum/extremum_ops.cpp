@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "frep/expressions/min_max_form.h"
 #include "frep/extremum/extremum.h"
 #include "frep/primitives/ops.h"
 
@@ -41,6 +42,9 @@ ExtremumSpec baseSpec(ExtremumKind kind, uint32_t n, uint32_t m, const SearchOpt
   return s;
 }
 
+// The operand as the search sees it (SearchOptions::minMaxOperands).
+Expr searched(const Expr& f, const SearchOptions& o) { return o.minMaxOperands ? minMaxForm(f) : f; }
+
 }  // namespace
 
 Expr minkowskiBalls(const std::vector<double>& c1, double r1, const std::vector<double>& c2, double r2) {
@@ -69,7 +73,7 @@ Expr minkowskiSum(const Expr& A, const Expr& B, uint32_t n, const Bounds& bounds
     xb.push_back(Expr::x(n + i));
   }
   ExtremumSpec s = baseSpec(ExtremumKind::Max, n, n, o);
-  s.body = rIntersection(remap(A, xa), remap(B, xb), o.a);
+  s.body = rIntersection(remap(searched(A, o), xa), remap(searched(B, o), xb), o.a);
   s.domain = DomainKind::Box;
   s.lo = boundsB.lo;
   s.hi = boundsB.hi;
@@ -87,7 +91,7 @@ Expr minkowskiDifference(const Expr& A, const Expr& B, uint32_t n, const Bounds&
     xb.push_back(Expr::x(n + i));
   }
   ExtremumSpec s = baseSpec(ExtremumKind::Min, n, n, o);
-  s.body = max(remap(A, xa), -remap(B, xb));
+  s.body = max(remap(searched(A, o), xa), -remap(searched(B, o), xb));
   s.domain = DomainKind::Box;
   s.lo = boundsB.lo;
   s.hi = boundsB.hi;
@@ -112,7 +116,7 @@ Expr project(const Expr& A, uint32_t totalDims, const std::vector<uint32_t>& hid
   for (uint32_t i = 0, k = 0; i < totalDims; ++i)
     if (!hidden[i]) vars[i] = Expr::x(k++);
   ExtremumSpec s = baseSpec(ExtremumKind::Max, n, m, o);
-  s.body = remap(A, vars);
+  s.body = remap(searched(A, o), vars);
   s.domain = DomainKind::Box;
   s.lo = box.lo;
   s.hi = box.hi;
@@ -148,7 +152,7 @@ Expr sweep(const Expr& A, uint32_t n, const Motion& motion, double t0, double t1
   }
   y.push_back(t);  // a time-varying shape reads t as x[n]
   ExtremumSpec s = baseSpec(ExtremumKind::Max, n, 1, o);
-  s.body = remap(A, y);
+  s.body = remap(searched(A, o), y);
   s.domain = DomainKind::Box;
   s.lo = {t0};
   s.hi = {t1};
@@ -162,7 +166,7 @@ Expr offsetRadius(const Expr& A, uint32_t n, double r, const SearchOptions& o, b
   std::vector<Expr> xa;
   for (uint32_t i = 0; i < n; ++i) xa.push_back(Expr::x(i) + Expr::x(n + i));
   ExtremumSpec s = baseSpec(r > 0 ? ExtremumKind::Max : ExtremumKind::Min, n, n, o);
-  s.body = remap(A, xa);
+  s.body = remap(searched(A, o), xa);
   if (n == 1) {
     s.domain = DomainKind::Box;
     s.lo = {-R};  // 1D: the segment (the two-point "sphere" is not searched separately)

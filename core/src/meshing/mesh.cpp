@@ -8,6 +8,7 @@
 // split along their shorter diagonal. Every step depends on the edge or the cell only, never on
 // the region, so adjacent pieces agree on shared vertices and the merged mesh is split-free.
 #include "frep/meshing/mesh.h"
+#include "frep/extremum/extremum.h"
 
 #include <tbb/enumerable_thread_specific.h>
 
@@ -198,6 +199,9 @@ class RegionMesher {
     }
     sampled_ = sample(tape_, grid_, so);
     piece.stats.samplePointEvals = sampled_.stats.pointEvals;
+    piece.stats.sampleIntervalEvals = sampled_.stats.intervalEvals;
+    piece.stats.nanValues = sampled_.stats.nanValues;
+    piece.stats.domainErrors = sampled_.stats.domainErrors;
     for (size_t i = 0; i < sampled_.leaves.size(); ++i) leafIndex_[blockKey(sampled_.leaves[i].origin)] = i;
     for (const Tile& t : sampled_.tiles) tileSign_[tileKey(t.origin, t.size)] = t.inside;
     maxTile_ = 8;
@@ -432,6 +436,19 @@ class RegionMesher {
       last[l] = 0;
     }
     const bool useBatch = !tape.hasExtrema();  // batch extremum lanes warm-start each other
+    // An extremum's value is certified only within its search's tolerance (and is usually far
+    // better: the incumbent is polished by local ascent), and every step costs a search per
+    // lane: a lane stops once |f| is below MeshOptions::rootStopValue (a test of the lane
+    // alone, so every vertex stays a function of its edge).
+    double noise = opt_.rootStopValue;
+    if (noise < 0) {
+      noise = 0.0;
+      if (tape.hasExtrema()) {
+        noise = INFINITY;
+        for (const ExtremumEntry& e : tape.extrema())
+          noise = std::min(noise, e.spec->method == ExtremumMethod::BranchAndBound ? 0.01 * e.spec->tolerance : 0.0);
+      }
+    }
     std::vector<double> tv(count), fv(count);
     // Evaluates f at tv for the lanes not done, packed together (a lane's value never depends on
     // the other lanes: batches of extremum tapes are avoided, their lanes warm-start each other).
@@ -492,6 +509,7 @@ class RegionMesher {
           continue;
         }
         if (it > 0 && std::abs(t - prevT[l]) < 1e-10) done[l] = true;
+        if (noise > 0 && std::abs(f) <= noise) done[l] = true;
         prevT[l] = t;
         if (std::isnan(f)) illinois[l] = false;
         if (insideValue(f)) {

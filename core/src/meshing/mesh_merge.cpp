@@ -35,6 +35,9 @@ Mesh mergeKeyed(const std::vector<MeshPiece>& pieces, const std::function<void(s
     s.gradientEvals += p.stats.gradientEvals;
     s.samplePointEvals += p.stats.samplePointEvals;
     s.fallbackEdges += p.stats.fallbackEdges;
+    s.sampleIntervalEvals += p.stats.sampleIntervalEvals;
+    s.nanValues += p.stats.nanValues;
+    s.domainErrors.add(p.stats.domainErrors);
     const SimplifyCarry& c = p.carry;
     mesh.carry.counters += c.counters;
     if (!c.triangles.empty() && c.triangles.size() != p.triangles.size())

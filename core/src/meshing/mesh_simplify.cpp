@@ -218,6 +218,10 @@ class Simplifier {
 
   void setUp() {
     const size_t nv = w_.pos.size();
+    // Where the surface leaves the grid's box the mesh ends in an open rim on the box's faces:
+    // its vertices stay where the mesher put them (moving one would cut a notch into the rim).
+    for (size_t v = 0; v < nv; ++v)
+      if (onBoxFace(w_.pos[v])) w_.locked[v] = 1;
     alive_.assign(nv, 1);
     version_.assign(nv, 0);
     vtris_.assign(nv, {});
@@ -238,6 +242,15 @@ class Simplifier {
   }
 
   // ---- positions ------------------------------------------------------------------------
+  bool onBoxFace(const V3& p) const {
+    const double eps = 1e-6 * grid_.voxel;
+    for (int k = 0; k < 3; ++k) {
+      const double lo = grid_.origin[k], hi = grid_.origin[k] + double(grid_.dims[k] - 1) * grid_.voxel;
+      if (p[k] <= lo + eps || p[k] >= hi - eps) return true;
+    }
+    return false;
+  }
+
   exact::P quantise(const V3& p) const {
     exact::P q;
     for (int k = 0; k < 3; ++k) q[k] = std::llround((p[k] - grid_.origin[k]) / grid_.voxel * kQuantum);

@@ -1,5 +1,5 @@
 // Output files appear whole on commit, or not at all.
-#include "atomic_output.h"
+#include "frep/io/atomic_output.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -9,6 +9,7 @@
 #include "exit_codes.h"
 
 using namespace frep::cli;
+using namespace frep::io;
 
 namespace {
 bool exists(const std::string& p) {

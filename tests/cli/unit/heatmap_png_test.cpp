@@ -6,10 +6,11 @@
 #include <cmath>
 #include <cstring>
 
-#include "heatmap.h"
-#include "png_writer.h"
+#include "frep/io/heatmap.h"
+#include "frep/io/png_writer.h"
 
-using namespace frep::cli;
+
+using namespace frep::io;
 
 TEST(Heatmap, RampsAreWarmInsideCoolOutsideAndDarkenWithDepth) {
   for (double t : {0.0, 0.3, 0.7, 1.0}) {

@@ -123,6 +123,10 @@ struct SearchOptions {
   double tolerance = 1e-3;  // B&B gap
   uint32_t maxBoxes = 20000;
   uint32_t intervalBudget = 24;
+  // Search the operands in their min/max form (frep/expressions/min_max_form.h): the same set,
+  // searched as fast as if it had been written with min/max; the node's value is then that of
+  // the min/max form. false: the operands' R-functions as written (slower, same set).
+  bool minMaxOperands = true;
 };
 
 struct MinkowskiOptions : SearchOptions {

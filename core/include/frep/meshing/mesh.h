@@ -62,6 +62,10 @@ struct MeshStats {
   uint64_t gradientEvals = 0;   // normals
   uint64_t samplePointEvals = 0;  // evaluations of the band sampling (grid points)
   uint64_t fallbackEdges = 0;   // edges whose end values disagreed with their signs (bisection)
+  // The band sampling's: NaN grid values and documented domain-error values. Not in the farm's
+  // mesh payload: workers send them in the result message, as for `frep sample`.
+  uint64_t sampleIntervalEvals = 0, nanValues = 0;
+  DomainCounts domainErrors;
 };
 
 // The simplifier's work counters (mesh_simplify.h), summed over passes, blocks and bricks.
@@ -119,6 +123,10 @@ struct MeshOptions {
   std::vector<double> fixedCoords;  // values of x[3], x[4], ... for models of dimension > 3
   int threads = 0;                  // 0: TBB's default; 1: serial (the result is the same)
   int rootIterations = 10;          // Illinois steps per edge after its two end values
+  // An edge's root search stops once |f| <= this. Negative (the default): 1% of the smallest
+  // branch-and-bound tolerance among the model's extremum nodes (0 for models without them):
+  // their searches' values are certified only that far, and each step costs a search.
+  double rootStopValue = -1.0;
   // Roots are kept at least this fraction of the edge away from its ends, so no two vertices
   // coincide and no triangle is degenerate (the surface moves by at most this much).
   double endGuard = 1e-3;

@@ -106,6 +106,8 @@ class ObjectLowering {
   // ---- expressions ------------------------------------------------------------------------
   // Folds an index to a constant, rounds it (ties up) and checks it against the array (0-based).
   size_t constIndex(const AstExpr& e, const Value& arr);
+  size_t constIndex(const AstExpr& e, const Expr& index, const Value& arr);  // index lowered
+  Expr readVaryingElement(const AstExpr& e, Value& arr, const Expr& index);
   Expr lower(const AstExpr& e);
   bool isCallable(const std::string& name) const;
   Expr readScalar(const AstExpr& e);

@@ -1,0 +1,31 @@
+// Which expression nodes are exact Minkowski terms. The language's basic-set primitives and the
+// exact frMinkowski / frMinkowskiDiff results register their field's node here, so a later
+// Minkowski operation (or `frep pov`) sees that an operand is a basic-set sum and uses the
+// algebra instead of the extremum search. Nodes are hash-consed, so equal fields share one
+// entry; the table keeps registered nodes alive. Thread-safe.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "frep/expressions/expr.h"
+#include "frep/minkowski_algebra/basic_set.h"
+
+namespace frep::minkowski {
+
+struct ExactTerm {
+  enum class Kind { Sum, Erosion } kind = Kind::Sum;
+  Sum sum;         // Sum: the secondary object; Erosion: the subtracted sum C1 ⊕ … ⊕ CN
+  Sum c0;          // Erosion: the solid eroded (a block or a sphere)
+  int pieces = 0;  // primitives of the union (Sum) or intersection (Erosion)
+};
+
+void registerExact(const Expr& e, const ExactTerm& t);
+std::optional<ExactTerm> lookupExact(const Expr& e);
+
+// One line per registered sum of two or more members (or chain) reachable in f ("exact Minkowski algebra (Roerdink): union of
+// 28 primitives, error bound 0"), for job reports next to the extremum nodes' bounds.
+std::vector<std::string> describeExact(const Expr& f);
+
+}  // namespace frep::minkowski

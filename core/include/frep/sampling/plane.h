@@ -1,0 +1,43 @@
+// Values of a model on a regular 2D lattice of a plane (a slice image), by quadtree interval
+// subdivision with tape pruning per tile: each tile's pixels are evaluated with the tape its
+// box decided, which is bit-identical to the full tape there, so the result does not depend on
+// the pruning, the tile size or the thread count. With signOnly, tiles whose interval decides
+// the sign are not evaluated at all (their pixels get +inf / -inf): the cost then follows the
+// boundary, not the area.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "frep/expressions/tape.h"
+
+namespace frep {
+
+struct PlaneLattice {
+  uint32_t u = 0, v = 1;  // model coordinates along the image's columns and rows
+  int normal = -1;        // coordinate held at `at` (-1: none)
+  double at = 0.0;
+  std::vector<double> fixed;  // values of further coordinates (index 3, 4, ...), if any
+  double origin[2] = {0, 0};  // (u, v) of the bottom-left pixel
+  double step = 1.0;          // pixel spacing in model units
+  int width = 0, height = 0;  // row 0 is the top row (v = origin[1] + (height - 1) * step)
+};
+
+struct PlaneStats {
+  uint64_t pointEvals = 0;     // pixels evaluated
+  uint64_t intervalEvals = 0;  // tiles classified
+  uint64_t tapeInstrs = 0;     // sum over evaluated batches of the pruned tape's length
+  uint64_t tapeBatches = 0;
+  uint64_t decidedPixels = 0;  // pixels whose sign a tile decided (signOnly: not evaluated)
+};
+
+struct PlaneOptions {
+  bool signOnly = false;
+  int threads = 0;  // 0: TBB's default, 1: serial
+};
+
+// width * height values, row-major from the top row.
+std::vector<double> evaluatePlane(const TapePtr& tape, const PlaneLattice& lattice,
+                                  const PlaneOptions& options = {}, PlaneStats* stats = nullptr);
+
+}  // namespace frep

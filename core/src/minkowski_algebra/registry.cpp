@@ -1,0 +1,52 @@
+// The table of exact Minkowski terms, keyed by hash-consed node (registry.h).
+#include "frep/minkowski_algebra/registry.h"
+
+#include <mutex>
+#include <unordered_map>
+
+namespace frep::minkowski {
+namespace {
+struct Entry {
+  NodePtr keep;  // keeps the node (and so its address) alive
+  ExactTerm term;
+};
+std::mutex gMutex;
+// Never destroyed: its nodes must not outlive the intern table's static destruction.
+std::unordered_map<const Node*, Entry>& table() {
+  static auto* t = new std::unordered_map<const Node*, Entry>();
+  return *t;
+}
+}  // namespace
+
+void registerExact(const Expr& e, const ExactTerm& t) {
+  std::lock_guard<std::mutex> lock(gMutex);
+  table()[&e.node()] = Entry{e.ptr(), t};
+}
+
+std::optional<ExactTerm> lookupExact(const Expr& e) {
+  std::lock_guard<std::mutex> lock(gMutex);
+  auto it = table().find(&e.node());
+  if (it == table().end()) return std::nullopt;
+  return it->second.term;
+}
+
+std::vector<std::string> describeExact(const Expr& f) {
+  std::vector<std::string> lines;
+  forEachNode(f, [&](const Node& n) {
+    std::lock_guard<std::mutex> lock(gMutex);
+    auto it = table().find(&n);
+    if (it == table().end()) return;
+    const ExactTerm& t = it->second.term;
+    if (t.kind == ExactTerm::Kind::Sum && t.sum.terms < 2) return;  // a member alone: no operation
+    if (t.kind == ExactTerm::Kind::Sum)
+      lines.push_back("exact Minkowski algebra (Roerdink): " + t.sum.describe() + " as a union of " +
+                      std::to_string(t.pieces) + " primitives, error bound 0 (no search)");
+    else
+      lines.push_back("exact Minkowski subtraction chain (Roerdink eq. 19-21): " + t.c0.describe() +
+                      " minus " + t.sum.describe() + " as an intersection of " +
+                      std::to_string(t.pieces) + " terms, error bound 0 (no search)");
+  });
+  return lines;
+}
+
+}  // namespace frep::minkowski

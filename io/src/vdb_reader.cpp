@@ -1,0 +1,302 @@
+// A FloatGrid (frep sample's output) read back as sampled values for meshSamples; see
+// vdb_reader.h. One of the two translation units of frep that include OpenVDB.
+#include "frep/io/vdb_reader.h"
+
+#include <openvdb/openvdb.h>
+#include <spdlog/spdlog.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <new>
+#include <unordered_set>
+#include <vector>
+
+#include "vdb_checksum.h"
+
+#include "frep/io/format_number.h"
+#include "frep/io/error.h"
+
+namespace frep::io {
+namespace {
+
+std::string gridList(const openvdb::GridPtrVec& grids) {
+  if (grids.empty()) return "it holds no grids";
+  std::string s = "it holds";
+  for (size_t i = 0; i < grids.size(); ++i)
+    s += std::string(i ? "," : "") + " '" + grids[i]->getName() + "' (" + grids[i]->valueType() + ")";
+  return s;
+}
+
+// An 8^3 block by its origin relative to the grid's lowest leaf origin `lo` (non-negative, and
+// below 2^19 + 8 voxels: 21 bits per axis).
+uint64_t blockId(const int64_t lo[3], int64_t x, int64_t y, int64_t z) {
+  return (uint64_t((x - lo[0]) >> 3) << 42) | (uint64_t((y - lo[1]) >> 3) << 21) | uint64_t((z - lo[2]) >> 3);
+}
+
+// The file's layout checked before OpenVDB sees it (OpenVDB trusts every length it reads and
+// reads past the end of a truncated file): the header, the file's metadata, each grid's
+// descriptor and metadata, every length bounded by what is left, the grids' offsets increasing
+// and the last grid ending exactly at the end of the file. Throws Error(kExitIoError).
+class LayoutCheck {
+ public:
+  LayoutCheck(const std::string& path, std::string bytes) : path_(path), b_(std::move(bytes)) {}
+
+  void run() {
+    if (u32(4) != 0 || u32(0) != 0x56444220) fail("not a VDB file (bad magic number)");
+    pos_ = 8;
+    const uint32_t version = u32();
+    if (version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION || version > openvdb::OPENVDB_FILE_VERSION)
+      fail("file format version " + std::to_string(version) + " is not supported (" +
+           std::to_string(openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) + " to " +
+           std::to_string(openvdb::OPENVDB_FILE_VERSION) + ")");
+    skip(8);  // library version
+    if (byte() != 1) fail("the file has no grid offsets (a stream, not a file)");
+    skip(36);  // UUID
+    metaMap(b_.size());
+    const uint32_t grids = u32();
+    if (grids > remaining() / 36) fail("declares " + std::to_string(grids) + " grids");
+    for (uint32_t g = 0; g < grids; ++g) {
+      string();  // name
+      string();  // type
+      string();  // instance parent
+      const uint64_t gridPos = u64(), blockPos = u64(), endPos = u64();
+      if (gridPos != pos_ || blockPos < gridPos || endPos < blockPos || endPos > b_.size())
+        fail("grid " + std::to_string(g) + "'s offsets " + std::to_string(gridPos) + ", " + std::to_string(blockPos) +
+             ", " + std::to_string(endPos) + " do not fit in the file's " + std::to_string(b_.size()) +
+             " bytes (truncated or damaged)");
+      skip(4);  // compression flags
+      metaMap(blockPos);
+      pos_ = endPos;
+    }
+    if (pos_ != b_.size())
+      fail(std::to_string(b_.size() - pos_) + " bytes after the last grid (damaged, or not written by OpenVDB)");
+    // frep sample's files are sealed (a tool that rewrites one must drop the seal; unsealed files
+    // get the layout checks only).
+    if (checksumAt_ && b_.compare(checksumAt_, kChecksumDigits, vdbChecksum(b_, checksumAt_)) != 0)
+      fail("the contents do not match " + std::string(kGridChecksumKey) + " (the file is damaged)");
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& why) const { throw ioError("cannot read VDB '" + path_ + "': " + why); }
+  uint64_t remaining() const { return b_.size() - pos_; }
+  void need(uint64_t n) const {
+    if (n > remaining()) fail("truncated at byte " + std::to_string(b_.size()) + " (needs " + std::to_string(n) +
+                              " more bytes at " + std::to_string(pos_) + ")");
+  }
+  void skip(uint64_t n) {
+    need(n);
+    pos_ += n;
+  }
+  uint32_t u32(size_t at) const {
+    uint32_t v = 0;
+    if (at + 4 <= b_.size()) std::memcpy(&v, b_.data() + at, 4);
+    return v;
+  }
+  uint32_t u32() {
+    need(4);
+    uint32_t v = u32(pos_);
+    pos_ += 4;
+    return v;
+  }
+  uint64_t u64() {
+    need(8);
+    uint64_t v;
+    std::memcpy(&v, b_.data() + pos_, 8);
+    pos_ += 8;
+    return v;
+  }
+  uint8_t byte() {
+    need(1);
+    return uint8_t(b_[pos_++]);
+  }
+  std::string string() {
+    const uint32_t n = u32();
+    need(n);
+    pos_ += n;
+    return b_.substr(pos_ - n, n);
+  }
+  // OpenVDB's MetaMap: count, then (name, type name, size, value) each; within [pos_, end).
+  void metaMap(uint64_t end) {
+    const uint32_t count = u32();
+    for (uint32_t i = 0; i < count; ++i) {
+      const std::string name = string(), type = string();
+      const uint32_t size = u32();
+      if (name == kGridChecksumKey && type == "string" && size == kChecksumDigits) checksumAt_ = pos_;
+      skip(size);
+      if (pos_ > end) fail("metadata runs past its grid (damaged)");
+    }
+  }
+
+  std::string path_, b_;
+  uint64_t pos_ = 0;
+  uint64_t checksumAt_ = 0;  // the checksum's digits, if the file has them
+};
+
+constexpr uint64_t kMaxVdbBytes = uint64_t(16) << 30;  // frep mesh reads at most 16 GiB
+
+void checkLayout(const std::string& path) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) throw ioError("cannot read VDB '" + path + "': " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) throw ioError("cannot read VDB '" + path + "': not a regular file");
+  if (uint64_t(st.st_size) > kMaxVdbBytes)
+    throw ioError("cannot read VDB '" + path + "': " + std::to_string(st.st_size) + " bytes, more than the " +
+                  std::to_string(kMaxVdbBytes >> 30) + " GiB frep mesh reads");
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes(size_t(st.st_size), '\0');
+  if (!in.read(bytes.data(), std::streamsize(bytes.size())) || in.peek() != EOF)
+    throw ioError("cannot read VDB '" + path + "': the file changed or could not be read to its end");
+  LayoutCheck(path, std::move(bytes)).run();
+}
+
+}  // namespace
+
+SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) {
+  openvdb::initialize();
+  SampledVdb out;
+  openvdb::FloatGrid::Ptr grid;
+  checkLayout(path);
+  try {
+    openvdb::io::File file(path);
+    file.open(false);  // read everything now: a corrupt file fails here, not half way through
+    openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();
+    openvdb::GridBase::ConstPtr chosen;
+    for (const auto& g : *metas) {
+      if (gridName.empty() ? g->isType<openvdb::FloatGrid>() : g->getName() == gridName) {
+        chosen = g;
+        break;
+      }
+    }
+    if (!chosen) {
+      file.close();
+      if (gridName.empty())
+        throw Error(kExitModelError, path + ": no float grid to mesh (" + gridList(*metas) +
+                                            "); frep mesh reads the FloatGrid written by frep sample");
+      throw Error(kExitModelError, path + ": no grid named '" + gridName + "' (-o/--object); " + gridList(*metas));
+    }
+    if (!chosen->isType<openvdb::FloatGrid>()) {
+      file.close();
+      throw Error(kExitModelError, path + ": grid '" + chosen->getName() + "' holds " + chosen->valueType() +
+                                          " values; frep mesh needs a float grid (as written by frep sample)");
+    }
+    out.gridName = chosen->getName();
+    grid = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(out.gridName));
+    file.close();
+  } catch (const openvdb::Exception& e) {
+    throw ioError("cannot read VDB '" + path + "': " + e.what());
+  } catch (const std::ios_base::failure& e) {
+    throw ioError("cannot read VDB '" + path + "': " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw ioError("cannot read VDB '" + path + "': out of memory (sizes in the file are damaged, or it is too large)");
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {  // e.g. std::length_error from a damaged size: bad input, not a bug
+    throw ioError("cannot read VDB '" + path + "': damaged (" + std::string(e.what()) + ")");
+  }
+  if (!grid) throw ioError("cannot read VDB '" + path + "': grid '" + out.gridName + "' could not be loaded");
+  if (grid->getGridClass() != openvdb::GRID_LEVEL_SET)
+    spdlog::warn("{}: grid '{}' is not a level set (class {}); meshing where its values change sign, negative inside",
+                 path, out.gridName, openvdb::GridBase::gridClassToString(grid->getGridClass()));
+
+  const openvdb::FloatTree& tree = grid->tree();
+  // Leaf origins shifted to be >= 0 (multiples of 8, so the shift keeps them aligned).
+  int64_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  size_t leafCount = 0;
+  for (auto it = tree.cbeginLeaf(); it; ++it, ++leafCount) {
+    const openvdb::Coord o = it->origin();
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min<int64_t>(lo[a], o[a]);
+      hi[a] = std::max<int64_t>(hi[a], int64_t(o[a]) + kLeafDim);
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+    if (hi[a] - lo[a] >= kMaxMeshGridPoints)
+      throw Error(kExitModelError, path + ": grid '" + out.gridName + "' spans " + std::to_string(hi[a] - lo[a]) +
+                                          " voxels along an axis; frep mesh handles up to " +
+                                          std::to_string(kMaxMeshGridPoints - 1));
+  SampleResult& s = out.samples;
+  s.leaves.reserve(leafCount);
+  std::unordered_set<uint64_t> leafIds;
+  leafIds.reserve(leafCount * 2);
+  for (auto it = tree.cbeginLeaf(); it; ++it) {
+    const openvdb::Coord o = it->origin();
+    LeafBlock b;
+    b.origin = {int32_t(o[0] - lo[0]), int32_t(o[1] - lo[1]), int32_t(o[2] - lo[2])};
+    b.active.fill(0);
+    for (openvdb::Index n = 0; n < openvdb::Index(kLeafVoxels); ++n) {
+      b.values[n] = -it->getValue(n);  // exact: the stored value is -f
+      if (it->isValueOn(n)) b.active[n >> 6] |= uint64_t(1) << (n & 63);
+    }
+    s.leaves.push_back(b);
+    leafIds.insert(blockId(lo, o[0], o[1], o[2]));
+  }
+  // Sign tiles for the blocks next to leaves (their gradients at the band's edge).
+  openvdb::FloatGrid::ConstAccessor acc = grid->getConstAccessor();
+  std::unordered_set<uint64_t> tileIds;
+  for (auto it = tree.cbeginLeaf(); it; ++it) {
+    const openvdb::Coord o = it->origin();
+    for (int n = 0; n < 27; ++n) {
+      if (n == 13) continue;
+      const openvdb::Coord b(o[0] + 8 * (n % 3 - 1), o[1] + 8 * (n / 3 % 3 - 1), o[2] + 8 * (n / 9 - 1));
+      if (b[0] < lo[0] || b[1] < lo[1] || b[2] < lo[2]) continue;
+      const uint64_t id = blockId(lo, b[0], b[1], b[2]);
+      if (leafIds.count(id) || !tileIds.insert(id).second) continue;
+      const float v = acc.getValue(b);
+      s.tiles.push_back(Tile{{int32_t(b[0] - lo[0]), int32_t(b[1] - lo[1]), int32_t(b[2] - lo[2])}, kLeafDim,
+                             std::signbit(v) && !std::isnan(v)});
+    }
+  }
+  sortByOrigin(s.leaves, s.tiles);
+  for (int a = 0; a < 3; ++a) s.grid.dims[a] = int32_t(hi[a] - lo[a]);
+
+  // The transform: a uniform scale and a translation becomes the GridSpec itself.
+  const openvdb::math::Transform::Ptr xform = grid->transformPtr();
+  bool scaleTranslate = false;
+  if (xform->isLinear()) {
+    const openvdb::Mat4d m = xform->baseMap()->getAffineMap()->getMat4();
+    const double v = m(0, 0);
+    scaleTranslate = v > 0 && m(1, 1) == v && m(2, 2) == v && m(0, 1) == 0 && m(0, 2) == 0 && m(1, 0) == 0 &&
+                     m(1, 2) == 0 && m(2, 0) == 0 && m(2, 1) == 0;
+    if (scaleTranslate) {
+      s.grid.voxel = v;
+      for (int a = 0; a < 3; ++a) s.grid.origin[a] = m(3, a) + double(lo[a]) * v;
+      out.transformDescription = "voxel " + formatNumber(v) + ", index (0,0,0) at (" + formatNumber(m(3, 0)) + ", " +
+                                 formatNumber(m(3, 1)) + ", " + formatNumber(m(3, 2)) + ")";
+    }
+  }
+  if (!scaleTranslate) {
+    s.grid.voxel = 1.0;
+    for (int a = 0; a < 3; ++a) s.grid.origin[a] = double(lo[a]);
+    out.transformDescription = "transform " + xform->mapType() + " (applied to the index-space mesh)";
+    const bool mirror = xform->baseMap()->determinant(openvdb::Vec3d(0, 0, 0)) < 0;
+    out.toWorld = [xform, mirror](Mesh& mesh) {
+      for (size_t i = 0; i < mesh.positions.size(); ++i) {
+        const openvdb::Vec3d p(mesh.positions[i][0], mesh.positions[i][1], mesh.positions[i][2]);
+        openvdb::Vec3d n = xform->baseMap()->applyIJT(
+            openvdb::Vec3d(mesh.normals[i][0], mesh.normals[i][1], mesh.normals[i][2]), p);
+        const double len = n.length();
+        if (len > 0 && std::isfinite(len)) n /= len;
+        const openvdb::Vec3d w = xform->indexToWorld(p);
+        for (int a = 0; a < 3; ++a) {
+          mesh.positions[i][a] = w[a];
+          if (len > 0 && std::isfinite(len)) mesh.normals[i][a] = n[a];
+        }
+      }
+      if (mirror) {
+        for (auto& t : mesh.triangles) std::swap(t[1], t[2]);  // the smallest index stays first
+        std::sort(mesh.triangles.begin(), mesh.triangles.end());
+      }
+    };
+  }
+  int band = 0;
+  if (auto meta = grid->getMetadata<openvdb::Int32Metadata>("frep_band_voxels")) band = meta->value();
+  if (band < 1) band = int(std::lround(std::abs(double(grid->background())) / xform->voxelSize()[0]));
+  s.bandVoxels = std::max(band, 1);
+  return out;
+}
+
+}  // namespace frep::io

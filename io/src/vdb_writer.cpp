@@ -1,0 +1,246 @@
+#include "frep/io/vdb_writer.h"
+
+#include "frep/io/vdb_grid.h"
+
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetRebuild.h>
+#include <openvdb/tools/LevelSetUtil.h>
+#include <openvdb/tools/Prune.h>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <sstream>
+
+#include "frep/io/error.h"
+#include "vdb_checksum.h"
+
+#ifndef FREP_VERSION
+#define FREP_VERSION "unknown"
+#endif
+
+namespace frep::io {
+namespace {
+
+// The sampler's index (i, j, k) is the world lattice's (i, j, k) + offset: its origin is a whole
+// number of voxels from the world origin (makeGrid), so the grid's transform is a pure scale.
+openvdb::Coord latticeOffset(const GridSpec& g) {
+  return openvdb::Coord(int32_t(std::llround(g.origin[0] / g.voxel)), int32_t(std::llround(g.origin[1] / g.voxel)),
+                        int32_t(std::llround(g.origin[2] / g.voxel)));
+}
+
+// A sampler tile, clipped to the grid's leaf-aligned extent (a brick's root cube may reach past
+// it) so that the tree, once pruned, does not depend on how the job was split into bricks.
+void addTile(openvdb::FloatTree& tree, const Tile& tile, float value, const std::array<int32_t, 3>& extent,
+             const openvdb::Coord& offset) {
+  openvdb::Coord lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    if (tile.origin[a] >= extent[a]) return;  // entirely past the grid
+    lo[a] = tile.origin[a] + offset[a];
+    hi[a] = std::min(tile.origin[a] + tile.size, extent[a]) - 1 + offset[a];
+  }
+  tree.fill(openvdb::CoordBBox(lo, hi), value, false);
+}
+
+void addLeaf(openvdb::FloatGrid::Accessor& acc, const LeafBlock& block, const openvdb::Coord& offset) {
+  const openvdb::Coord o = openvdb::Coord(block.origin[0], block.origin[1], block.origin[2]) + offset;
+  for (int x = 0; x < kLeafDim; ++x)
+    for (int y = 0; y < kLeafDim; ++y)
+      for (int z = 0; z < kLeafDim; ++z) {
+        const int n = leafOffset(x, y, z);
+        const float value = -block.values[size_t(n)];  // level sets are negative inside
+        const openvdb::Coord c = o.offsetBy(x, y, z);
+        if (block.isActive(n)) acc.setValueOn(c, value);
+        else acc.setValueOff(c, value);
+      }
+}
+
+// OpenVDB stamps a random UUID into every file header; replace it by one derived from the file's
+// contents, so the same grid always gives the same bytes (farm runs are compared byte for byte).
+void makeHeaderDeterministic(std::string& bytes) {
+  constexpr size_t kUuidAt = 21, kUuidLen = 36;  // after magic, version, library version, flag
+  bool looksLikeUuid = bytes.size() > kUuidAt + kUuidLen && bytes[kUuidAt + 8] == '-' && bytes[kUuidAt + 13] == '-' &&
+                       bytes[kUuidAt + 18] == '-' && bytes[kUuidAt + 23] == '-';
+  if (!looksLikeUuid) return;
+  uint64_t h1 = 1469598103934665603ULL, h2 = 0x9e3779b97f4a7c15ULL;
+  for (size_t i = kUuidAt + kUuidLen; i < bytes.size(); ++i) {
+    h1 = (h1 ^ uint8_t(bytes[i])) * 1099511628211ULL;
+    h2 = (h2 ^ uint8_t(bytes[i])) * 0x100000001b3ULL + (h2 >> 29);
+  }
+  char uuid[40];
+  std::snprintf(uuid, sizeof uuid, "%08llx-%04llx-%04llx-%04llx-%012llx", (unsigned long long)(h1 >> 32),
+                (unsigned long long)((h1 >> 16) & 0xffff), (unsigned long long)(h1 & 0xffff),
+                (unsigned long long)(h2 >> 48), (unsigned long long)(h2 & 0xffffffffffffULL));
+  bytes.replace(kUuidAt, kUuidLen, uuid, kUuidLen);
+}
+
+// The bytes openvdb::io::File::write would put in the file (the same Archive::write, seekable),
+// built in memory: OpenVDB's own file writer ignores a failing stream (ENOSPC, EFBIG).
+struct MemoryArchive : openvdb::io::Archive {
+  std::string bytes(const openvdb::GridCPtrVec& grids) const {
+    std::ostringstream os(std::ios_base::out | std::ios_base::binary);
+    write(os, grids, /*seekable=*/true);
+    if (!os) throw openvdb::IoError("cannot serialise the grid");
+    return os.str();
+  }
+};
+
+// The checksum entry's placeholder digits replaced by the file's checksum (vdb_checksum.h). The
+// entry is found with its length prefixes, which hold NUL bytes no metadata text from argv has.
+void sealChecksum(std::string& bytes) {
+  auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  const std::string key = kGridChecksumKey;
+  const std::string entry = u32(uint32_t(key.size())) + key + u32(6) + "string" + u32(uint32_t(kChecksumDigits)) +
+                            std::string(kChecksumDigits, '0');
+  const size_t at = bytes.find(entry);
+  if (at == std::string::npos) throw openvdb::IoError("the checksum entry is missing from the serialised grid");
+  const size_t digits = at + entry.size() - kChecksumDigits;
+  bytes.replace(digits, kChecksumDigits, vdbChecksum(bytes, digits));
+}
+
+// Every byte handed to the kernel and checked, then fsync and the size read back: a full disk
+// fails here (exit 3) and AtomicOutput never renames a truncated file into place.
+void writeAllOrThrow(const std::string& path, const std::string& bytes) {
+  auto fail = [&](const char* what) {
+    throw ioError("cannot write VDB '" + path + "': " + what + ": " + std::strerror(errno));
+  };
+  int fd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) fail("open");
+  size_t done = 0;
+  while (done < bytes.size()) {
+    ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n == 0) errno = ENOSPC;
+      int err = errno;
+      ::close(fd);
+      errno = err;
+      fail("write");
+    }
+    done += size_t(n);
+  }
+  struct stat st;
+  if (::fsync(fd) != 0 || ::fstat(fd, &st) != 0) {
+    int err = errno;
+    ::close(fd);
+    errno = err;
+    fail("fsync");
+  }
+  if (::close(fd) != 0) fail("close");
+  if (uint64_t(st.st_size) != bytes.size()) {
+    errno = EIO;
+    fail(("size " + std::to_string(st.st_size) + " instead of " + std::to_string(bytes.size())).c_str());
+  }
+}
+
+std::string hex(uint64_t v) {
+  char buf[19];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+}  // namespace
+
+openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result) {
+  openvdb::initialize();
+  const GridSpec& g = result.grid;
+  const float background = float(result.bandVoxels * g.voxel);
+  openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(background);
+  openvdb::FloatTree& tree = grid->tree();
+  const std::array<int32_t, 3> extent{(g.dims[0] + 7) & ~7, (g.dims[1] + 7) & ~7, (g.dims[2] + 7) & ~7};
+  const openvdb::Coord offset = latticeOffset(g);
+  for (const Tile& t : result.tiles) addTile(tree, t, t.inside ? -background : background, extent, offset);
+  openvdb::FloatGrid::Accessor acc = grid->getAccessor();
+  for (const LeafBlock& b : result.leaves) addLeaf(acc, b, offset);
+  openvdb::tools::pruneLevelSet(tree);  // canonical tree: the same whatever the brick layout
+
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(g.voxel));
+  grid->setGridClass(openvdb::GRID_LEVEL_SET);
+  return grid;
+}
+
+openvdb::FloatGrid::Ptr signedDistanceGrid(const openvdb::FloatGrid& raw, int bandVoxels) {
+  // Meshes the zero set of -f (linear along the lattice's edges) and takes the exact distance to
+  // that mesh in a band of bandVoxels either side, on the same transform: a pure function of the
+  // merged grid, so as deterministic as it is (TBB only splits a min over triangles).
+  const float band = float(bandVoxels);
+  openvdb::FloatGrid::Ptr sdf = openvdb::tools::levelSetRebuild(raw, 0.0f, band, band);
+  sdf->setGridClass(openvdb::GRID_LEVEL_SET);
+  openvdb::tools::pruneLevelSet(sdf->tree());
+  return sdf;
+}
+
+namespace {
+
+const char* signDescription(VdbStore store) {
+  switch (store) {
+    case VdbStore::Raw: return "value = -f";
+    case VdbStore::Fog: return "value = density: 1 inside, 0 outside, a linear ramp across the inner band";
+    case VdbStore::Sdf: break;
+  }
+  return "value = signed distance to the surface f = 0, negative inside, world units";
+}
+
+}  // namespace
+
+const char* storeName(VdbStore store) {
+  switch (store) {
+    case VdbStore::Raw: return "raw";
+    case VdbStore::Fog: return "fog";
+    case VdbStore::Sdf: break;
+  }
+  return "sdf";
+}
+
+void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta) {
+  openvdb::FloatGrid::Ptr grid = levelSetGrid(result);
+  if (meta.store != VdbStore::Raw) grid = signedDistanceGrid(*grid, result.bandVoxels);
+  if (meta.store == VdbStore::Fog) openvdb::tools::sdfToFogVolume(*grid);  // class fog volume
+  const GridSpec& g = result.grid;
+  const float background = float(result.bandVoxels * g.voxel);
+  const openvdb::Coord offset = latticeOffset(g);
+  const openvdb::Coord last = offset + openvdb::Coord(g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1);
+  // Blender's volume import looks for a grid named "density".
+  grid->setName(meta.store == VdbStore::Fog ? "density" : meta.gridName);
+  grid->insertMeta("frep_sign", openvdb::StringMetadata(signDescription(meta.store)));
+  grid->insertMeta("frep_store", openvdb::StringMetadata(storeName(meta.store)));
+  grid->insertMeta("frep_operation", openvdb::StringMetadata("sample"));
+  grid->insertMeta("frep_model_hash", openvdb::StringMetadata(hex(meta.sourceHash)));
+  grid->insertMeta("frep_source", openvdb::StringMetadata(meta.source));
+  grid->insertMeta("frep_object", openvdb::StringMetadata(meta.gridName));
+  grid->insertMeta("frep_job", openvdb::StringMetadata(meta.job));
+  grid->insertMeta("frep_units", openvdb::StringMetadata("model units (the .hf file's coordinates)"));
+  grid->insertMeta("frep_voxel", openvdb::DoubleMetadata(g.voxel));
+  grid->insertMeta("frep_box_index_min", openvdb::Vec3IMetadata(openvdb::Vec3i(offset.asVec3i())));
+  grid->insertMeta("frep_box_index_max", openvdb::Vec3IMetadata(openvdb::Vec3i(last.asVec3i())));
+  grid->insertMeta("frep_box_min", openvdb::Vec3DMetadata(grid->indexToWorld(offset)));
+  grid->insertMeta("frep_box_max", openvdb::Vec3DMetadata(grid->indexToWorld(last)));
+  grid->insertMeta("frep_band_voxels", openvdb::Int32Metadata(result.bandVoxels));
+  grid->insertMeta("frep_band", openvdb::DoubleMetadata(double(background)));
+  grid->insertMeta("frep_iso", openvdb::DoubleMetadata(meta.iso));
+  grid->insertMeta("frep_params", openvdb::StringMetadata(meta.params));
+  grid->insertMeta("frep_version", openvdb::StringMetadata(FREP_VERSION));
+
+  try {
+    grid->insertMeta(kGridChecksumKey, openvdb::StringMetadata(std::string(kChecksumDigits, '0')));  // sealed below
+    MemoryArchive archive;
+    uint32_t compression = openvdb::io::COMPRESS_ACTIVE_MASK;
+    if (openvdb::io::Archive::hasBloscCompression()) compression |= openvdb::io::COMPRESS_BLOSC;
+    archive.setCompression(compression);
+    std::string bytes = archive.bytes(openvdb::GridCPtrVec{grid});
+    sealChecksum(bytes);
+    makeHeaderDeterministic(bytes);
+    writeAllOrThrow(path, bytes);
+  } catch (const openvdb::Exception& e) {
+    throw ioError("cannot write VDB '" + path + "': " + e.what());
+  }
+}
+
+}  // namespace frep::io

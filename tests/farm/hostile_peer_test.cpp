@@ -1,0 +1,269 @@
+// The master against scripted hostile peers over loopback (docs/farm.md, "Threat model"):
+// only a brick's leaseholder can answer for it or be charged for it, strangers may send only a
+// small hello, and garbage drops the peer, never the brick.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <fstream>
+#include <thread>
+#include <zmq.hpp>
+#include <zmq_addon.hpp>
+
+#include "farm_test_util.h"
+#include "wire.h"
+
+using namespace farmtest;
+
+namespace {
+
+JobSpec sphereJob() {
+  JobSpec j;
+  j.set_operation("sample");
+  j.set_model_source("my_model(x[3], a[1]) { my_model = 0.64 - x[1]^2 - x[2]^2 - x[3]^2; }");
+  j.set_model_name("sphere.hf");
+  setGrid(j, GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 64));  // 8 bricks of 32
+  j.set_band(3);
+  return j;
+}
+
+FarmOptions clusterOptions() {
+  FarmOptions o;
+  o.brickVoxels = 32;
+  o.heartbeatMs = 100;
+  o.liveness = 3;
+  o.noWorkerTimeoutSec = 20;
+  return o;
+}
+
+void expectSameLeaves(const SampleResult& ref, const SampleResult& got) {
+  ASSERT_EQ(got.leaves.size(), ref.leaves.size());
+  for (size_t i = 0; i < ref.leaves.size(); ++i) {
+    ASSERT_EQ(got.leaves[i].origin, ref.leaves[i].origin);
+    ASSERT_EQ(got.leaves[i].values, ref.leaves[i].values);
+    ASSERT_EQ(got.leaves[i].active, ref.leaves[i].active);
+  }
+}
+
+SampleResult reference(const JobSpec& j) {
+  FarmOptions o = clusterOptions();
+  o.workers = 0;
+  return runJob(j, o).result;
+}
+
+// A peer scripted by the test: a DEALER that speaks the protocol by hand.
+struct ScriptedPeer {
+  zmq::socket_t s;
+  ScriptedPeer(zmq::context_t& ctx, const std::string& ep, const std::string& id, bool hello = true)
+      : s(ctx, zmq::socket_type::dealer) {
+    s.set(zmq::sockopt::linger, 200);
+    s.set(zmq::sockopt::routing_id, id);
+    s.connect(ep);
+    if (hello) sayHello(id);
+  }
+  void sayHello(const std::string& id) {
+    Envelope h;
+    h.mutable_hello()->set_worker_id(id);
+    send(s, "", h);
+  }
+  // Envelopes of one kind received within ms, or until count of them arrived.
+  std::vector<Envelope> collect(Envelope::BodyCase kind, size_t count, int ms = 5000) {
+    return collectEnvelopes(s, kind, count, ms);
+  }
+  void fail(uint64_t jobId, uint64_t brick, bool handedBack) {
+    Envelope f;
+    f.set_job_id(jobId);
+    f.mutable_failed()->set_brick_id(brick);
+    f.mutable_failed()->set_error(handedBack ? "handed back by the test" : "forged failure");
+    f.mutable_failed()->set_handed_back(handedBack);
+    send(s, "", f);
+  }
+  // A well-formed result for `brick` (right CRC, inside the brick) whose leaf is a lie.
+  void forgeResult(uint64_t jobId, const Task& t, bool corruptCrc = false) {
+    BrickOutput out;
+    LeafBlock l{};
+    l.origin = {t.lo(0), t.lo(1), t.lo(2)};
+    l.values.fill(42.0f);
+    l.active.fill(~0ull);
+    out.leaves.push_back(l);
+    std::string payload = encodePayload(Operation::Sample, out);
+    Envelope r;
+    r.set_job_id(jobId);
+    r.mutable_result()->set_brick_id(t.brick_id());
+    r.mutable_result()->set_leaves(1);
+    r.mutable_result()->set_payload_crc32(crc32Of(payload.data(), payload.size()) ^ (corruptCrc ? 1u : 0u));
+    send(s, "", r, &payload);
+  }
+  void handBackAndLeave(uint64_t jobId, const std::vector<Envelope>& tasks) {
+    for (const Envelope& t : tasks) fail(jobId, t.task().brick_id(), true);
+    Envelope bye;
+    bye.mutable_bye()->set_reason("test");
+    send(s, "", bye);
+  }
+};
+
+int runRealWorker(const std::string& ep) { return WorkerProcess(ep).wait(30); }
+
+// Peak resident set of this process (VmHWM), bytes.
+uint64_t vmHwmBytes() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) * 1024;
+  return 0;
+}
+
+}  // namespace
+
+// Before the lease check a peer that only said hello could submit any brick and have it merged.
+TEST(HostilePeer, ForgedResultForAnotherPeersBrickIsNotMerged) {
+  JobSpec j = sphereJob();
+  SampleResult ref = reference(j);
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
+  zmq::context_t ctx(1);
+  ScriptedPeer a(ctx, ep, "a");
+  std::vector<Envelope> held = a.collect(Envelope::kTask, 2);
+  ASSERT_EQ(held.size(), 2u);
+  ScriptedPeer b(ctx, ep, "b");
+  std::vector<Envelope> bHeld = b.collect(Envelope::kTask, 2);
+  ASSERT_EQ(bHeld.size(), 2u);
+  for (const Envelope& t : held) b.forgeResult(jobIdOf(j), t.task());  // a's bricks, forged by b
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  a.handBackAndLeave(jobIdOf(j), held);
+  b.handBackAndLeave(jobIdOf(j), bHeld);
+  EXPECT_EQ(runRealWorker(ep), 0);
+  master.join();
+  ASSERT_EQ(master.error, "");
+  const FarmReport& r = master.outcome.report;
+  EXPECT_EQ(r.foreignResults, 2u);
+  EXPECT_TRUE(r.poisoned.empty());
+  expectSameLeaves(ref, master.outcome.result);
+}
+
+TEST(HostilePeer, FailuresAndCorruptResultsFromNonHoldersDoNotPoison) {
+  JobSpec j = sphereJob();
+  SampleResult ref = reference(j);
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
+  zmq::context_t ctx(1);
+  ScriptedPeer a(ctx, ep, "a");
+  std::vector<Envelope> held = a.collect(Envelope::kTask, 2);
+  ASSERT_EQ(held.size(), 2u);
+  ScriptedPeer b(ctx, ep, "b");
+  std::vector<Envelope> bHeld = b.collect(Envelope::kTask, 2);
+  ASSERT_EQ(bHeld.size(), 2u);
+  // b fails a's first brick again and again and sends corrupt results for its second; then
+  // (after a handed them back) for every brick of the job, leased or pending.
+  for (int k = 0; k < 5; ++k) {
+    b.fail(jobIdOf(j), held[0].task().brick_id(), false);
+    b.forgeResult(jobIdOf(j), held[1].task(), /*corruptCrc=*/true);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  a.handBackAndLeave(jobIdOf(j), held);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  for (uint64_t id = 0; id < 8; ++id)
+    if (id != bHeld[0].task().brick_id() && id != bHeld[1].task().brick_id())
+      for (int k = 0; k < 4; ++k) b.fail(jobIdOf(j), id, false);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  b.handBackAndLeave(jobIdOf(j), bHeld);
+  EXPECT_EQ(runRealWorker(ep), 0);
+  master.join();
+  ASSERT_EQ(master.error, "");
+  const FarmReport& r = master.outcome.report;
+  EXPECT_TRUE(r.poisoned.empty());
+  EXPECT_GE(r.foreignResults, 10u);
+  EXPECT_EQ(r.bricksComputed, 8u);
+  expectSameLeaves(ref, master.outcome.result);
+}
+
+// Peers that say hello and vanish: the master leases them bricks they never see; their
+// deaths must not be charged to those bricks (before: each vanishing peer charged both).
+TEST(HostilePeer, HelloAndVanishPeersDoNotPoison) {
+  JobSpec j = sphereJob();
+  SampleResult ref = reference(j);
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
+  zmq::context_t ctx(1);
+  for (int k = 0; k < 6; ++k) {
+    {
+      ScriptedPeer v(ctx, ep, "vanish-" + std::to_string(k));
+      ASSERT_EQ(v.collect(Envelope::kTask, 2).size(), 2u);
+      v.s.set(zmq::sockopt::linger, 0);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(450));  // past its liveness window
+  }
+  EXPECT_EQ(runRealWorker(ep), 0);
+  master.join();
+  ASSERT_EQ(master.error, "");
+  const FarmReport& r = master.outcome.report;
+  EXPECT_TRUE(r.poisoned.empty()) << r.poisoned.size() << " brick(s) poisoned";
+  EXPECT_GE(r.deadWorkers, 6u);
+  expectSameLeaves(ref, master.outcome.result);
+}
+
+// Strangers may send a hello of at most 64 KiB; a bigger message is dropped unparsed and bans
+// its routing id (its later hello is ignored). Frames over the job's largest possible frame
+// are refused by ZeroMQ before they are allocated: many hostile peers sending 64 MiB frames
+// leave the master's memory flat (before: accepted up to 256 MiB each).
+TEST(HostilePeer, BigFramesFromUnwelcomedPeersAreDroppedWithBoundedMemory) {
+  JobSpec j = sphereJob();
+  SampleResult ref = reference(j);
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
+  zmq::context_t ctx(1);
+  {
+    ScriptedPeer big(ctx, ep, "big", /*hello=*/false);
+    std::string frame(100 << 10, 'x');
+    big.s.send(zmq::buffer(frame));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    big.sayHello("big");
+    EXPECT_EQ(big.collect(Envelope::kWelcome, 1, 800).size(), 0u) << "a banned peer was welcomed";
+  }
+  // Hostile peers send 64 MiB frames from one shared buffer (zero-copy: the test's own
+  // memory does not grow with the frames sent).
+  static std::string huge(64 << 20, 'h');
+  const uint64_t before = vmHwmBytes();
+  {
+    std::vector<zmq::socket_t> hostile;
+    for (int k = 0; k < 8; ++k) {
+      hostile.emplace_back(ctx, zmq::socket_type::dealer);
+      hostile.back().set(zmq::sockopt::linger, 0);
+      hostile.back().connect(ep);
+    }
+    for (int round = 0; round < 2; ++round)
+      for (auto& h : hostile) {
+        zmq::message_t m(huge.data(), huge.size(), [](void*, void*) {}, nullptr);
+        h.send(m, zmq::send_flags::dontwait);
+      }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+  }
+  const uint64_t grown = vmHwmBytes() - before;
+  std::printf("master peak RSS growth with 8 peers x 2 x 64 MiB frames: %.1f MiB\n", double(grown) / (1 << 20));
+  EXPECT_LT(grown, uint64_t(128) << 20);
+  EXPECT_EQ(runRealWorker(ep), 0);
+  master.join();
+  ASSERT_EQ(master.error, "");
+  const FarmReport& r = master.outcome.report;
+  EXPECT_GE(r.oversized, 1u);
+  EXPECT_GE(r.bannedPeers, 1u);
+  EXPECT_EQ(r.workersSeen, 1);  // only the real worker was welcomed
+  expectSameLeaves(ref, master.outcome.result);
+}
+
+TEST(HostilePeer, ListenOnTheNetworkWithoutCurveNeedsInsecure) {
+  EXPECT_TRUE(isLoopbackEndpoint("tcp://127.0.0.1:5555"));
+  EXPECT_TRUE(isLoopbackEndpoint("tcp://localhost:*"));
+  EXPECT_TRUE(isLoopbackEndpoint("tcp://[::1]:5555"));
+  EXPECT_FALSE(isLoopbackEndpoint("tcp://*:5555"));
+  EXPECT_FALSE(isLoopbackEndpoint("tcp://0.0.0.0:5555"));
+  EXPECT_FALSE(isLoopbackEndpoint("tcp://eth0:5555"));
+  EXPECT_FALSE(isLoopbackEndpoint("tcp://10.0.0.1:5555"));
+  FarmOptions o = clusterOptions();
+  o.listen = "tcp://*:5555";
+  try {
+    runJob(sphereJob(), o);
+    ADD_FAILURE() << "an open farm on the network was not refused";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--insecure"), std::string::npos) << e.what();
+  }
+}
