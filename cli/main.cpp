@@ -1,11 +1,14 @@
 // The frep command: argument wiring, logging setup and the mapping of failures to exit codes.
 #include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <iostream>
 
 #include "commands.h"
+#include "json_events.h"
+#include "status_line.h"
 #include "exit_codes.h"
 
 #ifndef FREP_VERSION
@@ -56,11 +59,19 @@ void checkObjectIsNotAFile(const ModelRequest& m) {
                   "' looks like a file name; -o selects the object (as in hfp), write files with -O/--out");
 }
 
-void setUpLogging(const std::string& level) {
-  auto logger = spdlog::stderr_color_mt("frep");
+// --log-level if given, else $SPDLOG_LEVEL (spdlog's syntax: "debug", or "warn,frep=debug"), else
+// info. Returns the level in effect, which local workers are started with.
+std::string setUpLogging(const std::string& level, bool levelGiven) {
+  // Through the status line: a log line erases the progress bar and the bar is drawn again below.
+  auto sink = std::make_shared<frep::farm::LineSafeSink>(std::make_shared<spdlog::sinks::stderr_color_sink_mt>());
+  auto logger = std::make_shared<spdlog::logger>("frep", sink);
+  spdlog::register_logger(logger);  // so that $SPDLOG_LEVEL's "frep=..." finds it
   logger->set_pattern("frep: %^%l%$: %v");
   logger->set_level(spdlog::level::from_str(level));
   spdlog::set_default_logger(logger);
+  if (!levelGiven) spdlog::cfg::load_env_levels();
+  const auto name = spdlog::level::to_string_view(logger->level());
+  return std::string(name.data(), name.size());
 }
 
 }  // namespace
@@ -72,7 +83,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", FREP_VERSION);
   std::string logLevel = "info";
-  app.add_option("--log-level", logLevel, "trace, debug, info, warn, error, critical or off (default info)")
+  CLI::Option* logLevelOption = app.add_option("--log-level", logLevel,
+                                               "trace, debug, info, warn, error, critical or off (default info, or $SPDLOG_LEVEL)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
 
   ModelRequest checkModel;
@@ -154,7 +166,8 @@ int main(int argc, char** argv) {
     return kExitBadArgs;
   }
 
-  setUpLogging(logLevel);
+  logLevel = setUpLogging(logLevel, logLevelOption->count() > 0);
+  if ((sampleCmd->parsed() && sample.farm.json) || (meshCmd->parsed() && mesh.farm.json)) enableJsonEvents();
   try {
     if (check->parsed()) {
       checkObjectIsNotAFile(checkModel);
@@ -181,9 +194,11 @@ int main(int argc, char** argv) {
     return runSample(sample);
   } catch (const CliError& e) {
     std::cerr << "frep: error: " << e.what() << "\n";
+    jsonError(e.code, e.what());
     return e.code;
   } catch (const std::exception& e) {
     std::cerr << "frep: internal error: " << e.what() << "\n";
+    jsonError(kExitInternal, std::string("internal error: ") + e.what());
     return kExitInternal;
   }
 }

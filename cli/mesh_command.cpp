@@ -15,6 +15,8 @@
 #include "commands.h"
 #include "exit_codes.h"
 #include "farm_job.h"
+#include "json_events.h"
+#include "progress.h"
 #include "frep/meshing/mesh.h"
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/io/mesh_writer.h"
@@ -74,6 +76,7 @@ int runMeshVdb(const MeshRequest& request) {
   if (mesh.triangles.empty()) spdlog::warn("grid '{}' has no sign change between active voxels: the mesh is empty", vdb.gridName);
   std::string comment = "frep mesh of grid '" + vdb.gridName + "' in " + request.model.path +
                         " (sampled values); normals point outward (decreasing f)";
+  jsonPhase("write");
   io::writeMesh(out.tempPath(), mesh, format, comment);
   out.commit();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -89,8 +92,7 @@ int runMeshVdb(const MeshRequest& request) {
        << "  time " << formatNumber(std::round(readSeconds * 1000) / 1000) << " s reading, "
        << formatNumber(std::round(meshSeconds * 1000) / 1000) << " s meshing, "
        << formatNumber(std::round(seconds * 1000) / 1000) << " s in all\n";
-  if (request.farm.json)
-    std::cout << "{\"event\":\"done\",\"output\":\"" << request.region.out << "\"}\n";
+  jsonDone(request.region.out, false);
   return kExitOk;
 }
 
@@ -140,6 +142,7 @@ int runMesh(const MeshRequest& request) {
   spdlog::info("meshing '{}' on {}x{}x{} points of {}", m.model.objectName, grid.dims[0], grid.dims[1], grid.dims[2],
                grid.voxel);
   const auto start = std::chrono::steady_clock::now();
+  jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
   farm::FarmReport& report = outcome.report;
   requireComplete(reportOut, report);
@@ -149,6 +152,8 @@ int runMesh(const MeshRequest& request) {
     spdlog::info("simplifying across the bricks: {} triangles (tolerance {} voxel, sharp features {}); a signal "
                  "now ends the run, --resume then redoes only this step",
                  mesh.triangles.size(), so.tolerance, so.sharpFeatures ? "on" : "off");
+  if (so.tolerance > 0) jsonPhase("simplify");
+  so.progress = farm::simplifyProgress(options.progressBar, options.progressJson);
   SimplifyStats ss = simplifyMesh(mesh, tape, grid, so);
   report.simplifyTolerance = so.tolerance;
   report.sharpFeatures = so.sharpFeatures;
@@ -160,6 +165,7 @@ int runMesh(const MeshRequest& request) {
   std::string comment = "frep mesh of '" + m.model.objectName + "', grid " + std::to_string(grid.dims[0]) + "x" +
                         std::to_string(grid.dims[1]) + "x" + std::to_string(grid.dims[2]) + " voxel " +
                         formatNumber(grid.voxel) + "; normals point outward (decreasing f)";
+  jsonPhase("write");
   io::writeMesh(out.tempPath(), mesh, format, comment);
   out.commit();
   writeReport(reportOut, report);
@@ -192,9 +198,7 @@ int runMesh(const MeshRequest& request) {
        << formatNumber(std::round(seconds * 1000) / 1000) << " s in all\n"
        << "  " << bricksSummary(report) << "\n"
        << "  report " << request.region.out << ".report.json\n";
-  if (request.farm.json)
-    std::cout << "{\"event\":\"done\",\"output\":\"" << request.region.out << "\",\"report\":\"" << request.region.out
-              << ".report.json\"}\n";
+  jsonDone(request.region.out, true);
   return kExitOk;
 }
 

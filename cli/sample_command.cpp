@@ -13,6 +13,7 @@
 #include "curve.h"
 #include "exit_codes.h"
 #include "farm_job.h"
+#include "json_events.h"
 #include "farm_master.h"
 #include "sampling_grid.h"
 #include "frep/io/vdb_writer.h"
@@ -69,6 +70,7 @@ int runSample(const SampleRequest& request) {
   job.set_band(request.band);
   spdlog::info("sampling '{}' on {}x{}x{} voxels of {}", m.model.objectName, grid.dims[0], grid.dims[1],
                grid.dims[2], grid.voxel);
+  jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
   const farm::FarmReport& report = outcome.report;
   requireComplete(reportOut, report);
@@ -81,6 +83,7 @@ int runSample(const SampleRequest& request) {
   meta.params = request.model.params;
   meta.sourceHash = m.model.sourceHash;
   meta.iso = request.model.iso;
+  jsonPhase("write");  // with the signed distance (levelSetRebuild) unless --store raw
   io::writeLevelSet(out.tempPath(), outcome.result, meta);
   out.commit();
   writeReport(reportOut, report);
@@ -100,10 +103,7 @@ int runSample(const SampleRequest& request) {
        << "\n"
        << "  " << bricksSummary(report) << "\n"
        << "  report " << request.region.out << ".report.json\n";
-  if (request.farm.json) {
-    std::cout << "{\"event\":\"done\",\"output\":\"" << request.region.out << "\",\"report\":\"" << request.region.out
-              << ".report.json\"}\n";
-  }
+  jsonDone(request.region.out, true);
   return kExitOk;
 }
 
