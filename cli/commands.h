@@ -54,7 +54,7 @@ struct FarmRequest {
   int workers = -1;          // local workers; -1 one per core, 0 in-process
   std::string listen;        // cluster mode endpoint
   int expectWorkers = 0;
-  int brick = 64;            // brick edge in voxels
+  int brick = -1;            // brick edge in voxels; -1 (not given): chooseBrick (grid and workers)
   int heartbeatMs = 500;
   bool resume = false;
   bool json = false;         // JSON progress events on stdout
@@ -69,7 +69,7 @@ struct SampleRequest {
   FarmRequest farm;
   int band = 3;     // narrow band half-width in voxels
   int threads = 0;  // threads of the in-process run (--workers 0); 0: all cores
-  std::string commandLine;  // recorded in the grid's metadata (without execution options)
+  std::string store = "sdf";  // --store: sdf, raw or fog (VdbStore)
   std::string logLevel = "info";
 };
 int runSample(const SampleRequest& request);

@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <algorithm>
 #include <fstream>
+#include <thread>
 #include <zmq.hpp>
 
 #include "arg_parse.h"
@@ -81,7 +83,7 @@ void checkJobSize(const GridSpec& grid, int brick) {
 
 farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, const std::string& logLevel, int threads) {
   requireRange("--workers", f.workers, -1, kMaxProcesses, " (0: in-process)");
-  if (f.brick < 8 || f.brick > kMaxBrick || f.brick % 8 != 0)
+  if (f.brick != -1 && (f.brick < 8 || f.brick > kMaxBrick || f.brick % 8 != 0))  // -1: not given (chooseBrick)
     throw badArgs("--brick: expected a multiple of 8 voxels from 8 to " + std::to_string(kMaxBrick) + ", got " +
                   std::to_string(f.brick));
   requireRange("--heartbeat-ms", f.heartbeatMs, 10, 600000);
@@ -107,6 +109,23 @@ farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, cons
   o.logLevel = logLevel == "info" ? "warn" : logLevel;
   o.threads = threads;
   return o;
+}
+
+int chooseBrick(const std::array<int32_t, 3>& dims, int workers, const std::string& listen, int expectWorkers) {
+  int n = !listen.empty() ? expectWorkers
+          : workers < 0   ? int(std::max(1u, std::thread::hardware_concurrency()))
+                          : workers;
+  if (n <= 0) return 64;  // in-process, or a cluster of unknown size: the default brick
+  int brick = 64;
+  auto bricks = [&](int e) {
+    int64_t count = 1;
+    for (int32_t d : dims) count *= (d + e - 1) / e;
+    return count;
+  };
+  // Two bricks per worker at least, so that none idles and a slow one can be backed up; not
+  // below 16 voxels, where a brick's fixed costs (messages, interval pass) start to dominate.
+  while (brick > 16 && bricks(brick) < 2 * int64_t(n)) brick /= 2;
+  return brick;
 }
 
 farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& options) {

@@ -32,6 +32,11 @@ void checkJobSize(const GridSpec& grid, int brick);
 // OUT.journal; `threads` is the in-process run's thread count (--workers 0).
 farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, const std::string& logLevel, int threads);
 
+// The brick edge when --brick is not given: 64, halved (down to 16) until the grid has at
+// least two bricks per worker (workers < 0: one per core; in cluster mode --expect-workers, else
+// 64). Any brick gives the same output bytes; this only keeps every worker busy.
+int chooseBrick(const std::array<int32_t, 3>& dims, int workers, const std::string& listen, int expectWorkers);
+
 // Runs the job: std::invalid_argument -> exit 2, std::runtime_error -> exit 7 (farm error).
 farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& options);
 

@@ -1,11 +1,14 @@
 // The frep command: argument wiring, logging setup and the mapping of failures to exit codes.
 #include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <iostream>
 
 #include "commands.h"
+#include "json_events.h"
+#include "status_line.h"
 #include "exit_codes.h"
 #include "hfp_invocation.h"
 
@@ -16,49 +19,6 @@
 namespace {
 
 using namespace frep::cli;
-
-// Recorded in output metadata: quoted so that it can be pasted back into a shell.
-std::string joinCommandLine(int argc, char** argv) {
-  std::string line;
-  for (int i = 0; i < argc; ++i) {
-    std::string arg = argv[i];
-    bool plain = !arg.empty() && arg.find_first_not_of(
-        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_.,/=:+@%") == std::string::npos;
-    if (!plain) {
-      std::string quoted = "'";
-      for (char c : arg) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-      arg = quoted + "'";
-    }
-    line += (i ? " " : "") + arg;
-  }
-  return line;
-}
-
-// The command line as recorded in the output, without the options that only choose how the
-// job runs (they never change the result, so outputs of any worker count stay identical).
-std::string recordedCommandLine(int argc, char** argv) {
-  // The output path is left out too: the same grid written anywhere is the same file.
-  static const char* execution[] = {"--workers", "--listen", "--expect-workers", "--heartbeat-ms", "--curve",
-                                    "--threads", "--log-level", "--brick", "-O", "--out"};
-  static const char* flags[] = {"--resume", "--json", "--no-progress", "--insecure"};
-  std::vector<char*> kept;
-  for (int i = 0; i < argc; ++i) {
-    std::string a = argv[i];
-    bool drop = false;
-    for (const char* f : flags) drop = drop || a == f;
-    for (const char* o : execution) {
-      std::string opt = o;
-      if (a == opt) {
-        drop = true;
-        ++i;  // and its value
-      } else if (a.rfind(opt + "=", 0) == 0) {
-        drop = true;
-      }
-    }
-    if (!drop) kept.push_back(argv[i]);
-  }
-  return joinCommandLine(int(kept.size()), kept.data());
-}
 
 void addModelOptions(CLI::App* sub, ModelRequest& m, bool withFieldOptions) {
   sub->add_option("model", m.path, "The HyperFun model (.hf)")->required();
@@ -97,7 +57,7 @@ void addFarmOptions(CLI::App* sub, FarmRequest& f) {
                   "frep-worker --connect");
   sub->add_option("--expect-workers", f.expectWorkers,
                   "Cluster mode: workers expected; dispatch waits up to 5 s after the first one joins for the rest");
-  sub->add_option("--brick", f.brick, "Brick edge in voxels, a multiple of 8 (default 64; same output)");
+  sub->add_option("--brick", f.brick, "Brick edge in voxels, a multiple of 8 (default: 64, smaller so that every worker gets two; same output)");
   sub->add_option("--heartbeat-ms", f.heartbeatMs, "Heartbeat interval both ways (default 500)");
   sub->add_flag("--resume", f.resume, "Continue a stopped job from OUT.journal");
   sub->add_flag("--json", f.json, "JSON progress events on stdout (batch systems)");
@@ -113,11 +73,19 @@ void checkObjectIsNotAFile(const ModelRequest& m) {
                   "' looks like a file name; -o selects the object (as in hfp), write files with -O/--out");
 }
 
-void setUpLogging(const std::string& level) {
-  auto logger = spdlog::stderr_color_mt("frep");
+// --log-level if given, else $SPDLOG_LEVEL (spdlog's syntax: "debug", or "warn,frep=debug"), else
+// info. Returns the level in effect, which local workers are started with.
+std::string setUpLogging(const std::string& level, bool levelGiven) {
+  // Through the status line: a log line erases the progress bar and the bar is drawn again below.
+  auto sink = std::make_shared<frep::farm::LineSafeSink>(std::make_shared<spdlog::sinks::stderr_color_sink_mt>());
+  auto logger = std::make_shared<spdlog::logger>("frep", sink);
+  spdlog::register_logger(logger);  // so that $SPDLOG_LEVEL's "frep=..." finds it
   logger->set_pattern("frep: %^%l%$: %v");
   logger->set_level(spdlog::level::from_str(level));
   spdlog::set_default_logger(logger);
+  if (!levelGiven) spdlog::cfg::load_env_levels();
+  const auto name = spdlog::level::to_string_view(logger->level());
+  return std::string(name.data(), name.size());
 }
 
 }  // namespace
@@ -150,7 +118,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", FREP_VERSION);
   std::string logLevel = "info";
-  app.add_option("--log-level", logLevel, "trace, debug, info, warn, error, critical or off (default info)")
+  CLI::Option* logLevelOption = app.add_option("--log-level", logLevel,
+                                               "trace, debug, info, warn, error, critical or off (default info, or $SPDLOG_LEVEL)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
 
   ModelRequest checkModel;
@@ -175,10 +144,13 @@ int main(int argc, char** argv) {
   addGeometricOptions(sliceCmd, slice.geometric);
 
   SampleRequest sample;
-  CLI::App* sampleCmd = app.add_subcommand("sample", "Narrow-band OpenVDB level set (stores -f) of a model");
+  CLI::App* sampleCmd = app.add_subcommand("sample", "Narrow-band OpenVDB level set (signed distance; -f or fog by --store) of a model");
   addModelOptions(sampleCmd, sample.model, true);
   addRegionOptions(sampleCmd, sample.region, "Output .vdb file", 128);
   sampleCmd->add_option("--band", sample.band, "Band half-width in voxels (default 3)");
+  sampleCmd->add_option("--store", sample.store,
+                        "What the grid holds: sdf (signed distance, default), raw (-f) or fog (density grid)")
+      ->check(CLI::IsMember({"sdf", "raw", "fog"}));
   sampleCmd->add_option("--threads", sample.threads, "Threads of the in-process run, --workers 0 (default 0: all cores)");
   addFarmOptions(sampleCmd, sample.farm);
 
@@ -268,7 +240,8 @@ int main(int argc, char** argv) {
     return kExitBadArgs;
   }
 
-  setUpLogging(logLevel);
+  logLevel = setUpLogging(logLevel, logLevelOption->count() > 0);
+  if ((sampleCmd->parsed() && sample.farm.json) || (meshCmd->parsed() && mesh.farm.json)) enableJsonEvents();
   try {
     if (check->parsed()) {
       checkObjectIsNotAFile(checkModel);
@@ -305,14 +278,15 @@ int main(int argc, char** argv) {
       return runMesh(mesh);
     }
     checkObjectIsNotAFile(sample.model);
-    sample.commandLine = recordedCommandLine(argc, argv);
     sample.logLevel = logLevel;
     return runSample(sample);
   } catch (const CliError& e) {
     std::cerr << "frep: error: " << e.what() << "\n";
+    jsonError(e.code, e.what());
     return e.code;
   } catch (const std::exception& e) {
     std::cerr << "frep: internal error: " << e.what() << "\n";
+    jsonError(kExitInternal, std::string("internal error: ") + e.what());
     return kExitInternal;
   }
 }

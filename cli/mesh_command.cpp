@@ -16,6 +16,8 @@
 #include "exit_codes.h"
 #include "farm_job.h"
 #include "frep/attributes/colour.h"
+#include "json_events.h"
+#include "progress.h"
 #include "frep/meshing/mesh.h"
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/io/mesh_writer.h"
@@ -76,6 +78,7 @@ int runMeshVdb(const MeshRequest& request) {
   if (mesh.triangles.empty()) spdlog::warn("grid '{}' has no sign change between active voxels: the mesh is empty", vdb.gridName);
   std::string comment = "frep mesh of grid '" + vdb.gridName + "' in " + request.model.path +
                         " (sampled values); normals point outward (decreasing f)";
+  jsonPhase("write");
   std::array<double, 6> box{0, 0, 0, 0, 0, 0};
   for (size_t i = 0; i < mesh.positions.size(); ++i)
     for (int c = 0; c < 3; ++c) {
@@ -96,8 +99,7 @@ int runMeshVdb(const MeshRequest& request) {
        << "  time " << formatNumber(std::round(readSeconds * 1000) / 1000) << " s reading, "
        << formatNumber(std::round(meshSeconds * 1000) / 1000) << " s meshing, "
        << formatNumber(std::round(seconds * 1000) / 1000) << " s in all\n";
-  if (request.farm.json)
-    std::cout << "{\"event\":\"done\",\"output\":\"" << request.region.out << "\"}\n";
+  jsonDone(request.region.out, false);
   return kExitOk;
 }
 
@@ -121,10 +123,12 @@ int runMesh(const MeshRequest& request) {
     throw badArgs("frep mesh needs at most three coordinates; '" + m.model.objectName + "' has " +
                   std::to_string(m.dims) + " (map them with -x, e.g. -x X,Y,Z,0.5)");
   GridSpec grid = makeGrid(box, 3, res);
+  if (request.farm.brick == -1)
+    options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
   for (int a = 0; a < 3; ++a)
     if (grid.dims[a] < 2 || grid.dims[a] >= kMaxMeshGridPoints)
       throw badArgs("--res/-g: the grid needs 2 to " + std::to_string(kMaxMeshGridPoints - 1) + " points per axis");
-  checkJobSize(grid, request.farm.brick);
+  checkJobSize(grid, options.brickVoxels);
 
   openMeshOutputFiles(outputs);
   io::AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
@@ -145,6 +149,7 @@ int runMesh(const MeshRequest& request) {
   spdlog::info("meshing '{}' on {}x{}x{} points of {}", m.model.objectName, grid.dims[0], grid.dims[1], grid.dims[2],
                grid.voxel);
   const auto start = std::chrono::steady_clock::now();
+  jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
   farm::FarmReport& report = outcome.report;
   requireComplete(reportOut, report);
@@ -154,6 +159,8 @@ int runMesh(const MeshRequest& request) {
     spdlog::info("simplifying across the bricks: {} triangles (tolerance {} voxel, sharp features {}); a signal "
                  "now ends the run, --resume then redoes only this step",
                  mesh.triangles.size(), so.tolerance, so.sharpFeatures ? "on" : "off");
+  if (so.tolerance > 0) jsonPhase("simplify");
+  so.progress = farm::simplifyProgress(options.progressBar, options.progressJson);
   SimplifyStats ss = simplifyMesh(mesh, tape, grid, so);
   report.simplifyTolerance = so.tolerance;
   report.sharpFeatures = so.sharpFeatures;
@@ -165,6 +172,7 @@ int runMesh(const MeshRequest& request) {
   std::string comment = "frep mesh of '" + m.model.objectName + "', grid " + std::to_string(grid.dims[0]) + "x" +
                         std::to_string(grid.dims[1]) + "x" + std::to_string(grid.dims[2]) + " voxel " +
                         formatNumber(grid.voxel) + "; normals point outward (decreasing f)";
+  jsonPhase("write");
   // Colours after the merge and the simplification, at the final vertices half a voxel inside:
   // the same for any split of the job (colour.h).
   const bool coloured = !m.colour.empty() && wantsColours(outputs);
@@ -206,9 +214,7 @@ int runMesh(const MeshRequest& request) {
        << formatNumber(std::round(seconds * 1000) / 1000) << " s in all\n"
        << "  " << bricksSummary(report) << "\n"
        << "  report " << request.region.out << ".report.json\n";
-  if (request.farm.json)
-    std::cout << "{\"event\":\"done\",\"output\":\"" << request.region.out << "\",\"report\":\"" << request.region.out
-              << ".report.json\"}\n";
+  jsonDone(request.region.out, true);
   return kExitOk;
 }
 

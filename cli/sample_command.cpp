@@ -13,11 +13,42 @@
 #include "curve.h"
 #include "exit_codes.h"
 #include "farm_job.h"
+#include "json_events.h"
 #include "farm_master.h"
 #include "sampling_grid.h"
 #include "frep/io/vdb_writer.h"
 
 namespace frep::cli {
+namespace {
+
+std::string exact(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::string baseName(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// The job as resolved (object, bound parameters, iso, axis mapping, world lattice, band, store):
+// the same text however the command was spelt (argv[0], the model's path, option order, -g or
+// --res for the same lattice), so the file's bytes do not depend on the spelling.
+std::string jobDescription(const LoadedModel& m, const GridSpec& g, int band, const std::string& store) {
+  std::string s = "sample object=" + m.model.objectName + " params=";
+  for (size_t i = 0; i < m.spec.params.size(); ++i) s += (i ? "," : "") + exact(m.spec.params[i]);
+  s += " iso=" + exact(m.spec.iso) + " map=";
+  for (size_t i = 0; i < m.spec.axis.size(); ++i)
+    s += (i ? "," : "") + (m.spec.axis[i] >= 0 ? std::string(1, char('X' + m.spec.axis[i])) : exact(m.spec.constant[i]));
+  s += " voxel=" + exact(g.voxel) + " lattice=";
+  for (int a = 0; a < 3; ++a) s += (a ? "," : "") + std::to_string(std::llround(g.origin[a] / g.voxel));
+  s += ":";
+  for (int a = 0; a < 3; ++a) s += (a ? "," : "") + std::to_string(std::llround(g.origin[a] / g.voxel) + g.dims[a] - 1);
+  return s + " band=" + std::to_string(band) + " store=" + store;
+}
+
+}  // namespace
 
 int runSample(const SampleRequest& request) {
   if (request.region.out.empty()) throw badArgs("-O/--out: the output .vdb path is required");
@@ -27,8 +58,10 @@ int runSample(const SampleRequest& request) {
   Box box = request.region.bounds.empty() ? Box{} : parseBounds("-b/--bounds", request.region.bounds);
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);
   farm::FarmOptions options = farmOptions(request.farm, request.region.out, request.logLevel, request.threads);
-  GridSpec grid = makeGrid(box, 3, res);
-  checkJobSize(grid, request.farm.brick);  // before the model is even read: refused at once
+  GridSpec grid = makeWorldLatticeGrid(box, res);
+  if (request.farm.brick == -1)
+    options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
+  checkJobSize(grid, options.brickVoxels);  // before the model is even read: refused at once
   LoadedModel m = loadModel(request.model, true);
 
   io::AtomicOutput out("-O/--out", request.region.out);
@@ -37,16 +70,20 @@ int runSample(const SampleRequest& request) {
   job.set_band(request.band);
   spdlog::info("sampling '{}' on {}x{}x{} voxels of {}", m.model.objectName, grid.dims[0], grid.dims[1],
                grid.dims[2], grid.voxel);
+  jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
   const farm::FarmReport& report = outcome.report;
   requireComplete(reportOut, report);
 
   io::VdbMetadata meta;
   meta.gridName = m.model.objectName;
-  meta.commandLine = request.commandLine;
+  meta.job = jobDescription(m, grid, request.band, request.store);
+  meta.source = baseName(request.model.path);
+  meta.store = request.store == "raw" ? io::VdbStore::Raw : request.store == "fog" ? io::VdbStore::Fog : io::VdbStore::Sdf;
   meta.params = request.model.params;
   meta.sourceHash = m.model.sourceHash;
   meta.iso = request.model.iso;
+  jsonPhase("write");  // with the signed distance (levelSetRebuild) unless --store raw
   io::writeLevelSet(out.tempPath(), outcome.result, meta);
   out.commit();
   writeReport(reportOut, report);
@@ -66,10 +103,7 @@ int runSample(const SampleRequest& request) {
        << "\n"
        << "  " << bricksSummary(report) << "\n"
        << "  report " << request.region.out << ".report.json\n";
-  if (request.farm.json) {
-    std::cout << "{\"event\":\"done\",\"output\":\"" << request.region.out << "\",\"report\":\"" << request.region.out
-              << ".report.json\"}\n";
-  }
+  jsonDone(request.region.out, true);
   return kExitOk;
 }
 

@@ -18,8 +18,17 @@ struct Resolution {
 // Grid over the first `axes` axes of `box` (the others get one point at lo). The grid starts at
 // box.lo; the voxel is the largest extent / cells ratio (extent / (res - 1) for --res), and each
 // axis gets the points that fit in the box, so -g N on a cube gives hfp's N + 1 points and
-// --res in 3D gives exactly GridSpec::fromBounds.
+// --res in 3D gives exactly GridSpec::fromBounds. (frep mesh and frep slice.)
 GridSpec makeGrid(const Box& box, int axes, const Resolution& r);
+
+// frep sample's grid: the voxel of makeGrid(box, 3, r), the points on the world lattice
+// (integer multiples of the voxel from the world origin, OpenVDB's index space, so that grids
+// of other tools with the same voxel line up) that covers the box rounded outward to it. A box
+// whose bounds are multiples of the voxel gives makeGrid's points; one off the lattice gets a
+// point more on each axis it is off.
+// Throws CliError(kExitBadArgs) when the lattice index passes kMaxLatticeIndex.
+constexpr int64_t kMaxLatticeIndex = int64_t(1) << 30;
+GridSpec makeWorldLatticeGrid(const Box& box, const Resolution& r);
 
 }  // namespace frep::cli
 

@@ -1,5 +1,6 @@
 // frep-worker: joins a frepfarm master and computes bricks until the job ends.
 #include <CLI/CLI.hpp>
+#include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdlib>
@@ -18,7 +19,10 @@ int main(int argc, char** argv) {
   app.add_option("--curve", opt.curveDir, "directory with CURVE keys from `frep keygen`");
   app.add_option("--master-timeout", opt.masterTimeoutSec, "seconds without a master before giving up")
       ->capture_default_str();
-  app.add_option("--log-level", level, "trace, debug, info, warn, error, off")->capture_default_str();
+  app.set_version_flag("--version", "frep-worker " FREP_VERSION);
+  CLI::Option* levelOption =
+      app.add_option("--log-level", level, "trace, debug, info, warn, error, off (default info, or $SPDLOG_LEVEL)")
+          ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -30,6 +34,8 @@ int main(int argc, char** argv) {
     return frep::farm::kWorkerBadArgs;
   }
   spdlog::set_level(spdlog::level::from_str(level));
+  // $SPDLOG_LEVEL (e.g. debug, or warn,frep=debug) unless --log-level is given: the option wins.
+  if (levelOption->count() == 0) spdlog::cfg::load_env_levels();
   try {
     return frep::farm::runWorker(opt);
   } catch (const std::exception& e) {

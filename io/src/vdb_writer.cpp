@@ -3,11 +3,16 @@
 #include "frep/io/vdb_grid.h"
 
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetRebuild.h>
+#include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/Prune.h>
 
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include <cerrno>
 #include <cstdio>
@@ -24,51 +29,37 @@
 namespace frep::io {
 namespace {
 
-// OpenVDB's Tree4<float, 5, 4, 3> stores tiles of these edge lengths at levels 1, 2, 3.
-constexpr int32_t kTileEdge[4] = {1, 8, 128, 4096};
-
-// A sampler tile (power-of-two cube, aligned to its size) as the fewest VDB tiles.
-// Tiles are clipped to the grid's leaf-aligned extent (a brick's root cube may reach past it),
-// so that the tree, once pruned, does not depend on how the job was split into bricks.
-void addClippedTile(openvdb::FloatTree& tree, const Tile& tile, float value, const std::array<int32_t, 3>& extent);
-
-void addTile(openvdb::FloatTree& tree, const Tile& tile, float value) {
-  int level = 3;
-  while (kTileEdge[level] > tile.size) --level;
-  const int32_t step = kTileEdge[level];
-  for (int32_t i = 0; i < tile.size; i += step)
-    for (int32_t j = 0; j < tile.size; j += step)
-      for (int32_t k = 0; k < tile.size; k += step)
-        tree.addTile(openvdb::Index(level),
-                     openvdb::Coord(tile.origin[0] + i, tile.origin[1] + j, tile.origin[2] + k), value, false);
+// The sampler's index (i, j, k) is the world lattice's (i, j, k) + offset: its origin is a whole
+// number of voxels from the world origin (makeGrid), so the grid's transform is a pure scale.
+openvdb::Coord latticeOffset(const GridSpec& g) {
+  return openvdb::Coord(int32_t(std::llround(g.origin[0] / g.voxel)), int32_t(std::llround(g.origin[1] / g.voxel)),
+                        int32_t(std::llround(g.origin[2] / g.voxel)));
 }
 
-void addLeaf(openvdb::FloatTree& tree, const LeafBlock& block) {
-  auto* leaf = tree.touchLeaf(openvdb::Coord(block.origin[0], block.origin[1], block.origin[2]));
-  for (int n = 0; n < kLeafVoxels; ++n) {
-    const float value = -block.values[size_t(n)];  // level sets are negative inside
-    if (block.isActive(n)) leaf->setValueOn(openvdb::Index(n), value);
-    else leaf->setValueOff(openvdb::Index(n), value);
-  }
-}
-
-void addClippedTile(openvdb::FloatTree& tree, const Tile& tile, float value, const std::array<int32_t, 3>& extent) {
-  bool inside = true;
+// A sampler tile, clipped to the grid's leaf-aligned extent (a brick's root cube may reach past
+// it) so that the tree, once pruned, does not depend on how the job was split into bricks.
+void addTile(openvdb::FloatTree& tree, const Tile& tile, float value, const std::array<int32_t, 3>& extent,
+             const openvdb::Coord& offset) {
+  openvdb::Coord lo, hi;
   for (int a = 0; a < 3; ++a) {
     if (tile.origin[a] >= extent[a]) return;  // entirely past the grid
-    inside = inside && tile.origin[a] + tile.size <= extent[a];
+    lo[a] = tile.origin[a] + offset[a];
+    hi[a] = std::min(tile.origin[a] + tile.size, extent[a]) - 1 + offset[a];
   }
-  if (inside || tile.size == kLeafDim) {
-    addTile(tree, tile, value);
-    return;
-  }
-  const int32_t h = tile.size / 2;
-  for (int c = 0; c < 8; ++c)
-    addClippedTile(tree,
-                   Tile{{tile.origin[0] + ((c >> 2) & 1) * h, tile.origin[1] + ((c >> 1) & 1) * h,
-                         tile.origin[2] + (c & 1) * h},
-                        h, tile.inside},
-                   value, extent);
+  tree.fill(openvdb::CoordBBox(lo, hi), value, false);
+}
+
+void addLeaf(openvdb::FloatGrid::Accessor& acc, const LeafBlock& block, const openvdb::Coord& offset) {
+  const openvdb::Coord o = openvdb::Coord(block.origin[0], block.origin[1], block.origin[2]) + offset;
+  for (int x = 0; x < kLeafDim; ++x)
+    for (int y = 0; y < kLeafDim; ++y)
+      for (int z = 0; z < kLeafDim; ++z) {
+        const int n = leafOffset(x, y, z);
+        const float value = -block.values[size_t(n)];  // level sets are negative inside
+        const openvdb::Coord c = o.offsetBy(x, y, z);
+        if (block.isActive(n)) acc.setValueOn(c, value);
+        else acc.setValueOff(c, value);
+      }
 }
 
 // OpenVDB stamps a random UUID into every file header; replace it by one derived from the file's
@@ -164,26 +155,73 @@ openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result) {
   openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(background);
   openvdb::FloatTree& tree = grid->tree();
   const std::array<int32_t, 3> extent{(g.dims[0] + 7) & ~7, (g.dims[1] + 7) & ~7, (g.dims[2] + 7) & ~7};
-  for (const Tile& t : result.tiles) addClippedTile(tree, t, t.inside ? -background : background, extent);
-  for (const LeafBlock& b : result.leaves) addLeaf(tree, b);
+  const openvdb::Coord offset = latticeOffset(g);
+  for (const Tile& t : result.tiles) addTile(tree, t, t.inside ? -background : background, extent, offset);
+  openvdb::FloatGrid::Accessor acc = grid->getAccessor();
+  for (const LeafBlock& b : result.leaves) addLeaf(acc, b, offset);
   openvdb::tools::pruneLevelSet(tree);  // canonical tree: the same whatever the brick layout
 
-  openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(g.voxel);
-  xform->postTranslate(openvdb::Vec3d(g.origin[0], g.origin[1], g.origin[2]));
-  grid->setTransform(xform);
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(g.voxel));
   grid->setGridClass(openvdb::GRID_LEVEL_SET);
   return grid;
 }
 
+openvdb::FloatGrid::Ptr signedDistanceGrid(const openvdb::FloatGrid& raw, int bandVoxels) {
+  // Meshes the zero set of -f (linear along the lattice's edges) and takes the exact distance to
+  // that mesh in a band of bandVoxels either side, on the same transform: a pure function of the
+  // merged grid, so as deterministic as it is (TBB only splits a min over triangles).
+  const float band = float(bandVoxels);
+  openvdb::FloatGrid::Ptr sdf = openvdb::tools::levelSetRebuild(raw, 0.0f, band, band);
+  sdf->setGridClass(openvdb::GRID_LEVEL_SET);
+  openvdb::tools::pruneLevelSet(sdf->tree());
+  return sdf;
+}
+
+namespace {
+
+const char* signDescription(VdbStore store) {
+  switch (store) {
+    case VdbStore::Raw: return "value = -f";
+    case VdbStore::Fog: return "value = density: 1 inside, 0 outside, a linear ramp across the inner band";
+    case VdbStore::Sdf: break;
+  }
+  return "value = signed distance to the surface f = 0, negative inside, world units";
+}
+
+}  // namespace
+
+const char* storeName(VdbStore store) {
+  switch (store) {
+    case VdbStore::Raw: return "raw";
+    case VdbStore::Fog: return "fog";
+    case VdbStore::Sdf: break;
+  }
+  return "sdf";
+}
+
 void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta) {
   openvdb::FloatGrid::Ptr grid = levelSetGrid(result);
-  const float background = float(result.bandVoxels * result.grid.voxel);
-  grid->setName(meta.gridName);
-  grid->insertMeta("frep_sign", openvdb::StringMetadata("value = -f"));
+  if (meta.store != VdbStore::Raw) grid = signedDistanceGrid(*grid, result.bandVoxels);
+  if (meta.store == VdbStore::Fog) openvdb::tools::sdfToFogVolume(*grid);  // class fog volume
+  const GridSpec& g = result.grid;
+  const float background = float(result.bandVoxels * g.voxel);
+  const openvdb::Coord offset = latticeOffset(g);
+  const openvdb::Coord last = offset + openvdb::Coord(g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1);
+  // Blender's volume import looks for a grid named "density".
+  grid->setName(meta.store == VdbStore::Fog ? "density" : meta.gridName);
+  grid->insertMeta("frep_sign", openvdb::StringMetadata(signDescription(meta.store)));
+  grid->insertMeta("frep_store", openvdb::StringMetadata(storeName(meta.store)));
   grid->insertMeta("frep_operation", openvdb::StringMetadata("sample"));
   grid->insertMeta("frep_model_hash", openvdb::StringMetadata(hex(meta.sourceHash)));
+  grid->insertMeta("frep_source", openvdb::StringMetadata(meta.source));
   grid->insertMeta("frep_object", openvdb::StringMetadata(meta.gridName));
-  grid->insertMeta("frep_command", openvdb::StringMetadata(meta.commandLine));
+  grid->insertMeta("frep_job", openvdb::StringMetadata(meta.job));
+  grid->insertMeta("frep_units", openvdb::StringMetadata("model units (the .hf file's coordinates)"));
+  grid->insertMeta("frep_voxel", openvdb::DoubleMetadata(g.voxel));
+  grid->insertMeta("frep_box_index_min", openvdb::Vec3IMetadata(openvdb::Vec3i(offset.asVec3i())));
+  grid->insertMeta("frep_box_index_max", openvdb::Vec3IMetadata(openvdb::Vec3i(last.asVec3i())));
+  grid->insertMeta("frep_box_min", openvdb::Vec3DMetadata(grid->indexToWorld(offset)));
+  grid->insertMeta("frep_box_max", openvdb::Vec3DMetadata(grid->indexToWorld(last)));
   grid->insertMeta("frep_band_voxels", openvdb::Int32Metadata(result.bandVoxels));
   grid->insertMeta("frep_band", openvdb::DoubleMetadata(double(background)));
   grid->insertMeta("frep_iso", openvdb::DoubleMetadata(meta.iso));

@@ -19,7 +19,7 @@ class FarmCli : public FarmTest {
     write("part.hf", kPartModel);
   }
   std::string sampleArgs(const std::string& out) const {
-    return "sample part.hf -b 1 --res 96 --no-progress --heartbeat-ms 100 -O " + out;
+    return "sample part.hf -b 1 --res 95 --no-progress --heartbeat-ms 100 -O " + out;
   }
 };
 
@@ -89,7 +89,7 @@ TEST_F(FarmCli, PoisonedBrickExitsFiveAndIsNamed) {
     r.err = readText(path(".err"));
   }
   EXPECT_EQ(r.code, 5);
-  EXPECT_NE(r.err.find("brick 2 voxels [0,0,64)-(32,32,96)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("brick 2 voxels [0,0,64)-(32,32,95)"), std::string::npos) << r.err;
   EXPECT_FALSE(fileExists(path("out.vdb")));
   EXPECT_TRUE(fileExists(path("out.vdb.journal")));
 }

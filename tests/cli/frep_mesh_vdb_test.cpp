@@ -50,7 +50,7 @@ void expectClosedSphere(const ReadMesh& m, double volume, double volumeTolerance
 
 TEST_F(FrepTest, MeshFromVdbIsWatertightAndAgreesWithTheModelMesh) {
   write("s.hf", kSphere);  // radius 1
-  ASSERT_EQ(run("sample s.hf -b 1.5 --res 48 -O s.vdb").code, 0);
+  ASSERT_EQ(run("sample s.hf -b 1.5 -g 48 --store raw -O s.vdb").code, 0);
   RunResult r = run("mesh s.vdb -O v.ply");
   ASSERT_EQ(r.code, 0) << r.err;
   ReadMesh v = readPly(readText(path("v.ply")));
@@ -59,7 +59,8 @@ TEST_F(FrepTest, MeshFromVdbIsWatertightAndAgreesWithTheModelMesh) {
       << r.out;
   EXPECT_TRUE(contains(r.out, "from grid 'my_model' of s.vdb")) << r.out;
   EXPECT_TRUE(contains(r.out, "left out 0")) << r.out;
-  const double volume = 4.0 / 3.0 * kPi, voxel = 3.0 / 47;
+  // -g 48: voxel 1/16, so that +-1.5 are on sample's world lattice and mesh samples the same points.
+  const double volume = 4.0 / 3.0 * kPi, voxel = 1.0 / 16;
   expectClosedSphere(v, volume, 0.01);
   EXPECT_NEAR(mc::surfaceArea(v.positions, v.triangles), 4 * kPi, 0.01 * 4 * kPi);
   EXPECT_EQ(mc::selfIntersections(v.positions, v.triangles), 0u);
@@ -73,7 +74,7 @@ TEST_F(FrepTest, MeshFromVdbIsWatertightAndAgreesWithTheModelMesh) {
   // carry vertices, in the same (edge key) order, and each pair lies within a voxel (along an
   // edge that grazes the sphere the linear interpolant's root slides along the edge, ~0.6 voxel,
   // while staying on the surface to within 0.25 voxel, asserted above).
-  ASSERT_EQ(run("mesh s.hf -b 1.5 --res 48 --tolerance 0 -O m.ply").code, 0);  // unsimplified, like the .vdb's
+  ASSERT_EQ(run("mesh s.hf -b 1.5 -g 48 --tolerance 0 -O m.ply").code, 0);  // unsimplified, like the .vdb's
   ReadMesh m = readPly(readText(path("m.ply")));
   // The farm report gives the master's peak memory (ru_maxrss), here a few MB at least.
   for (const char* report : {"m.ply.report.json", "s.vdb.report.json"}) {
@@ -102,14 +103,15 @@ TEST_F(FrepTest, MeshFromVdbIsWatertightAndAgreesWithTheModelMesh) {
   // A sample with the narrowest band (1 voxel) still has every crossed cell's corners active:
   // the same vertices and triangles (normals differ where a central difference reaches past the
   // band and uses an inactive voxel's +-band value).
-  ASSERT_EQ(run("sample s.hf -b 1.5 --res 48 --band 1 -O b1.vdb").code, 0);
+  ASSERT_EQ(run("sample s.hf -b 1.5 -g 48 --band 1 --store raw -O b1.vdb").code, 0);
   RunResult b = run("mesh b1.vdb -O b1.ply");
   ASSERT_EQ(b.code, 0) << b.err;
   EXPECT_TRUE(contains(b.out, "left out 0")) << b.out;
   ReadMesh b1 = readPly(readText(path("b1.ply")));
   EXPECT_TRUE(b1.positions == v.positions);
   EXPECT_TRUE(b1.triangles == v.triangles);
-  for (size_t i = 0; i < b1.normals.size(); ++i) ASSERT_GT(mc::dot(b1.normals[i], v.normals[i]), 0.9) << i;
+  // (0.85: on this lattice the worst such vertex turns its normal by 27 degrees, 0.893.)
+  for (size_t i = 0; i < b1.normals.size(); ++i) ASSERT_GT(mc::dot(b1.normals[i], v.normals[i]), 0.85) << i;
 }
 
 TEST_F(FrepTest, MeshFromVdbFollowsTheGridTransform) {

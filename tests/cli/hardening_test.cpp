@@ -93,8 +93,10 @@ TEST_F(Hardening, FullDiskDuringTheFinalWriteLeavesNoOutput) {
   const size_t size = readText(path("full.vdb")).size();
   std::remove(path("full.vdb").c_str());
   std::remove(path("full.vdb.report.json").c_str());
-  ASSERT_GT(size, 17u * 1024) << "the test needs the .vdb larger than the journal";
-  RunResult r = runWith("trap '' XFSZ; ulimit -f 17", sampleArgs("full.vdb"));
+  // 40 KiB: above the journal (~19 KB: -b 1.5 is rounded out to the lattice of 0.2, 17 points),
+  // below the .vdb (a signed distance, ~84 KB).
+  ASSERT_GT(size, 40u * 1024) << "the test needs the .vdb larger than the limit";
+  RunResult r = runWith("trap '' XFSZ; ulimit -f 40", sampleArgs("full.vdb"));
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_NE(r.err.find("File too large"), std::string::npos) << r.err;
   EXPECT_FALSE(fileExists(path("full.vdb")));
@@ -146,9 +148,13 @@ TEST_F(Hardening, IntegerArgumentsOutOfRangeAreRefused) {
       EXPECT_LT(seconds, 30.0) << c.args;  // generous: refused before planning, not after
     }
   }
+  // sample's lattice: -1..1 is rounded out to 65537 points (+-1 are half a voxel of 2/65535
+  // off it), 1025^3 bricks of 64; mesh keeps the box corner: 65536 points, 1024^3 bricks.
   RunResult big = run("sample sphere.hf -O out.vdb --res 65536");
-  EXPECT_NE(big.err.find("1073741824 bricks"), std::string::npos) << big.err;
+  EXPECT_NE(big.err.find("1076890625 bricks"), std::string::npos) << big.err;
   EXPECT_NE(big.err.find("MiB"), std::string::npos) << big.err;
+  RunResult bigMesh = run("mesh sphere.hf -O out.ply --res 65536");
+  EXPECT_NE(bigMesh.err.find("1073741824 bricks"), std::string::npos) << bigMesh.err;
   EXPECT_EQ(listing(), "sphere.hf");
 }
 

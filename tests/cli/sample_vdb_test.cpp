@@ -20,10 +20,10 @@ openvdb::FloatGrid::Ptr readGrid(const std::string& path) {
 
 }  // namespace
 
-TEST_F(FrepTest, SampleWritesALevelSetOfMinusF) {
+TEST_F(FrepTest, SampleStoreRawWritesALevelSetOfMinusF) {
   write("s.hf", kSphere);
   // Voxel 4 / 32 = 0.125: every grid point is dyadic, so f is exact in float.
-  RunResult r = run("sample s.hf -b 2 --res 33 --band 3 -O s.vdb");
+  RunResult r = run("sample s.hf -b 2 --res 33 --band 3 --store raw -O s.vdb");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(r.out.find("wrote s.vdb: 33x33x33 voxels of 0.125, band 3 voxels\n") == 0) << r.out;
   EXPECT_NE(r.out.find("  NaN values 0\n"), std::string::npos) << r.out;
@@ -37,14 +37,18 @@ TEST_F(FrepTest, SampleWritesALevelSetOfMinusF) {
   EXPECT_EQ(grid->metaValue<std::string>("frep_object"), "my_model");
   EXPECT_EQ(grid->metaValue<std::string>("frep_operation"), "sample");
   EXPECT_EQ(grid->metaValue<std::string>("frep_model_hash").size(), 16u);
-  EXPECT_NE(grid->metaValue<std::string>("frep_command").find("sample s.hf -b 2 --res 33 --band 3"),
-            std::string::npos);
+  EXPECT_EQ(grid->metaValue<std::string>("frep_store"), "raw");
+  EXPECT_EQ(grid->metaValue<std::string>("frep_job"),
+            "sample object=my_model params= iso=0 map= voxel=0.125 lattice=-16,-16,-16:16,16,16 band=3 store=raw");
+  EXPECT_EQ(grid->metaValue<std::string>("frep_source"), "s.hf");
   EXPECT_EQ(grid->metaValue<int32_t>("frep_band_voxels"), 3);
   EXPECT_EQ(grid->metaValue<double>("frep_band"), 0.375);
   EXPECT_FALSE(grid->metaValue<std::string>("frep_version").empty());
   EXPECT_EQ(grid->background(), 0.375f);
   EXPECT_EQ(grid->voxelSize(), openvdb::Vec3d(0.125));
-  EXPECT_EQ(grid->indexToWorld(openvdb::Coord(0, 0, 0)), openvdb::Vec3d(-2.0));
+  // The world lattice: index (i, j, k) is world (i, j, k) * voxel; the box -2..2 is -16..16.
+  EXPECT_EQ(grid->indexToWorld(openvdb::Coord(0, 0, 0)), openvdb::Vec3d(0.0));
+  EXPECT_EQ(grid->indexToWorld(openvdb::Coord(-16, -16, -16)), openvdb::Vec3d(-2.0));
 
   // Every active voxel holds -f; the band reaches 3 voxels from the sphere of radius 1.
   size_t active = 0;
@@ -57,33 +61,96 @@ TEST_F(FrepTest, SampleWritesALevelSetOfMinusF) {
   EXPECT_GT(active, 1000u);
   // The surface point (1, 0, 0) is active with value 0; centre and corner are ∓background.
   auto acc = grid->getConstAccessor();
-  EXPECT_TRUE(acc.isValueOn(openvdb::Coord(24, 16, 16)));
-  EXPECT_EQ(acc.getValue(openvdb::Coord(24, 16, 16)), 0.0f);
-  EXPECT_EQ(acc.getValue(openvdb::Coord(16, 16, 16)), -0.375f);
-  EXPECT_FALSE(acc.isValueOn(openvdb::Coord(16, 16, 16)));
-  EXPECT_EQ(acc.getValue(openvdb::Coord(0, 0, 0)), 0.375f);
+  EXPECT_TRUE(acc.isValueOn(openvdb::Coord(8, 0, 0)));
+  EXPECT_EQ(acc.getValue(openvdb::Coord(8, 0, 0)), 0.0f);
+  EXPECT_EQ(acc.getValue(openvdb::Coord(0, 0, 0)), -0.375f);
+  EXPECT_FALSE(acc.isValueOn(openvdb::Coord(0, 0, 0)));
+  EXPECT_EQ(acc.getValue(openvdb::Coord(-16, -16, -16)), 0.375f);
 }
 
 TEST_F(FrepTest, SampleHonoursParamsIsoAndGrid) {
   write("s.hf", kSphere);
   // Radius 1 + a[1] = 1.5, iso 1.25: the solid is 2.25 - r^2 >= 1.25, radius 1 again.
-  RunResult r = run("sample s.hf -b 2 -g 32 -a 0.5 -i 1.25 -O s.vdb");
+  RunResult r = run("sample s.hf -b 2 -g 32 -a 0.5 -i 1.25 --store raw -O s.vdb");
   ASSERT_EQ(r.code, 0) << r.err;
   openvdb::FloatGrid::Ptr grid = readGrid(path("s.vdb"));
   ASSERT_TRUE(grid);
   EXPECT_EQ(grid->metaValue<double>("frep_iso"), 1.25);
   EXPECT_EQ(grid->metaValue<std::string>("frep_params"), "0.5");
   auto acc = grid->getConstAccessor();
-  EXPECT_TRUE(acc.isValueOn(openvdb::Coord(24, 16, 16)));
-  EXPECT_EQ(acc.getValue(openvdb::Coord(24, 16, 16)), 0.0f);
-  EXPECT_EQ(acc.getValue(openvdb::Coord(25, 16, 16)), float(-(1.0 - 1.125 * 1.125)));
+  EXPECT_TRUE(acc.isValueOn(openvdb::Coord(8, 0, 0)));
+  EXPECT_EQ(acc.getValue(openvdb::Coord(8, 0, 0)), 0.0f);
+  EXPECT_EQ(acc.getValue(openvdb::Coord(9, 0, 0)), float(-(1.0 - 1.125 * 1.125)));
+}
+
+TEST_F(FrepTest, SampleWritesASignedDistanceByDefault) {
+  write("s.hf", kSphere);
+  RunResult r = run("sample s.hf -b 2 --res 33 -O s.vdb");
+  ASSERT_EQ(r.code, 0) << r.err;
+  openvdb::FloatGrid::Ptr grid = readGrid(path("s.vdb"));
+  ASSERT_TRUE(grid);
+  EXPECT_EQ(grid->getGridClass(), openvdb::GRID_LEVEL_SET);
+  EXPECT_EQ(grid->metaValue<std::string>("frep_store"), "sdf");
+  EXPECT_EQ(grid->background(), 0.375f);
+  // The sphere's distance |p| - 1 (the sampler's -f is 1 - |p|^2: twice as steep at the surface).
+  size_t active = 0;
+  for (auto it = grid->cbeginValueOn(); it; ++it) {
+    const openvdb::Vec3d p = grid->indexToWorld(it.getCoord());
+    if (std::abs(*it) < 0.25) EXPECT_NEAR(*it, p.length() - 1.0, 0.01) << it.getCoord();
+    ++active;
+  }
+  EXPECT_GT(active, 1000u);
+}
+
+TEST_F(FrepTest, SampleBoxIsRoundedOutwardToTheWorldLattice) {
+  write("s.hf", kSphere);
+  // Voxel 0.125 (-g 32 over 4); -1.95..2.05 rounds to -2..2.125 (index -16..17).
+  RunResult r = run("sample s.hf -b -1.95,-1.95,-1.95,2.05,2.05,2.05 -g 32 --store raw -O s.vdb");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(r.out.find("wrote s.vdb: 34x34x34 voxels of 0.125") == 0) << r.out;
+  openvdb::FloatGrid::Ptr grid = readGrid(path("s.vdb"));
+  EXPECT_EQ(grid->metaValue<openvdb::Vec3i>("frep_box_index_min"), openvdb::Vec3i(-16));
+  EXPECT_EQ(grid->metaValue<openvdb::Vec3i>("frep_box_index_max"), openvdb::Vec3i(17));
+  EXPECT_EQ(grid->metaValue<openvdb::Vec3d>("frep_box_min"), openvdb::Vec3d(-2.0));
+  EXPECT_EQ(grid->metaValue<openvdb::Vec3d>("frep_box_max"), openvdb::Vec3d(2.125));
+  // The surface point (1, 0, 0) is lattice index (8, 0, 0) whatever the box.
+  EXPECT_EQ(grid->getConstAccessor().getValue(openvdb::Coord(8, 0, 0)), 0.0f);
+}
+
+TEST_F(FrepTest, SampleBytesDoNotDependOnHowTheCommandIsSpelt) {
+  write("s.hf", kSphere);
+  ASSERT_EQ(run("sample s.hf -b 2 --res 33 -O a.vdb").code, 0);
+  // Another spelling of the model's path, options in another order, -g for the same lattice,
+  // another argv[0] (a symlink to the binary).
+  ASSERT_EQ(std::system(("mkdir -p '" + path("sub") + "' && ln -s '" FREP_BINARY "' '" + path("frep-link") + "'").c_str()), 0);
+  std::string cmd = "cd '" + path("sub") + "' && ../frep-link sample -O ../b.vdb --band 3 -g 32 ../sub/../s.hf -b -2,2 "
+                    "--no-progress >/dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_TRUE(readText(path("a.vdb")) == readText(path("b.vdb"))) << "output bytes differ";
+  ASSERT_EQ(run("sample s.hf -b 2 --res 33 --band 2 -O c.vdb").code, 0);
+  EXPECT_FALSE(readText(path("a.vdb")) == readText(path("c.vdb"))) << "a different job must differ";
+}
+
+TEST_F(FrepTest, SampleFogVolumeIsADensityGrid) {
+  write("s.hf", kSphere);
+  ASSERT_EQ(run("sample s.hf -b 2 --res 33 --store fog -O f.vdb").code, 0);
+  openvdb::FloatGrid::Ptr grid = readGrid(path("f.vdb"));
+  EXPECT_EQ(grid->getName(), "density");
+  EXPECT_EQ(grid->getGridClass(), openvdb::GRID_FOG_VOLUME);
+  EXPECT_EQ(grid->metaValue<std::string>("frep_object"), "my_model");
+  auto acc = grid->getConstAccessor();
+  EXPECT_EQ(acc.getValue(openvdb::Coord(0, 0, 0)), 1.0f);
+  EXPECT_EQ(acc.getValue(openvdb::Coord(16, 16, 16)), 0.0f);
+  RunResult bad = run("sample s.hf --res 16 --store density -O x.vdb");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--store"), std::string::npos) << bad.err;
 }
 
 TEST_F(FrepTest, SampleLogsThroughSpdlogAtTheChosenLevel) {
   write("s.hf", kSphere);
   RunResult info = run("sample s.hf --res 16 -O a.vdb");
   ASSERT_EQ(info.code, 0) << info.err;
-  EXPECT_NE(info.err.find("frep: info: sampling 'my_model' on 16x16x16 voxels"), std::string::npos) << info.err;
+  EXPECT_NE(info.err.find("frep: info: sampling 'my_model' on 17x17x17 voxels"), std::string::npos) << info.err;
   RunResult quiet = run("sample s.hf --res 16 -O b.vdb --log-level warn");
   ASSERT_EQ(quiet.code, 0) << quiet.err;
   EXPECT_EQ(quiet.err, "");
@@ -93,6 +160,19 @@ TEST_F(FrepTest, SampleCountsNaNValues) {
   write("n.hf", "my_model(x[3], a[1]) { my_model = 0.5 - x[1]^0.5; }\n");
   RunResult r = run("sample n.hf -b 1 --res 16 -O n.vdb");
   ASSERT_EQ(r.code, 0) << r.err;
-  // Voxels with x < 0 (8 of 16 columns) are NaN; NaN widens every interval, so all are sampled.
-  EXPECT_NE(r.out.find("  NaN values 2048 (domain errors, stored as outside)\n"), std::string::npos) << r.out;
+  // Voxels with x < 0 (8 of 17 columns: -1..1 is the lattice of 2/15 from -8 to 8) are NaN; NaN widens every interval, so all are sampled.
+  EXPECT_NE(r.out.find("  NaN values 2312 (domain errors, stored as outside)\n"), std::string::npos) << r.out;
+}
+
+TEST_F(FrepTest, DefaultBrickKeepsTwoWorkersBusyWithTheSameBytes) {
+  // 64^3 points (-b 0..63 with -g 63: voxel 1): one brick of 64 would idle a worker.
+  write("s.hf", "my_model(x[3], a[1]) { my_model = 400 - (x[1]-30)^2 - (x[2]-30)^2 - (x[3]-30)^2; }\n");
+  RunResult a = run("sample s.hf -b 0,0,0,63,63,63 -g 63 --workers 2 --no-progress -O a.vdb");
+  ASSERT_EQ(a.code, 0) << a.err;
+  EXPECT_TRUE(a.out.find("wrote a.vdb: 64x64x64 voxels") == 0) << a.out;
+  EXPECT_NE(a.out.find("bricks 8 (8 computed"), std::string::npos) << a.out;  // bricks of 32
+  RunResult b = run("sample s.hf -b 0,0,0,63,63,63 -g 63 --workers 2 --brick 64 --no-progress -O b.vdb");
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_NE(b.out.find("bricks 1 (1 computed"), std::string::npos) << b.out;
+  EXPECT_TRUE(readText(path("a.vdb")) == readText(path("b.vdb"))) << "output bytes differ";
 }

@@ -3,6 +3,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <functional>
@@ -189,12 +190,17 @@ class Simplifier {
   // the result.
   const SimplifyStats& run() {
     setUp();
+    const bool report = opt_.progress && !w_.confined;  // the global pass (stage 2) only
+    uint64_t examined = 0;
     while (!queue_.empty()) {
+      if (report && (examined & 4095) == 0) opt_.progress(2, examined, examined + queue_.size());
+      ++examined;
       Candidate c = queue_.top();
       queue_.pop();
       if (!alive_[c.a] || !alive_[c.b] || version_[c.a] != c.va || version_[c.b] != c.vb) continue;
       tryCollapse(c.a, c.b);
     }
+    if (report) opt_.progress(2, examined, examined);
     int worst = -1;  // over the triangles that collapses made
     for (uint32_t t = 0; t < w_.tris.size(); ++t)
       if (tAlive_[t] && w_.made[t]) worst = std::max<int>(worst, w_.level[t]);
@@ -961,8 +967,13 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
       r.made.push_back(out.made[t]);
     }
   };
+  std::atomic<uint64_t> solved{0};
+  if (opt.progress) opt.progress(pass, 0, blocks.size());
   parallelChunks(blocks.size(), 1, opt.threads, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) solve(i);
+    for (size_t i = b; i < e; ++i) {
+      solve(i);
+      if (opt.progress) opt.progress(pass, ++solved, blocks.size());
+    }
   });
 
   for (Result& r : results) {

@@ -26,6 +26,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "frep/meshing/mesh.h"
@@ -43,6 +44,10 @@ struct SimplifyOptions {
   // The mesh's bricks of this many cells (from index 0) went through simplifyRegion already:
   // their blocks are not done again. 0: none.
   int bricksSimplified = 0;
+  // Called as simplifyMesh advances (from the block passes' threads too: it must be thread-safe):
+  // stage 0 and 1 are the block passes (blocks done of total), stage 2 the global pass (collapse
+  // candidates examined of examined + queued, so its total grows). Never changes the result.
+  std::function<void(int stage, uint64_t done, uint64_t total)> progress;
 };
 
 struct SimplifyStats : SimplifyCounters {

@@ -11,9 +11,12 @@ namespace frep::io {
 
 // One FloatGrid of class level set holding -f (negative inside): the sampler's leaf voxels
 // (active in the band), tiles and the background at +-band * voxel, pruned to the canonical
-// tree, with the grid's transform (voxel size, index (0,0,0) at the grid's origin). No name and
-// no metadata (writeLevelSet adds them). Calls openvdb::initialize().
+// tree, on the world lattice (a pure scale transform; the sampler's index shifted by its
+// origin / voxel). No name and no metadata (writeLevelSet adds them). Calls openvdb::initialize().
 openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result);
 
-}  // namespace frep::io
+// The true signed distance (class level set, band of bandVoxels either side) to the zero set
+// of `raw` (a levelSetGrid), by tools::levelSetRebuild on the same transform.
+openvdb::FloatGrid::Ptr signedDistanceGrid(const openvdb::FloatGrid& raw, int bandVoxels);
 
+}  // namespace frep::io

@@ -9,19 +9,28 @@
 
 namespace frep::io {
 
+// What the grid holds: a true signed distance (default), the sampler's -f, or a fog volume.
+enum class VdbStore { Sdf, Raw, Fog };
+const char* storeName(VdbStore store);  // "sdf", "raw", "fog" (the --store values)
+
 struct VdbMetadata {
-  std::string gridName;     // the object's name
-  std::string commandLine;  // as typed
-  std::string params;       // -a as given ("" = none)
+  std::string gridName;  // the object's name
+  std::string job;       // canonical job description (frepJobDescription): stable provenance
+  std::string source;    // the model file's name without its directories
+  std::string params;    // -a as given ("" = none)
   uint64_t sourceHash = 0;  // lang::Model::sourceHash
   double iso = 0.0;
+  VdbStore store = VdbStore::Sdf;
 };
 
-// Writes one FloatGrid of class level set holding -f (negative inside, as OpenVDB expects):
-// leaf voxels from the sampler (active in the band), tiles and the background at ±band*voxel,
-// the grid's transform (voxel size, translated to the grid origin) and metadata (frep_sign =
-// "value = -f", frep_operation, frep_model_hash, frep_object, frep_command, frep_band_voxels,
-// frep_band, frep_iso, frep_params, frep_version). Throws Error(kExitIoError).
+// Writes one FloatGrid on the world lattice (index (i, j, k) at world (i, j, k) * voxel: a pure
+// scale transform). Sdf: class level set, the exact distance to the zero set of f (meshed from
+// the samples) in a band of bandVoxels either side, background band * voxel, negative inside.
+// Raw: the sampler's -f (active in its band, tiles and background at +-band * voxel). Fog:
+// the Sdf grid through tools::sdfToFogVolume, named "density". Metadata: frep_sign, frep_store,
+// frep_operation, frep_model_hash, frep_source, frep_object, frep_job, frep_units, frep_voxel,
+// frep_box_index_min/max, frep_box_min/max (world), frep_band_voxels, frep_band, frep_iso,
+// frep_params, frep_version. Throws Error(kExitIoError).
 void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta);
 
 }  // namespace frep::io
