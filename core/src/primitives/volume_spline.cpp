@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 
 namespace frep {
@@ -106,8 +108,45 @@ void distanceRange(const double lo[3], const double hi[3], double cx, double cy,
 
 }  // namespace
 
+// Fitted splines by the hash of their data, so that compiling a model again in the same process
+// (the farm master compiles it for planning and for checking) does not solve again.
+namespace {
+std::mutex gCacheMutex;
+std::multimap<uint64_t, std::weak_ptr<const VolumeSpline>> gCache;
+uint64_t dataHash(const std::vector<Point3>& centres, const std::vector<double>& values) {
+  uint64_t h = 0x5f1e5eedULL;
+  for (size_t i = 0; i < centres.size() && i < values.size(); ++i) {
+    for (int k = 0; k < 3; ++k) h = mixBits(h, centres[i][k]);
+    h = mixBits(h, values[i]);
+  }
+  return h;
+}
+}  // namespace
+
 std::shared_ptr<const VolumeSpline> VolumeSpline::fit(const std::vector<Point3>& centres,
                                                       const std::vector<double>& values) {
+  const uint64_t key = dataHash(centres, values);
+  {
+    std::lock_guard<std::mutex> lock(gCacheMutex);
+    for (auto [it, end] = gCache.equal_range(key); it != end;) {
+      auto alive = it->second.lock();
+      if (!alive) {
+        it = gCache.erase(it);
+        continue;
+      }
+      if (alive->centres_ == centres && alive->values_ == values) return alive;
+      ++it;
+    }
+  }
+  auto s = solve(centres, values);
+  s->hash_ = key;
+  std::lock_guard<std::mutex> lock(gCacheMutex);
+  gCache.emplace(key, s);
+  return s;
+}
+
+std::shared_ptr<VolumeSpline> VolumeSpline::solve(const std::vector<Point3>& centres,
+                                                  const std::vector<double>& values) {
   const size_t n = centres.size();
   if (values.size() != n)
     throw std::invalid_argument("volume spline: " + std::to_string(n) + " centres but " +
@@ -118,6 +157,7 @@ std::shared_ptr<const VolumeSpline> VolumeSpline::fit(const std::vector<Point3>&
                                 std::to_string(kMaxCentres));
   auto s = std::shared_ptr<VolumeSpline>(new VolumeSpline());
   s->centres_ = centres;
+  s->values_ = values;
   double lo[3], hi[3], vmax = 1.0;
   for (int k = 0; k < 3; ++k) lo[k] = hi[k] = centres[0][k];
   for (size_t i = 0; i < n; ++i) {
@@ -229,12 +269,6 @@ std::shared_ptr<const VolumeSpline> VolumeSpline::fit(const std::vector<Point3>&
     for (uint32_t i : g.items) s->sparse_.push_back({q[i][0], q[i][1], q[i][2], mu(Eigen::Index(i))});
   }
 
-  uint64_t h = 0x5f1e5eedULL;
-  for (size_t i = 0; i < n; ++i) {
-    for (int k = 0; k < 3; ++k) h = mixBits(h, centres[i][k]);
-    h = mixBits(h, values[i]);
-  }
-  s->hash_ = h;
   double worst = 0.0;
   for (size_t i = 0; i < n; ++i) worst = std::max(worst, std::fabs(s->value(centres[i].data()) - values[i]));
   s->maxResidual_ = worst;
@@ -250,7 +284,7 @@ std::string VolumeSpline::describe() const {
 
 bool VolumeSpline::sameContent(const FieldFunction& other) const {
   const auto* o = dynamic_cast<const VolumeSpline*>(&other);
-  if (!o || o->hash_ != hash_ || o->centres_ != centres_ || o->dense_.size() != dense_.size() ||
+  if (!o || o->hash_ != hash_ || o->centres_ != centres_ || o->values_ != values_ || o->dense_.size() != dense_.size() ||
       o->sparse_.size() != sparse_.size())
     return false;
   for (size_t i = 0; i < dense_.size(); ++i)

@@ -41,7 +41,8 @@ class VolumeSpline final : public FieldFunction {
   static constexpr size_t kMaxDense = 2000;
   static constexpr size_t kMaxCentres = 200000;
 
-  // Throws std::invalid_argument with the reason (and the centres concerned).
+  // Throws std::invalid_argument with the reason (and the centres concerned). Fits of the same
+  // data in one process share one object (a cache of the live ones).
   static std::shared_ptr<const VolumeSpline> fit(const std::vector<Point3>& centres,
                                                  const std::vector<double>& values);
 
@@ -63,12 +64,14 @@ class VolumeSpline final : public FieldFunction {
     double x, y, z, w;
   };
   VolumeSpline() = default;
+  static std::shared_ptr<VolumeSpline> solve(const std::vector<Point3>& centres, const std::vector<double>& values);
   double denseValue(const double q[3]) const;
   double sparseValue(const double q[3]) const;
   template <typename Fn>
   void forSparseNear(const double lo[3], const double hi[3], Fn&& fn) const;
 
-  std::vector<Point3> centres_;  // as given (for sameContent)
+  std::vector<Point3> centres_;  // as given (for sameContent and the fit cache)
+  std::vector<double> values_;
   double origin_[3] = {0, 0, 0}, scale_ = 1.0;  // q = (X - origin) / scale
   std::vector<Term> dense_;      // l_i at c_i
   double poly_[4] = {0, 0, 0, 0};  // p0 + p . q
