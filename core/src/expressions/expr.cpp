@@ -326,6 +326,7 @@ bool commutative(Op op) {
 }
 
 Expr build(Op op, Expr a, Expr b, Expr c, double imm) {
+  if (op == Op::Field) throw std::invalid_argument("Expr::make: a field node needs its object (use fieldCall)");
   int arity = opArity(op);
   // Constant folding.
   bool allConst = a.isConst() && (arity < 2 || b.isConst()) && (arity < 3 || c.isConst());
