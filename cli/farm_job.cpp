@@ -21,6 +21,11 @@ farm::JobSpec makeJob(const LoadedModel& m, const std::string& modelPath, const 
   job.set_operation(operation);
   job.set_model_source(m.source);
   job.set_model_name(modelPath);
+  for (const auto& [path, contents] : m.files) {
+    farm::ModelFile* f = job.add_model_files();
+    f->set_path(path);
+    f->set_contents(contents);
+  }
   job.set_object(m.model.objectName);
   for (double p : m.spec.params) job.add_params(p);
   for (int a : m.spec.axis) job.add_map_axis(a);

@@ -81,6 +81,7 @@ LoadedModel loadModel(const ModelRequest& request, bool toView) {
   m.source = source;
   m.model = compiled.model;
   m.objects = compiled.objects;
+  m.files = compiled.files;
   m.spec.params = parseParameters(m.model, request.params);
   m.spec.iso = request.iso;
   m.dims = mapCoordinates(m.model, request.mapping, toView, m.spec);

@@ -21,6 +21,7 @@ struct ModelRequest {
 
 struct LoadedModel {
   std::string source;                    // the file's text (sent to farm workers)
+  std::vector<std::pair<std::string, std::string>> files;  // files the model read (sent too)
   lang::Model model;                     // as compiled, before binding
   lang::FieldSpec spec;                  // -a, -i and -x as resolved against the model
   std::vector<lang::ObjectInfo> objects;

@@ -50,6 +50,7 @@ namespace {
 Expr jobField(const JobSpec& job, uint32_t* dimsOut) {
   lang::CompileOptions opt;
   opt.object = job.object();
+  for (const auto& f : job.model_files()) opt.files[f.path()] = f.contents();
   lang::CompileResult r = lang::compile(job.model_source(), job.model_name(), opt);
   if (!r.ok) {
     std::string msg;

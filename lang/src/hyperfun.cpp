@@ -35,7 +35,7 @@ CompileResult compile(const std::string& source, const std::string& fileName,
   DiagnosticSink diags(fileName, source);
   std::vector<Token> tokens = lex(source, diags);
   Program program = parse(tokens, diags);
-  std::vector<LoweredObject> lowered = lowerProgram(program, options, diags);
+  std::vector<LoweredObject> lowered = lowerProgram(program, options, diags, fileName, result.files);
   for (const auto& o : lowered) result.objects.push_back(o.info);
   int sel = selectedObject(program, options);
   if (sel >= 0 && !options.object.empty() && lowered[sel].info.name != lowerCase(options.object))

@@ -187,6 +187,7 @@ class Run {
         return (truthOf(eval(*e.args[0])) != 0.0 || r != 0.0) ? 1.0 : 0.0;
       }
       case AstExpr::Kind::Not: return truthOf(eval(*e.args[0])) != 0.0 ? 0.0 : 1.0;
+      case AstExpr::Kind::String: throw InterpretError("a string has no value");
     }
     return 0.0;
   }

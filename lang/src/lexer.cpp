@@ -9,6 +9,7 @@ namespace frep::lang {
 std::string tokenName(Tok kind) {
   switch (kind) {
     case Tok::End: return "end of file";
+    case Tok::String: return "a string";
     case Tok::Number: return "a number";
     case Tok::Ident: return "a name";
     case Tok::Plus: return "'+'";
@@ -207,12 +208,18 @@ class Lexer {
       diags_.error(loc, "unexpected '!='; HyperFun writes 'not equal' as '/='");
       return two(Tok::Ne);
     }
-    if (c == '"') {
-      diags_.error(loc, "string literals are not supported (no function takes a string)");
+    if (c == '"') {  // a file name (frVolumeSplineFile); one line, no escapes
       advance();
+      const size_t start = pos_;
       while (pos_ < src_.size() && src_[pos_] != '"' && src_[pos_] != '\n') advance();
-      if (pos_ < src_.size() && src_[pos_] == '"') advance();
-      return false;
+      if (pos_ >= src_.size() || src_[pos_] != '"') {
+        diags_.error(loc, "unterminated string (a string ends with '\"' on the same line)");
+        return false;
+      }
+      t.kind = Tok::String;
+      t.text = src_.substr(start, pos_ - start);
+      advance();
+      return true;
     }
     unsigned char u = static_cast<unsigned char>(c);
     std::string shown = std::isprint(u) ? std::string("'") + c + "'" : "byte 0x" + hex(u);

@@ -201,8 +201,17 @@ int selectedObject(const Program& program, const CompileOptions& options) {
 
 std::vector<LoweredObject> lowerProgram(const Program& program, const CompileOptions& options,
                                         DiagnosticSink& diags) {
+  std::vector<std::pair<std::string, std::string>> files;
+  return lowerProgram(program, options, diags, "", files);
+}
+
+std::vector<LoweredObject> lowerProgram(const Program& program, const CompileOptions& options,
+                                        DiagnosticSink& diags, const std::string& modelFile,
+                                        std::vector<std::pair<std::string, std::string>>& files) {
   std::vector<LoweredObject> done;
   Shared shared{program, options, diags, done};
+  shared.modelFile = modelFile;
+  shared.files = &files;
   const ObjectDecl* selected = nullptr;
   if (int sel = selectedObject(program, options); sel >= 0) selected = &program.objects[sel];
   for (const auto& obj : program.objects) {

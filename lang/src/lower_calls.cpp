@@ -2,6 +2,9 @@
 // earlier objects.
 #include "frep/lang/lower_object.h"
 
+#include <fstream>
+#include <sstream>
+
 namespace frep::lang::detail {
 
 Value& ObjectLowering::arrayArgument(const AstExpr& arg, const std::string& callee, size_t index) {
@@ -109,7 +112,7 @@ std::string ObjectLowering::describeSignature(const std::string& sig) {
   std::string out;
   for (size_t i = 0; i < sig.size(); ++i) {
     if (i) out += ", ";
-    out += sig[i] == 'A' ? "array" : sig[i] == 'O' ? "object" : "scalar";
+    out += sig[i] == 'A' ? "array" : sig[i] == 'O' ? "object" : sig[i] == 'F' ? "file name" : "scalar";
   }
   return out;
 }
@@ -137,6 +140,14 @@ Expr ObjectLowering::callLibrary(const AstExpr& e, const LibraryFunction& f) {
     const AstExpr& a = *e.args[i];
     if (sig[i] == 'O') {
       objectArgument(a, f.name, i, args[i]);
+      continue;
+    }
+    if (sig[i] == 'F') {
+      if (a.kind != AstExpr::Kind::String)
+        throw CompileError{a.loc, "argument " + std::to_string(i + 1) + " of " + f.name +
+                                      " must be a file name in double quotes"};
+      args[i].name = a.name;
+      args[i].file = &readModelFile(a);
       continue;
     }
     if (a.kind == AstExpr::Kind::Name) {
@@ -203,6 +214,30 @@ Expr ObjectLowering::callObject(const AstExpr& e, const ObjectDecl& callee, cons
   for (int j = 0; j < callee.aSize; ++j) paramsAsVars.push_back(Expr::x(callee.xSize + j));
   vars.insert(vars.end(), arrs[1]->elems.begin(), arrs[1]->elems.end());
   return remap(bindParams(lowered.field, paramsAsVars), vars);
+}
+
+const std::string& ObjectLowering::readModelFile(const AstExpr& path) {
+  const std::string& written = path.name;
+  auto cached = sh_.fileCache.find(written);
+  if (cached != sh_.fileCache.end()) return cached->second;
+  std::string contents;
+  auto given = sh_.options.files.find(written);
+  if (given != sh_.options.files.end()) {
+    contents = given->second;
+  } else {
+    if (written.empty()) throw CompileError{path.loc, "empty file name"};
+    std::string full = written;
+    const size_t slash = sh_.modelFile.rfind('/');
+    if (written[0] != '/' && slash != std::string::npos) full = sh_.modelFile.substr(0, slash + 1) + written;
+    std::ifstream in(full, std::ios::binary);
+    if (!in) throw CompileError{path.loc, "cannot open file '" + full + "'"};
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) throw CompileError{path.loc, "cannot read file '" + full + "'"};
+    contents = ss.str();
+  }
+  sh_.files->emplace_back(written, contents);
+  return sh_.fileCache.emplace(written, std::move(contents)).first->second;
 }
 
 }  // namespace frep::lang::detail

@@ -69,6 +69,8 @@ Expr ObjectLowering::lower(const AstExpr& e) {
       return logicalOr(truth(lower(*e.args[0])), r);
     }
     case AstExpr::Kind::Not: return logicalNot(truth(lower(*e.args[0])));
+    case AstExpr::Kind::String:
+      throw CompileError{e.loc, "a string is only allowed as a file name argument (frVolumeSplineFile)"};
   }
   return Expr(0.0);
 }

@@ -430,6 +430,12 @@ class Parser {
       next();
       return n;
     }
+    if (t.kind == Tok::String) {
+      auto n = node(AstExpr::Kind::String, t.loc);
+      n->name = n->spelling = t.text;
+      next();
+      return n;
+    }
     if (t.kind == Tok::LParen) {
       next();
       // A parenthesised condition is allowed anywhere (hfp allows it only in conditions).

@@ -23,7 +23,9 @@ const ErrorCase kCases[] = {
     {"BangEquals", "m(x[3], a[1]) {\n  if x[1] != 0 then m = 1; endif;\n}", 2, 11,
      "unexpected '!='; HyperFun writes 'not equal' as '/='"},
     {"StringLiteral", "m(x[3], a[1]) {\n  m = \"s\";\n}", 2, 7,
-     "string literals are not supported (no function takes a string)"},
+     "a string is only allowed as a file name argument (frVolumeSplineFile)"},
+    {"UnterminatedString", "m(x[3], a[1]) {\n  m = \"s;\n}", 2, 7,
+     "unterminated string (a string ends with '\"' on the same line)"},
     // syntax
     {"EmptyFile", "  \n", 2, 1, "the file defines no object; expected 'name(x[n], a[m]) { ... }'"},
     {"NotAnObject", "42", 1, 1,

@@ -9,6 +9,7 @@
 
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/pow_int.h"
+#include "frep/expressions/field_function.h"
 #include "frep/extremum/extremum.h"
 
 namespace frep {
@@ -76,9 +77,26 @@ void countDomainErrors(const Instr& ins, const T* a, const T* b, size_t count, D
   }
 }
 
+// An Op::Field instruction: the object evaluates all lanes at once in double (its output may
+// alias an input, so through a side buffer).
+template <typename T>
+void runField(const FieldFunction& fn, const Instr& ins, T* regs, size_t n) {
+  constexpr size_t B = BatchEvaluator<T>::kBatch;
+  thread_local std::vector<double> buf;
+  buf.resize(4 * B);
+  double *u = buf.data(), *v = u + B, *w = v + B, *out = w + B;
+  const T* a = regs + size_t(ins.a) * B;
+  const T* b = regs + size_t(ins.b) * B;
+  const T* c = regs + size_t(ins.c) * B;
+  for (size_t i = 0; i < n; ++i) u[i] = double(a[i]), v[i] = double(b[i]), w[i] = double(c[i]);
+  fn.values(u, v, w, out, n);
+  T* o = regs + size_t(ins.out) * B;
+  for (size_t i = 0; i < n; ++i) o[i] = T(out[i]);
+}
+
 template <typename T>
 FREP_CLONES void runTape(const Instr* code, const uint32_t* sinCos, size_t ninstr, T* __restrict regs, size_t n,
-                         DomainCounts* dom, size_t count) {
+                         DomainCounts* dom, size_t count, const std::shared_ptr<const FieldFunction>* fields) {
   constexpr size_t B = BatchEvaluator<T>::kBatch;
   for (size_t k = 0; k < ninstr; ++k) {
     const Instr& ins = code[k];
@@ -151,6 +169,7 @@ FREP_CLONES void runTape(const Instr* code, const uint32_t* sinCos, size_t ninst
       case Op::And: LOOP((a[i] != T(0)) & (b[i] != T(0)) ? T(1) : T(0));
       case Op::Or: LOOP((a[i] != T(0)) | (b[i] != T(0)) ? T(1) : T(0));
       case Op::Select: LOOP(a[i] != T(0) ? b[i] : c[i]);
+      case Op::Field: runField(*fields[size_t(ins.imm)], ins, regs, n); break;
       case Op::RAnd: case Op::ROr: {
         // rFunctionValue, lane by lane (same association, so the same bits as the point
         // evaluator in double)
@@ -210,18 +229,19 @@ const T* BatchEvaluator<T>::eval(const Tape& tape, size_t count) {
   // sinCos[k]: instruction k's entry in the sin/cos pairing plan (nullptr: no pair)
   const uint32_t* sinCos = tape.sinCosPlan().empty() ? nullptr : tape.sinCosPlan().data();
   auto at = [&](size_t k) { return sinCos ? sinCos + k : nullptr; };
+  const auto* fields = tape.fields().data();
   if (!tape.hasExtrema()) {
-    runTape<T>(code.data(), sinCos, code.size(), regs_.data(), n, domain_, count);
+    runTape<T>(code.data(), sinCos, code.size(), regs_.data(), n, domain_, count, fields);
   } else {
     // Straight-line segments between extremum instructions run vectorised as usual.
     size_t start = 0;
     for (size_t k = 0; k < code.size(); ++k) {
       if (code[k].op != Op::Extremum) continue;
-      runTape<T>(code.data() + start, at(start), k - start, regs_.data(), n, domain_, count);
+      runTape<T>(code.data() + start, at(start), k - start, regs_.data(), n, domain_, count, fields);
       runExtremum(tape, code[k], count);
       start = k + 1;
     }
-    runTape<T>(code.data() + start, at(start), code.size() - start, regs_.data(), n, domain_, count);
+    runTape<T>(code.data() + start, at(start), code.size() - start, regs_.data(), n, domain_, count, fields);
   }
   return regs_.data() + size_t(tape.resultReg()) * kBatch;
 }

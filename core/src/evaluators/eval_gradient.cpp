@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "frep/evaluators/eval.h"
+#include "frep/expressions/field_function.h"
 #include "frep/extremum/extremum.h"
 
 namespace frep {
@@ -101,6 +102,21 @@ double GradientEvaluator::eval(const Tape& tape, const double* x, double* grad) 
       for (size_t k = 0; k < nin; ++k) {
         const double* dk = d + size_t(e.inputRegs[k]) * nv;
         for (uint32_t j = 0; j < nv; ++j) row_[j] += term(gbuf_[k], dk[j]);
+      }
+      std::copy(row_.begin(), row_.end(), d + size_t(ins.out) * nv);
+      v[ins.out] = value;
+      continue;
+    }
+    if (ins.op == Op::Field) {
+      // Chain rule through the object's own partials.
+      const double p[3] = {v[ins.a], v[ins.b], v[ins.c]};
+      double g[3];
+      const double value = tape.field(ins).gradient(p, g);
+      const uint32_t in[3] = {ins.a, ins.b, ins.c};
+      row_.assign(nv, 0.0);
+      for (int k = 0; k < 3; ++k) {
+        const double* dk = d + size_t(in[k]) * nv;
+        for (uint32_t j = 0; j < nv; ++j) row_[j] += term(g[k], dk[j]);
       }
       std::copy(row_.begin(), row_.end(), d + size_t(ins.out) * nv);
       v[ins.out] = value;

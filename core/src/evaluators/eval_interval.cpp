@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "frep/evaluators/eval.h"
+#include "frep/expressions/field_function.h"
 #include "frep/extremum/extremum.h"
 #include "evaluators/interval_fast.h"
 
@@ -61,6 +62,11 @@ Interval IntervalEvaluator::eval(const Tape& tape, const Interval* box) {
       xbuf_.resize(e.inputRegs.size());
       for (size_t i = 0; i < e.inputRegs.size(); ++i) xbuf_[i] = r[e.inputRegs[i]];
       r[ins.out] = extrema_.get(tape, ins.a).bound(xbuf_.data(), extremumSignOnly_);
+      continue;
+    }
+    if (ins.op == Op::Field) {
+      const Interval in[3] = {r[ins.a], r[ins.b], r[ins.c]};
+      r[ins.out] = tape.field(ins).bound(in);
       continue;
     }
     if (ins.op == Op::Min || ins.op == Op::Max || ins.op == Op::Select) {

@@ -1,5 +1,6 @@
 // Point evaluator: the double-precision reference walk of a tape.
 #include "frep/evaluators/eval.h"
+#include "frep/expressions/field_function.h"
 #include "frep/extremum/extremum.h"
 
 namespace frep {
@@ -14,7 +15,7 @@ double PointEvaluator::eval(const Tape& tape, const double* x) {
   double* r = regs_.data();
   const uint32_t v0 = tape.varReg(0);
   for (uint32_t i = 0; i < tape.numVars(); ++i) r[v0 + i] = x[i];
-  if (!tape.hasExtrema() && !domain_) {
+  if (!tape.hasExtrema() && tape.fields().empty() && !domain_) {
     for (const Instr& ins : tape.code()) r[ins.out] = applyOp(ins.op, r[ins.a], r[ins.b], r[ins.c], ins.imm);
     return r[tape.resultReg()];
   }
@@ -25,6 +26,11 @@ double PointEvaluator::eval(const Tape& tape, const double* x) {
       xbuf_.resize(e.inputRegs.size());
       for (size_t k = 0; k < e.inputRegs.size(); ++k) xbuf_[k] = r[e.inputRegs[k]];
       r[ins.out] = extrema_.get(tape, ins.a).solve(xbuf_.data()).value;
+      continue;
+    }
+    if (ins.op == Op::Field) {
+      const double p[3] = {r[ins.a], r[ins.b], r[ins.c]};
+      r[ins.out] = tape.field(ins).value(p);
       continue;
     }
     if (domain_ && isDomainError(ins.op, r[ins.a], r[ins.b], kind)) ++domain_->n[size_t(kind)];

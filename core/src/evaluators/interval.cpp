@@ -234,6 +234,7 @@ Interval dispatch(Op op, const Interval& a, const Interval& b, const Interval& c
   switch (op) {
     case Op::Const: case Op::Var: case Op::Param: case Op::Copy: return a;
     case Op::Extremum: break;  // evaluated by the extremum search, never through here
+    case Op::Field: break;     // bounded by its FieldFunction object, never through here
     case Op::Neg: return {-a.hi, -a.lo};
     case Op::Abs:
       if (a.lo >= 0.0) return a;

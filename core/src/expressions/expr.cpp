@@ -3,6 +3,7 @@
 #include "frep/expressions/pow_int.h"
 
 #include "frep/extremum/extremum.h"
+#include "frep/expressions/field_function.h"
 
 #include <algorithm>
 #include <cmath>
@@ -30,7 +31,7 @@ const OpInfo kOps[] = {
     {"copy", 1},  {"add", 2},    {"sub", 2},   {"mul", 2},   {"div", 2},    {"pow", 2},
     {"atan2", 2}, {"min", 2},    {"max", 2},   {"fmod", 2},  {"lt", 2},     {"le", 2},
     {"gt", 2},    {"ge", 2},     {"eq", 2},    {"ne", 2},    {"and", 2},    {"or", 2},
-    {"rand", 2},  {"ror", 2},    {"select", 3}};
+    {"rand", 2},  {"ror", 2},    {"select", 3}, {"field", 3}};
 static_assert(sizeof(kOps) / sizeof(kOps[0]) == static_cast<size_t>(Op::Count_), "op table");
 
 uint64_t mix(uint64_t h, uint64_t v) {
@@ -86,9 +87,11 @@ struct Key {
   uint64_t valueBits;
   const Node* args[3];
   const ExtremumSpec* spec;
+  const FieldFunction* fn;
   bool operator==(const Key& o) const {
     if (op != o.op) return false;
     if (op == Op::Extremum) return sameSpec(*spec, *o.spec);
+    if (op == Op::Field && fn != o.fn && !fn->sameContent(*o.fn)) return false;
     return index == o.index && valueBits == o.valueBits && args[0] == o.args[0] &&
            args[1] == o.args[1] && args[2] == o.args[2];
   }
@@ -98,6 +101,7 @@ struct KeyHash {
     uint64_t h = mix(static_cast<uint64_t>(k.op), k.index);
     h = mix(h, k.valueBits);
     if (k.spec) return mix(h, specHash(*k.spec));
+    if (k.fn) h = mix(h, k.fn->contentHash());
     for (auto* a : k.args) h = mix(h, reinterpret_cast<uintptr_t>(a));
     return h;
   }
@@ -116,7 +120,8 @@ InternTable& table() {
 Key keyOf(const Node& n) {
   uint64_t vb = 0;
   std::memcpy(&vb, &n.value, sizeof vb);
-  return Key{n.op, n.index, vb, {n.args[0].get(), n.args[1].get(), n.args[2].get()}, n.spec.get()};
+  return Key{n.op, n.index, vb, {n.args[0].get(), n.args[1].get(), n.args[2].get()}, n.spec.get(),
+             n.fn.get()};
 }
 
 // Deleting a node releases its children, which may delete them in turn: on a chain of 10^5
@@ -163,6 +168,7 @@ NodePtr intern(Node&& proto) {
     depth = std::max(depth, proto.spec->body.node().depth + 1);
     for (const Expr& in : proto.spec->inputs) depth = std::max(depth, in.node().depth + 1);
   }
+  if (proto.fn) h = mix(h, proto.fn->contentHash());
   proto.hash = h;
   proto.depth = depth;
   auto* raw = new Node(std::move(proto));
@@ -255,6 +261,7 @@ double applyOp(Op op, double a, double b, double c, double imm) {
   switch (op) {
     case Op::Const: case Op::Var: case Op::Param: return a;
     case Op::Extremum: break;  // not a scalar op: evaluated by a search (extremum.h)
+    case Op::Field: break;     // evaluated by its FieldFunction object
     case Op::Neg: return -a;
     case Op::Abs: return std::fabs(a);
     case Op::Sqrt: return a > 0.0 ? std::sqrt(a) : 0.0;
@@ -319,6 +326,7 @@ bool commutative(Op op) {
 }
 
 Expr build(Op op, Expr a, Expr b, Expr c, double imm) {
+  if (op == Op::Field) throw std::invalid_argument("Expr::make: a field node needs its object (use fieldCall)");
   int arity = opArity(op);
   // Constant folding.
   bool allConst = a.isConst() && (arity < 2 || b.isConst()) && (arity < 3 || c.isConst());
@@ -495,6 +503,8 @@ Expr rebuild(const Expr& e, const std::function<bool(const Node&, Expr&)>& leafM
           spec->inputs = std::move(ins);
           out = Expr::makeExtremum(std::move(spec));
         }
+      } else if (n.op == Op::Field) {
+        out = fieldCall(n.fn, done.at(n.args[0].get()), done.at(n.args[1].get()), done.at(n.args[2].get()));
       } else if (arity == 0) {
         out = Expr(n.op == Op::Const ? leaf(Op::Const, 0, n.value) : leaf(n.op, n.index, n.value));
       } else {
@@ -549,6 +559,15 @@ Expr derivative(const Expr& e, uint32_t var) {
       d.emplace(&n, Expr(0.0));
       return;
     }
+    if (n.op == Op::Field) {
+      // The object's partials are not expressions (GradientEvaluator uses fn->gradient).
+      for (int i = 0; i < 3; ++i)
+        if (!d.at(n.args[i].get()).isConst(0.0))
+          throw std::logic_error("derivative: " + n.fn->describe() +
+                                 " has no closed-form derivative (use GradientEvaluator)");
+      d.emplace(&n, Expr(0.0));
+      return;
+    }
     auto D = [&](int i) { return d.at(n.args[i].get()); };
     Expr a = opArity(n.op) > 0 ? Expr(n.args[0]) : Expr();
     Expr b = opArity(n.op) > 1 ? Expr(n.args[1]) : Expr();
@@ -556,7 +575,7 @@ Expr derivative(const Expr& e, uint32_t var) {
     auto binary = [&](const Expr& pa, const Expr& pb) { return term(pa, D(0)) + term(pb, D(1)); };
     Expr r;
     switch (n.op) {
-      case Op::Const: case Op::Param: case Op::Extremum: r = 0.0; break;
+      case Op::Const: case Op::Param: case Op::Extremum: case Op::Field: r = 0.0; break;
       case Op::Var: r = n.index == var ? 1.0 : 0.0; break;
       case Op::Neg: r = -D(0); break;
       case Op::Abs: r = unary(sign(a)); break;
@@ -610,6 +629,25 @@ Expr derivative(const Expr& e, uint32_t var) {
 
 uint64_t structuralHash(const Expr& e) { return e.node().hash; }
 
+void FieldFunction::values(const double* u, const double* v, const double* w, double* out, size_t n) const {
+  for (size_t i = 0; i < n; ++i) {
+    const double p[3] = {u[i], v[i], w[i]};
+    out[i] = value(p);
+  }
+}
+
+Expr fieldCall(FieldFunctionPtr fn, const Expr& u, const Expr& v, const Expr& w) {
+  if (u.isConst() && v.isConst() && w.isConst()) {
+    const double p[3] = {u.constValue(), v.constValue(), w.constValue()};
+    return Expr(fn->value(p));
+  }
+  Node n;
+  n.op = Op::Field;
+  n.args[0] = u.ptr(), n.args[1] = v.ptr(), n.args[2] = w.ptr();
+  n.fn = std::move(fn);
+  return Expr(intern(std::move(n)));
+}
+
 std::string toString(const Expr& e) {
   std::ostringstream os;
   std::unordered_map<const Node*, std::string> s;
@@ -634,6 +672,10 @@ std::string toString(const Expr& e) {
         o << ")";
         break;
       }
+      case Op::Field:
+        o << "(field " << n.fn->describe() << " " << s.at(n.args[0].get()) << " " << s.at(n.args[1].get()) << " "
+          << s.at(n.args[2].get()) << ")";
+        break;
       default: {
         o << "(" << opName(n.op);
         if (n.op == Op::PowI) o << " " << n.value;

@@ -99,6 +99,7 @@ TapePtr Tape::compile(const Expr& e, uint32_t nvars) {
   for (size_t i = 0; i < order.size(); ++i)
     for (size_t k = 0; k < numChildren(*order[i]); ++k) lastUse[&child(*order[i], k)] = i;
   auto extrema = std::make_shared<std::vector<ExtremumEntry>>();
+  auto fields = std::make_shared<std::vector<std::shared_ptr<const FieldFunction>>>();
 
   // 3. Linear-scan allocation of temporaries; inputs whose last use is this instruction are
   //    freed before the output is allocated, so an output may reuse an input's register.
@@ -132,6 +133,10 @@ TapePtr Tape::compile(const Expr& e, uint32_t nvars) {
       ins.a = in[0];
       ins.b = in[1];
       ins.c = in[2];
+      if (n->op == Op::Field) {
+        ins.imm = double(fields->size());
+        fields->push_back(n->fn);
+      }
     }
     for (int k = 0; k < arity; ++k) {
       const Node* ch = &child(*n, static_cast<size_t>(k));
@@ -159,6 +164,7 @@ TapePtr Tape::compile(const Expr& e, uint32_t nvars) {
   t.numRegs_ = next;
   t.uniforms_ = uniforms;
   t.extrema_ = extrema;
+  t.fields_ = fields;
   t.result_ = regOf(&e.node());
   t.sinCos_ = planSinCos(t.code_, t.numRegs_);
   t.id_ = gNextTapeId++;
@@ -302,6 +308,7 @@ TapePtr Tape::prune(const std::vector<Choice>& choices, const TapePtr& self) con
   t.numRegs_ = numRegs_;
   t.uniforms_ = uniforms_;
   t.extrema_ = extrema_;
+  t.fields_ = fields_;
   t.result_ = result;
   t.code_ = sc.kept;
   for (auto& ins : t.code_)

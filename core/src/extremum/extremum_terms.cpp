@@ -123,7 +123,7 @@ void TermForm::build(const Expr& objective, uint32_t n, uint32_t p, const std::v
   indep_.clear();
   bool bad = false;
   forEachNode(objective, [&](const Node& nd) {
-    if (nd.op == Op::Extremum || nd.op == Op::Param) bad = true;
+    if (nd.op == Op::Extremum || nd.op == Op::Field || nd.op == Op::Param) bad = true;
   });
   if (bad || p == 0) return;
   std::vector<Expr> vars;

@@ -40,6 +40,9 @@ enum class Op : uint8_t {
   RAnd, ROr,
   // ternary
   Select,
+  // fn(a, b, c) of a FieldFunction object in Node::fn (field_function.h): data-driven fields
+  // such as volume splines. Tapes keep the object in a table (Instr::imm is its index).
+  Field,
   Count_
 };
 
@@ -51,6 +54,7 @@ constexpr double kLogFloor = 1e-300;
 
 struct Node;
 struct ExtremumSpec;  // extremum.h
+class FieldFunction;  // field_function.h
 using NodePtr = std::shared_ptr<const Node>;
 
 struct Node {
@@ -61,6 +65,7 @@ struct Node {
   size_t hash = 0;
   uint32_t depth = 0;      // longest path to a leaf (used for stable ordering)
   std::shared_ptr<const ExtremumSpec> spec;  // Op::Extremum only (body, domain, inputs)
+  std::shared_ptr<const FieldFunction> fn;   // Op::Field only
 };
 
 // Children of a node: args[0..arity) for ordinary ops, spec->inputs for Op::Extremum.

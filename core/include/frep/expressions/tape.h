@@ -56,6 +56,9 @@ class Tape {
   // Extremum instructions (an extremum is not a choice: interval pruning leaves it in place).
   const std::vector<ExtremumEntry>& extrema() const { return *extrema_; }
   bool hasExtrema() const { return !extrema_->empty(); }
+  // Objects of Op::Field instructions (an instruction's imm is its index; shared by pruned tapes).
+  const std::vector<std::shared_ptr<const FieldFunction>>& fields() const { return *fields_; }
+  const FieldFunction& field(const Instr& ins) const { return *(*fields_)[size_t(ins.imm)]; }
 
   // Sin/Cos pairs of the same input value that the batch evaluator computes with one sincos()
   // call at the first of the two: rotations and gyroids take both of one angle, and glibc's
@@ -75,6 +78,7 @@ class Tape {
   uint32_t numVars_ = 0, numRegs_ = 0, result_ = 0, numChoices_ = 0;
   std::shared_ptr<const std::vector<double>> uniforms_;
   std::shared_ptr<const std::vector<ExtremumEntry>> extrema_;
+  std::shared_ptr<const std::vector<std::shared_ptr<const FieldFunction>>> fields_;
   std::vector<Instr> code_;
   std::vector<uint32_t> sinCos_;
   TapePtr root_;  // the compiled tape this one was pruned from (keeps uniforms alive)

@@ -21,11 +21,11 @@ struct AstExpr;
 using AstExprPtr = std::unique_ptr<AstExpr>;
 
 struct AstExpr {
-  enum class Kind { Number, Name, Index, Call, Unary, Binary, Compare, And, Or, Not };
+  enum class Kind { Number, Name, Index, Call, Unary, Binary, Compare, And, Or, Not, String };
   Kind kind = Kind::Number;
   Loc loc;                    // operator or first token
   double number = 0.0;        // Number
-  std::string name;           // Name, Index, Call: lower-cased
+  std::string name;           // Name, Index, Call: lower-cased; String: its text
   std::string spelling;       // as written
   UnOp unop = UnOp::Neg;
   BinOp binop = BinOp::Add;

@@ -1,7 +1,9 @@
 // HyperFun front end: source text -> checked, lowered models (core expressions).
 #pragma once
 
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "frep/expressions/expr.h"
@@ -42,6 +44,8 @@ struct CompileResult {
   std::vector<ObjectInfo> objects;      // every object in the file
   bool ok = false;                      // no errors and a model was selected
   Model model;
+  // Files the model read, by the path as written, in first-read order (for farm jobs).
+  std::vector<std::pair<std::string, std::string>> files;
 };
 
 struct CompileOptions {
@@ -51,6 +55,9 @@ struct CompileOptions {
   // Values of a[1..]: when given, a[i] is that constant at compile time (so loop conditions and
   // indices may depend on it) instead of Expr::param(i). Missing entries stay parameters.
   std::vector<double> params;
+  // Contents of files the model reads (frVolumeSplineFile), by the path as written in the model:
+  // used instead of the disk (farm workers get them with the job).
+  std::map<std::string, std::string> files;
 };
 
 CompileResult compile(const std::string& source, const std::string& fileName,

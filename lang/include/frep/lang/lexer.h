@@ -10,7 +10,7 @@
 namespace frep::lang {
 
 enum class Tok {
-  End, Number, Ident,
+  End, Number, Ident, String /* "...": a file name argument */,
   Plus, Minus, Star, Slash, Caret, Tilde, Amp, Bar, Backslash, At,
   Comma, Semi, Assign /* '=' (assignment and equality) */, LParen, RParen, LBracket, RBracket,
   LBrace, RBrace, Lt, Le, Gt, Ge, Ne,

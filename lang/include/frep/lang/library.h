@@ -25,6 +25,9 @@ struct Arg {
   // (its a[] bound to the caller's a values, or zeros beyond the caller's a).
   bool isObject = false;
   int objectDims = 0;
+  // File arguments (signature letter 'F', a string literal): `name` is the path as written,
+  // `file` its contents (read relative to the model file's directory).
+  const std::string* file = nullptr;
 };
 
 // Thrown by a library function on bad arguments (wrong array size, ...). The lowering turns it
@@ -36,7 +39,8 @@ struct LibraryError : std::runtime_error {
 
 struct LibraryFunction {
   std::string name;       // canonical spelling, e.g. "hfSphere" (lookup is case-insensitive)
-  // One letter per argument: 'A' array, 'S' scalar, 'O' object name, e.g. "AAS"; "*": any
+  // One letter per argument: 'A' array, 'S' scalar, 'O' object name, 'F' file name (a string),
+  // e.g. "AAS"; "*": any
   // arguments (bare array names pass as arrays, earlier objects' names as objects, the rest as
   // scalars; the function checks them).
   std::string signature;

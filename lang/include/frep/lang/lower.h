@@ -24,6 +24,9 @@ int selectedObject(const Program& program, const CompileOptions& options);
 
 // Lowers every object in file order (an object may call the objects before it).
 std::vector<LoweredObject> lowerProgram(const Program& program, const CompileOptions& options,
+                                        DiagnosticSink& diags, const std::string& modelFile,
+                                        std::vector<std::pair<std::string, std::string>>& files);
+std::vector<LoweredObject> lowerProgram(const Program& program, const CompileOptions& options,
                                         DiagnosticSink& diags);
 
 }  // namespace frep::lang

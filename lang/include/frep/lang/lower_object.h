@@ -58,6 +58,9 @@ struct Shared {
   std::vector<LoweredObject>& done;  // objects lowered so far, in file order
   bool warnedAttributes = false;
   bool fixParams = false;  // the object being lowered is the selected one (options.params)
+  std::string modelFile;   // the model's file name: file arguments are relative to its directory
+  std::vector<std::pair<std::string, std::string>>* files = nullptr;  // files read so far
+  std::map<std::string, std::string> fileCache;  // the same, by path (stable references)
 };
 
 class ObjectLowering {
@@ -76,6 +79,9 @@ class ObjectLowering {
 
   // ---- diagnostics ------------------------------------------------------------------------
   void error(Loc loc, const std::string& message);
+  // The contents of a file argument (a String node): CompileOptions::files, else the disk,
+  // relative to the model file's directory.
+  const std::string& readModelFile(const AstExpr& path);
   std::vector<std::string> knownNames(bool functionsOnly) const;
   std::string suggestion(const std::string& spelling, bool functionsOnly) const;
   // Throws the error for an unknown (or not yet assigned) name, with a suggestion.
