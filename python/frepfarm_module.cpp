@@ -1,5 +1,6 @@
 // The Python module `frepfarm`: HyperFun models compiled by frep_lang, evaluated by the core's
 // batch evaluator on NumPy arrays, sampled and meshed by the core, written by frep_io (docs/python.md).
+#include <cmath>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -126,7 +127,16 @@ GridSpec gridOf(const std::array<double, 3>& lo, const std::array<double, 3>& hi
   for (int a = 0; a < 3; ++a)
     if (!(hi[a] > lo[a])) throw py::value_error("box: hi must exceed lo on every axis");
   if (res < 2 || res > 4096) throw py::value_error("res: expected 2 to 4096 points along the longest axis");
-  return GridSpec::fromBounds(lo, hi, res);
+  // The voxel of res points along the longest axis, on the world lattice (voxel (i, j, k) at
+  // (i, j, k) * voxel) as frep sample's grids and the .vdb writer have it; the box rounds outward.
+  GridSpec g = GridSpec::fromBounds(lo, hi, res);
+  for (int a = 0; a < 3; ++a) {
+    const double l = std::floor(lo[a] / g.voxel + 1e-9), h = std::ceil(hi[a] / g.voxel - 1e-9);
+    if (std::max(std::abs(l), std::abs(h)) > double(1 << 30)) throw py::value_error("box: too far from the origin for OpenVDB's index range");
+    g.origin[a] = l * g.voxel;
+    g.dims[a] = static_cast<int32_t>(h - l) + 1;
+  }
+  return g;
 }
 
 struct Volume {
@@ -161,7 +171,7 @@ void writeVdb(const Volume& v, const std::string& path) {
   io::AtomicOutput out("path", path);
   io::VdbMetadata meta;
   meta.gridName = v.name;
-  meta.commandLine = "frepfarm (Python) sample";
+  meta.job = "frepfarm (Python) sample";
   meta.params = v.params;
   meta.sourceHash = v.sourceHash;
   meta.iso = v.iso;

@@ -146,7 +146,10 @@ def test_vdb_read_by_pyopenvdb(tmp_path, via):
             continue
         ijk = item["min"]
         f = m.eval(np.array(g.transform.indexToWorld(ijk)))[0]
-        assert (item["value"] < 0) == (f > 0), (ijk, item["value"], f)
+        # A true signed distance (the default) is the distance to the meshed zero set: its sign
+        # may differ from f's only within a small fraction of a voxel of the surface.
+        if exact or abs(item["value"]) > 0.1 * v.voxel:
+            assert (item["value"] < 0) == (f > 0), (ijk, item["value"], f)
         if exact:
             assert item["value"] == np.float32(-f)
         n += 1
@@ -156,7 +159,9 @@ def test_vdb_read_by_pyopenvdb(tmp_path, via):
     dense = np.zeros(tuple(v.dims), dtype=np.float32)
     g.copyToArray(dense, ijk=tuple(lo))
     _, pts = lattice_points(v)
-    assert np.count_nonzero(dense < 0) == np.count_nonzero(m.eval(pts) > 0)
+    fv = m.eval(pts).reshape(dense.shape)
+    agree = (dense < 0) == (fv > 0)
+    assert np.all(agree | (np.abs(dense) < 0.1 * v.voxel))
 
 
 def test_write_vdb_errors_leave_nothing(tmp_path):
