@@ -186,9 +186,10 @@ int runRender(const RenderRequest& r) {
   for (size_t i = 0; i < 3; ++i) shade.colour[i] = colour[i] / 255.0;
   const Box box = r.bounds.empty() ? Box{} : parseBounds("-b/--bounds", r.bounds);
   if (r.farm.resume) throw badArgs("--resume: a render keeps no journal (its tiles are recomputed)");
-  if (r.farm.brick % kRenderTile != 0 || r.farm.brick < kRenderTile)
+  const int brick = r.farm.brick == -1 ? 2 * kRenderTile : r.farm.brick;  // not given: 64 pixels
+  if (brick % kRenderTile != 0 || brick < kRenderTile)
     throw badArgs("--brick: a render's bricks are tiles of whole " + std::to_string(kRenderTile) +
-                  "-pixel squares: expected a multiple of " + std::to_string(kRenderTile) + ", got " + std::to_string(r.farm.brick));
+                  "-pixel squares: expected a multiple of " + std::to_string(kRenderTile) + ", got " + std::to_string(brick));
   if (r.geometric.tFrames > 0 && r.model.mapping.empty() && loadModel(r.model, false).dims < 4)
     throw badArgs("--t-frames: the object has no x[4] to sweep");
   const GeometricTypes g = parseGeometricTypes(r.model.mapping, r.geometric, true);
@@ -200,6 +201,7 @@ int runRender(const RenderRequest& r) {
     throw badArgs("--size/--v-cells/--w-cells: the grid of pictures exceeds " + std::to_string(kMaxSide) + " pixels a side");
   farm::FarmOptions options = farmOptions(r.farm, r.out, r.logLevel, r.threads);
   options.journalPath.clear();
+  options.brickVoxels = brick;
 
   // Every picture's job and the box of the solid over all of them: the view stays put while
   // the t-sweep's solid changes (and a turntable's box does not depend on the azimuth).

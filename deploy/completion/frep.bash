@@ -5,13 +5,15 @@
 _frep_options() {
   local model="-o --object -a --params -x --map -i --iso"
   local region="-b --bounds --res -g --grid -O --out"
+  local geometric="--t-frames --t-range --v-range --v-cells --w-range --w-cells --c-range --c-levels --g-values"
   local farm="--workers --threads --listen --expect-workers --brick --heartbeat-ms --resume --json --no-progress --curve --insecure"
   case "$1" in
     check) echo "-h --help -o --object -b --bounds" ;;
     eval) echo "-h --help $model --at --tolerance" ;;
-    slice) echo "-h --help $model $region --axis --at --mask" ;;
+    slice) echo "-h --help $model $region --axis --at --mask $geometric" ;;
     sample) echo "-h --help $model $region --band --store $farm" ;;
-    mesh) echo "-h --help $model $region --tolerance --no-sharp $farm" ;;
+    mesh) echo "-h --help $model $region --tolerance --no-sharp --format --up --wrl --stl --stlb --pov --cli --gs --timing $farm" ;;
+    render) echo "-h --help $model -b --bounds -O --out --size --azimuth --elevation --distance --zoom --eye --target --up --perspective --fov --background --colour --color --frames --no-footprint $geometric $farm" ;;
     pov) echo "-h --help -o --object -O --out --thin" ;;
     relate) echo "-h --help --object-a --object-b -b --bounds --min-size --at" ;;
     keygen) echo "-h --help" ;;
@@ -22,7 +24,7 @@ _frep() {
   local cur prev verb i
   cur="${COMP_WORDS[COMP_CWORD]}"
   prev="${COMP_WORDS[COMP_CWORD-1]}"
-  local verbs="check eval slice sample mesh pov relate keygen"
+  local verbs="check eval slice sample mesh render pov relate keygen"
   for ((i = 1; i < COMP_CWORD; i++)); do
     case "${COMP_WORDS[i]}" in
       --log-level) ((i++)) ;;
@@ -34,9 +36,13 @@ _frep() {
     --log-level) COMPREPLY=($(compgen -W "trace debug info warn error critical off" -- "$cur")); return ;;
     --store) COMPREPLY=($(compgen -W "sdf raw fog" -- "$cur")); return ;;
     --axis) COMPREPLY=($(compgen -W "x y z" -- "$cur")); return ;;
+    --format) COMPREPLY=($(compgen -W "ply obj stl stl-ascii wrl pov 3mf glb cli cli-binary" -- "$cur")); return ;;
+    --wrl|--stl|--stlb|--pov|--cli) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     -O|--out) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     --curve) COMPREPLY=($(compgen -d -- "$cur")); return ;;
     -o|--object|--object-a|--object-b|-a|--params|-x|--map|-i|--iso|-b|--bounds|--res|-g|--grid|--at|--tolerance|\
+    --gs|--up|--size|--azimuth|--elevation|--distance|--zoom|--eye|--target|--fov|--background|--colour|--color|--frames|\
+    --t-frames|--t-range|--v-range|--v-cells|--w-range|--w-cells|--c-range|--c-levels|--g-values|\
     --band|--workers|--threads|--listen|--expect-workers|--brick|--heartbeat-ms|--thin|--min-size)
       return ;;  # a value: nothing to offer
   esac
@@ -52,7 +58,7 @@ _frep() {
     COMPREPLY=($(compgen -W "$(_frep_options "$verb")" -- "$cur"))
   elif [[ "$verb" == keygen ]]; then
     COMPREPLY=($(compgen -d -- "$cur"))
-  elif [[ "$verb" == mesh ]]; then
+  elif [[ "$verb" == mesh || "$verb" == render ]]; then
     COMPREPLY=($(compgen -f -X '!*.@(hf|vdb)' -- "$cur") $(compgen -d -- "$cur"))
   elif [[ "$verb" == pov ]]; then
     COMPREPLY=($(compgen -f -X '!*.@(hf|pov)' -- "$cur") $(compgen -d -- "$cur"))
