@@ -94,7 +94,7 @@ failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 model="$tmp/sphere.hf"
 echo 'my_model(x[3], a[1]) { my_model = 1 - x[1]^2 - x[2]^2 - x[3]^2; }' >"$model"
-job_args=(--res 32 -b 1.5 --brick 16)  # 8 bricks: the churn job's workers die on their fourth
+job_args=(-g 32 -b 1.6 --brick 32)  # 33³ points on the world lattice, 8 bricks: the churn job's workers die on their fourth
 frep sample "$model" "${job_args[@]}" --workers 0 --out "$tmp/reference.vdb" >/dev/null 2>&1 || fail "--workers 0 run failed"
 
 # One sbatch --wait job in its own directory; prints its exit code.
