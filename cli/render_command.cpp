@@ -17,6 +17,7 @@
 #include "commands.h"
 #include "exit_codes.h"
 #include "farm_job.h"
+#include "frep/attributes/colour.h"
 #include "frep/evaluators/eval.h"
 #include "frep/io/atomic_output.h"
 #include "frep/io/mesh_reader.h"
@@ -151,7 +152,18 @@ struct Cell {
   farm::JobSpec job;
   bool found = false;  // the solid has a point in the box
   std::vector<TapePtr> sections;  // C/G: each section's field, to colour the hits
+  std::shared_ptr<const ColourField> colour;  // the model's attributes s[1..3], if it has them
+  double inset = 0;  // colours are read this far inside the hit (colour.h: f >= 0 tests)
 };
+
+// The model's colour (HyperFun's s[1..3], frep/attributes/colour.h) a little inside the hit,
+// as the mesh writers read it at vertices: an hfA_SetColor(f, ...) test holds on the surface.
+std::array<double, 3> attributeColour(const Cell& cell, const RayHit& h) {
+  const Vec3 p{h.point[0] - cell.inset * h.normal[0], h.point[1] - cell.inset * h.normal[1],
+               h.point[2] - cell.inset * h.normal[2]};
+  const std::array<float, 3> c = cell.colour->at(p.data());
+  return {c[0], c[1], c[2]};
+}
 
 // The section a hit belongs to: the one whose field is largest at the point (the union's max).
 std::array<double, 3> sectionColour(const Cell& cell, size_t count, const RayHit& h) {
@@ -219,6 +231,12 @@ int runRender(const RenderRequest& r) {
           throw badArgs("render: the object is " + std::to_string(lm.dims) + "-dimensional; render draws 3D solids (use frep slice)");
         Cell cell;
         cell.job = makeJob(lm, r.model.path, grid, "render");
+        if (!lm.colour.empty() && g.sections.empty()) {
+          cell.colour = std::make_shared<const ColourField>(lm.colour, 3);
+          double diagonal = 0;
+          for (int a = 0; a < 3; ++a) diagonal += (box.hi[a] - box.lo[a]) * (box.hi[a] - box.lo[a]);
+          cell.inset = 1e-4 * std::sqrt(diagonal);
+        }
         farm::RenderSpec& spec = *cell.job.mutable_render();
         setVec(spec.mutable_clip_lo(), box.lo);
         setVec(spec.mutable_clip_hi(), box.hi);
@@ -273,6 +291,8 @@ int runRender(const RenderRequest& r) {
         ShadeOptions cellShade = shade;
         if (!cell.sections.empty())
           cellShade.colourAt = [&cell, n = g.sections.size()](const RayHit& hit) { return sectionColour(cell, n, hit); };
+        else if (cell.colour)
+          cellShade.colourAt = [&cell](const RayHit& hit) { return attributeColour(cell, hit); };
         const std::vector<uint8_t> rgb = shadeImage(depth, view.camera, cellShade);
         for (int y = 0; y < h; ++y)
           std::copy(&rgb[size_t(y) * size_t(w) * 3], &rgb[size_t(y + 1) * size_t(w) * 3],

@@ -257,5 +257,38 @@ TEST_F(FrepTest, RenderOfMeshesAndVdbMatchesTheModel) {
   EXPECT_TRUE(contains(opt.err, "-b/--bounds: 's.ply' is a mesh or grid")) << opt.err;
 }
 
+// HyperFun's attributes colour the picture: hfA_SetColor's red on the sphere's left half and
+// blue on its right (s[1..3] as hfp's VRML colours), the same for 0 and 2 workers.
+TEST_F(FrepTest, RenderColoursByTheModelsAttributes) {
+  write("c.hf", R"(my_model(x[3], a[1], s[3]) {
+    r = 1 - x[1]*x[1] - x[2]*x[2] - x[3]*x[3];
+    d = hfA_SetColor(r, s, 1, 0, 0);
+    d = hfA_SetColor(x[1], s, 0, 0, 1);
+    my_model = r;
+  })");
+  for (const char* workers : {"0", "2"}) {
+    RunResult r = run(std::string("render c.hf -b 2 --size 120x120 --azimuth -90 --elevation 0 --background 0,0,0 "
+                                  "--no-footprint --workers ") + workers + " -O c" + workers + ".png");
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+  Image img = readImage(path("c0.png"));
+  ASSERT_EQ(img.width, 120u);
+  // Looking along +y (azimuth -90: the eye on -y), x grows to the right of the image.
+  size_t redLeft = 0, blueRight = 0, hitLeft = 0, hitRight = 0;
+  for (unsigned y = 0; y < img.height; ++y)
+    for (unsigned x = 0; x < img.width; ++x) {
+      const uint8_t* p = &img.rgb[(size_t(y) * img.width + x) * 3];
+      if (p[0] == 0 && p[1] == 0 && p[2] == 0) continue;
+      if (x < 50) ++hitLeft, redLeft += p[0] > 0 && p[1] == 0 && p[2] == 0;
+      if (x > 70) ++hitRight, blueRight += p[2] > 0 && p[0] == 0 && p[1] == 0;
+    }
+  EXPECT_GT(hitLeft, 500u);
+  EXPECT_EQ(redLeft, hitLeft);
+  EXPECT_GT(hitRight, 500u);
+  EXPECT_EQ(blueRight, hitRight);
+  EXPECT_EQ(readText(path("c0.png")), readText(path("c2.png")));
+}
+
 }  // namespace
 }  // namespace frep_cli_test
+
