@@ -314,18 +314,9 @@ int runRender(const RenderRequest& r) {
 
 // ---- meshes and sampled grids -----------------------------------------------------------------
 
-namespace {
-std::string lowerExtension(const std::string& path) {
-  const size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || path.find('/', dot) != std::string::npos) return "";
-  std::string ext = path.substr(dot + 1);
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-}  // namespace
 
 bool isMeshOrVdb(const std::string& path) {
-  const std::string ext = lowerExtension(path);
+  const std::string ext = io::lowerExtension(path);
   return ext == "ply" || ext == "obj" || ext == "stl" || ext == "vdb";
 }
 
@@ -353,7 +344,7 @@ int runRenderMesh(const RenderRequest& r) {
 
   const auto t0 = std::chrono::steady_clock::now();
   Mesh mesh;
-  if (lowerExtension(r.model.path) == "vdb") {  // the grid's zero level set, meshed as frep mesh does
+  if (io::lowerExtension(r.model.path) == "vdb") {  // the grid's zero level set, meshed as frep mesh does
     io::SampledVdb vdb = io::readSampledVdb(r.model.path, r.model.object);
     SampledMeshOptions mo;
     mo.threads = r.threads;

@@ -11,13 +11,6 @@
 namespace frep::io {
 namespace {
 
-std::string lowerExtension(const std::string& path) {
-  const size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || path.find('/', dot) != std::string::npos) return "";
-  std::string ext = path.substr(dot + 1);
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
 
 [[noreturn]] void fail(const std::string& path, const std::string& why) { throw ioError(path + ": " + why); }
 
@@ -229,6 +222,14 @@ Mesh readStl(const std::string& path) {
 }
 
 }  // namespace
+
+std::string lowerExtension(const std::string& path) {
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || path.find('/', dot) != std::string::npos) return "";
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
 
 Mesh readMesh(const std::string& path) {
   const std::string ext = lowerExtension(path);

@@ -14,4 +14,7 @@ namespace frep::io {
 // is truncated, or is malformed (an index out of range, a non-finite coordinate, no triangles).
 Mesh readMesh(const std::string& path);
 
+// The path's extension in lower case ("" if none): "Part.STL" -> "stl".
+std::string lowerExtension(const std::string& path);
+
 }  // namespace frep::io
