@@ -1,5 +1,7 @@
 #include "sampling_grid.h"
 
+#include "frep/io/world_lattice.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -35,21 +37,7 @@ GridSpec makeGrid(const Box& box, int axes, const Resolution& r) {
 }
 
 GridSpec makeWorldLatticeGrid(const Box& box, const Resolution& r) {
-  GridSpec g;
-  g.voxel = voxelOf(box, 3, r);
-  for (int a = 0; a < 3; ++a) {
-    // Integer multiples of the voxel, the box rounded outward to them (1e-9 keeps a bound that
-    // is a whole number of voxels up to rounding where it is, so it gains no point).
-    const double lo = std::floor(box.lo[a] / g.voxel + 1e-9), hi = std::ceil(box.hi[a] / g.voxel - 1e-9);
-    // OpenVDB's coordinates are 32-bit: a box far from the origin at a fine voxel has none.
-    if (std::max(std::abs(lo), std::abs(hi)) > double(kMaxLatticeIndex))
-      throw badArgs("-b/--bounds: the box reaches " + std::to_string(std::max(std::abs(lo), std::abs(hi)) * g.voxel) +
-                    ", more than " + std::to_string(kMaxLatticeIndex) + " voxels of " + std::to_string(g.voxel) +
-                    " from the origin (OpenVDB's index range); use a coarser --res/-g or move the model");
-    g.origin[a] = lo * g.voxel;
-    g.dims[a] = static_cast<int32_t>(hi - lo) + 1;
-  }
-  return g;
+  return io::worldLatticeGrid("-b/--bounds", box.lo, box.hi, voxelOf(box, 3, r));
 }
 
 Resolution resolutionFrom(int res, const std::string& cellsText, int defaultRes) {

@@ -26,8 +26,8 @@ GridSpec makeGrid(const Box& box, int axes, const Resolution& r);
 // of other tools with the same voxel line up) that covers the box rounded outward to it. A box
 // whose bounds are multiples of the voxel gives makeGrid's points; one off the lattice gets a
 // point more on each axis it is off.
-// Throws CliError(kExitBadArgs) when the lattice index passes kMaxLatticeIndex.
-constexpr int64_t kMaxLatticeIndex = int64_t(1) << 30;
+// (frep/io/world_lattice.h.) Throws CliError(kExitBadArgs) naming -b/--bounds when a lattice
+// index passes OpenVDB's range.
 GridSpec makeWorldLatticeGrid(const Box& box, const Resolution& r);
 
 }  // namespace frep::cli

@@ -20,6 +20,7 @@
 #include "frep/io/error.h"
 #include "frep/io/mesh_writer.h"
 #include "frep/io/vdb_writer.h"
+#include "frep/io/world_lattice.h"
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 #include "frep/meshing/mesh.h"
@@ -127,16 +128,9 @@ GridSpec gridOf(const std::array<double, 3>& lo, const std::array<double, 3>& hi
   for (int a = 0; a < 3; ++a)
     if (!(hi[a] > lo[a])) throw py::value_error("box: hi must exceed lo on every axis");
   if (res < 2 || res > 4096) throw py::value_error("res: expected 2 to 4096 points along the longest axis");
-  // The voxel of res points along the longest axis, on the world lattice (voxel (i, j, k) at
-  // (i, j, k) * voxel) as frep sample's grids and the .vdb writer have it; the box rounds outward.
-  GridSpec g = GridSpec::fromBounds(lo, hi, res);
-  for (int a = 0; a < 3; ++a) {
-    const double l = std::floor(lo[a] / g.voxel + 1e-9), h = std::ceil(hi[a] / g.voxel - 1e-9);
-    if (std::max(std::abs(l), std::abs(h)) > double(1 << 30)) throw py::value_error("box: too far from the origin for OpenVDB's index range");
-    g.origin[a] = l * g.voxel;
-    g.dims[a] = static_cast<int32_t>(h - l) + 1;
-  }
-  return g;
+  // The voxel of res points along the longest axis, on the world lattice as frep sample's
+  // grids and the .vdb writer have it (the box rounds outward).
+  return io::worldLatticeGrid("box", lo, hi, GridSpec::fromBounds(lo, hi, res).voxel);
 }
 
 struct Volume {
