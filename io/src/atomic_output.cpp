@@ -1,6 +1,7 @@
 #include "frep/io/atomic_output.h"
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -91,11 +92,20 @@ AtomicOutput::AtomicOutput(const std::string& field, const std::string& path) : 
   std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
   temp_ = dir + "." + base + ".tmp" + std::to_string(::getpid());
   ::unlink(temp_.c_str());  // a leftover of an earlier process with our pid (never followed)
+  // The stop signals wait while the file is created and tracked: one arriving in between would
+  // exit without knowing the file (seen on a loaded machine).
+  sigset_t stops, old;
+  sigemptyset(&stops);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&stops, sig);
+  ::pthread_sigmask(SIG_BLOCK, &stops, &old);
   int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
-  if (fd < 0)
-    throw ioError(field + ": cannot write '" + path + "': " + std::strerror(errno));
-  ::close(fd);
-  slot_ = trackPending(temp_);
+  const int err = errno;
+  if (fd >= 0) {
+    ::close(fd);
+    slot_ = trackPending(temp_);
+  }
+  ::pthread_sigmask(SIG_SETMASK, &old, nullptr);
+  if (fd < 0) throw ioError(field + ": cannot write '" + path + "': " + std::strerror(err));
 }
 
 AtomicOutput::~AtomicOutput() {

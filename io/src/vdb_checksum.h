@@ -1,7 +1,9 @@
 // The checksum frep sample seals into its .vdb files and frep mesh verifies before OpenVDB parses
 // anything (OpenVDB's reader trusts the file: a flipped bit in the topology can corrupt its heap).
 // The grid's metadata entry frep_grid_checksum (a 16-hex-digit string) holds the FNV-1a 64 hash
-// of the file's bytes after the header's UUID, computed with those 16 digits as '0'.
+// of every byte of the file but the header's UUID (the writer derives that from the rest),
+// computed with those 16 digits as '0'. The header's format version is covered: OpenVDB parses a
+// grid by the version it is told, so an edited version alone makes it read garbage.
 #pragma once
 
 #include <cstdint>
@@ -11,13 +13,15 @@
 namespace frep::io {
 
 inline constexpr const char* kGridChecksumKey = "frep_grid_checksum";
-constexpr size_t kVdbHashedFrom = 21 + 36;  // magic, versions, offsets flag, then the UUID
+constexpr size_t kVdbUuidAt = 21, kVdbUuidLength = 36;  // after magic, versions and offsets flag
 constexpr size_t kChecksumDigits = 16;
 
-// The hash of bytes[kVdbHashedFrom..], the checksum's digits at `digitsAt` counted as '0'.
+// The hash of the bytes outside the UUID, the checksum's digits at `digitsAt` counted as '0'.
 inline std::string vdbChecksum(const std::string& bytes, size_t digitsAt) {
   uint64_t h = 0xcbf29ce484222325ULL;
-  for (size_t i = kVdbHashedFrom; i < bytes.size(); ++i) {
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    if (i == kVdbUuidAt) i += kVdbUuidLength;
+    if (i >= bytes.size()) break;
     const unsigned char c = i >= digitsAt && i < digitsAt + kChecksumDigits ? '0' : uint8_t(bytes[i]);
     h = (h ^ c) * 0x100000001b3ULL;
   }

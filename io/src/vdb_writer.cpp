@@ -65,7 +65,7 @@ void addLeaf(openvdb::FloatGrid::Accessor& acc, const LeafBlock& block, const op
 // OpenVDB stamps a random UUID into every file header; replace it by one derived from the file's
 // contents, so the same grid always gives the same bytes (farm runs are compared byte for byte).
 void makeHeaderDeterministic(std::string& bytes) {
-  constexpr size_t kUuidAt = 21, kUuidLen = 36;  // after magic, version, library version, flag
+  constexpr size_t kUuidAt = kVdbUuidAt, kUuidLen = kVdbUuidLength;
   bool looksLikeUuid = bytes.size() > kUuidAt + kUuidLen && bytes[kUuidAt + 8] == '-' && bytes[kUuidAt + 13] == '-' &&
                        bytes[kUuidAt + 18] == '-' && bytes[kUuidAt + 23] == '-';
   if (!looksLikeUuid) return;

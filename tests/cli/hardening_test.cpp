@@ -266,3 +266,27 @@ TEST_F(Hardening, DamagedVdbIsRefusedNotMeshed) {
   std::cout << corpus.size() << " damaged files: " << refused << " refused, " << identical << " meshed identically\n";
   EXPECT_TRUE(noTemporaries()) << listing();
 }
+
+// The seal covers the header too: OpenVDB parses a grid by the format version the header states,
+// so a sealed file whose version alone was edited (to another version it supports) would be read
+// as garbage. Each such edit is refused before OpenVDB reads a byte; the UUID, which the writer
+// derives from the rest of the file, is the only part outside the seal.
+TEST_F(Hardening, SealCoversTheHeaderVersions) {
+  write("sphere.hf", kSphere);
+  ASSERT_EQ(run(sampleArgs("good.vdb")).code, 0);
+  const std::string good = readText(path("good.vdb"));
+  ASSERT_EQ(uint8_t(good[8]), 224u) << "OpenVDB 10's file format version";
+  struct Edit {
+    size_t at;
+    char value;
+  } edits[] = {{8, char(222)}, {8, char(223)}, {12, char(9)}, {16, char(1)}};
+  for (const Edit& e : edits) {
+    std::string b = good;
+    b[e.at] = e.value;
+    std::ofstream(path("bad.vdb"), std::ios::binary) << b;
+    RunResult r = run("mesh bad.vdb -O bad.ply");
+    EXPECT_EQ(r.code, 3) << "byte " << e.at << "\n" << r.err;
+    EXPECT_NE(r.err.find("do not match frep_grid_checksum"), std::string::npos) << r.err;
+    EXPECT_FALSE(fileExists(path("bad.ply")));
+  }
+}

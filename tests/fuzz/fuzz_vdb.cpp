@@ -4,8 +4,9 @@
 // The first byte's low bit asks to re-seal the file (recompute its frep_grid_checksum), as an
 // attacker can: crafted files. That mode needs FREP_FUZZ_VDB_CRAFTED=1 and is off in CI: it finds
 // a heap overflow inside OpenVDB's block decompression that the checks cannot see yet (a negative
-// stored block size, docs/cli.md "Fuzzing"). CI fuzzes damage to sealed files that keeps the
-// seal entry.
+// stored block size, docs/cli.md "Fuzzing"). CI fuzzes damage to sealed files: inputs that the
+// reader's own layout check (vdb_layout.h) still finds sealed, i.e. the seal's entry survived
+// where the reader looks for it.
 #include <unistd.h>
 
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include <string>
 
 #include "../../io/src/vdb_checksum.h"
+#include "../../io/src/vdb_layout.h"
 #include "frep/io/error.h"
 #include "frep/io/vdb_reader.h"
 #include "frep/meshing/mesh_grid.h"
@@ -41,8 +43,6 @@ void frep::fuzz::vdb(const uint8_t* data, size_t size) {
   std::string bytes(reinterpret_cast<const char*>(data) + 1, size - 1);
   static const bool crafted = std::getenv("FREP_FUZZ_VDB_CRAFTED") != nullptr;
   if (crafted && (data[0] & 1)) reseal(bytes);
-  // Damage mode: a file whose seal entry itself was damaged reads as another tool's (unsealed)
-  // file, whose grids OpenVDB parses unchecked: the open gap of docs/cli.md, not fuzzed in CI.
   if (!crafted && bytes.find(sealEntry()) == std::string::npos) return;
   static const std::string path = "/tmp/frep_fuzz_vdb." + std::to_string(::getpid()) + ".vdb";
   if (FILE* f = std::fopen(path.c_str(), "wb")) {
@@ -50,6 +50,13 @@ void frep::fuzz::vdb(const uint8_t* data, size_t size) {
     std::fclose(f);
   }
   try {
+    // Damage mode: a file whose seal entry itself was damaged (moved out of the grid's metadata,
+    // or its key or length changed) reads as another tool's unsealed file, whose grids OpenVDB
+    // parses unchecked: the open gap of docs/cli.md, not fuzzed in CI.
+    if (!crafted && !io::checkVdbLayout(path).sealed) {
+      std::remove(path.c_str());
+      return;
+    }
     const io::SampledVdb v = io::readSampledVdb(path, "");
     if (v.samples.leaves.size() <= 4096) {
       SampledMeshOptions options;

@@ -1,0 +1,22 @@
+// The layout of a .vdb file checked before OpenVDB sees it (OpenVDB trusts every length it reads):
+// a regular file of at most 16 GiB read to its end, the header, the metadata, each grid's
+// descriptor and offsets bounded by the file, and frep sample's seal (vdb_checksum.h) verified
+// when the file has one. The .vdb reader and the .vdb fuzz target share it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace frep::io {
+
+constexpr uint64_t kMaxVdbBytes = uint64_t(16) << 30;  // frep mesh reads at most 16 GiB
+
+struct VdbLayout {
+  uint64_t bytes = 0;   // the file's size
+  bool sealed = false;  // it carries frep_grid_checksum and its contents match it
+};
+
+// Throws Error(kExitIoError) naming the path and what is wrong.
+VdbLayout checkVdbLayout(const std::string& path);
+
+}  // namespace frep::io
