@@ -10,6 +10,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <deque>
 #include <random>
@@ -137,6 +138,12 @@ class ComputeThread {
         std::this_thread::sleep_for(std::chrono::milliseconds(200));
         std::abort();
       }
+    // Test hook: the file appears when the first brick starts (a test stops the worker only then).
+    if (const char* f = std::getenv("FREP_TEST_STARTED_FILE"))
+      if (!announcedStart_) {
+        if (FILE* file = std::fopen(f, "w")) std::fclose(file);
+        announcedStart_ = true;
+      }
     if (const char* slow = std::getenv("FREP_TEST_SLOW_MS"))
       std::this_thread::sleep_for(std::chrono::milliseconds(std::atoi(slow)));
     try {
@@ -175,6 +182,7 @@ class ComputeThread {
 
   int threads_;
   uint64_t started_ = 0;  // bricks this worker started (FREP_TEST_DIE_AFTER)
+  bool announcedStart_ = false;  // FREP_TEST_STARTED_FILE written
   zmq::socket_t wakeSend_;
   ModelCache cache_;
   std::mutex mutex_;

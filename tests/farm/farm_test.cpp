@@ -80,10 +80,17 @@ TEST(Farm, StoppedWorkerPastLivenessThenContinuedChangesNothing) {
   FarmOutcome ref = runJob(j, fast(0));
   FarmOptions o = fast(0);
   MasterThread m(j, o);
-  WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=40"});
-  WorkerProcess sleeper(m.endpoint(), {"FREP_TEST_SLOW_MS=40"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // The sleeper starts alone and is stopped once it holds a brick (a fixed delay missed that on
+  // a loaded machine); the steady worker then has to finish the job.
+  const std::string started = "/tmp/frep_farm_test_started." + std::to_string(getpid());
+  std::remove(started.c_str());
+  WorkerProcess sleeper(m.endpoint(), {"FREP_TEST_SLOW_MS=40", "FREP_TEST_STARTED_FILE=" + started});
+  for (int i = 0; i < 3000 && access(started.c_str(), F_OK) != 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_EQ(access(started.c_str(), F_OK), 0) << "the worker never started a brick";
+  std::remove(started.c_str());
   kill(sleeper.pid, SIGSTOP);
+  WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=40"});
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // > 5 x 100 ms liveness
   kill(sleeper.pid, SIGCONT);
   m.join();
