@@ -296,6 +296,8 @@ TEST_F(MeshFormatsTest, HfpCommandLine) {
   RunResult r = run("m.hf -b 1.5 -g 20 -stl a.stl -wrl a.wrl -stlb b.stl -pov a.pov -cli a.cli -gs 0.3 -t -d 5 --workers 0");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("-d 5 ignored"), std::string::npos) << r.err;
+  // -t: hfp's timing line (frep prints it always).
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  time [0-9.]+ s meshing, [0-9.]+ s in all\n"))) << r.out;
   EXPECT_EQ(readText(path("a.stl")).rfind("solid my_model", 0), 0u);
   mesh("ref.ply");
   const size_t triangles = readBack("ref.ply").triangles;
