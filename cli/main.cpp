@@ -219,6 +219,9 @@ int main(int argc, char** argv) {
   renderCmd->add_option("--frames", render.frames, "Turntable: N frames turning the azimuth through 360 degrees");
   addGeometricOptions(renderCmd, render.geometric);
   addFarmOptions(renderCmd, render.farm);
+  // render also draws meshes and grids, and its bricks are squares of pixels, not voxels.
+  renderCmd->get_option("model")->description("The HyperFun model (.hf), or a mesh (.ply, .obj, .stl) or OpenVDB grid (.vdb)");
+  renderCmd->get_option("--brick")->description("Tile edge in pixels, a multiple of 32 (default 64; same output)");
   renderCmd->add_option("--threads", render.threads, "Threads of the in-process run, --workers 0 (default 0: all cores; same output)");
   renderCmd->add_flag("--no-footprint", render.noFootprint,
                       "Cast centre rays only (sub-pixel features between pixel centres are then not drawn)");

@@ -58,8 +58,10 @@ _frep() {
     COMPREPLY=($(compgen -W "$(_frep_options "$verb")" -- "$cur"))
   elif [[ "$verb" == keygen ]]; then
     COMPREPLY=($(compgen -d -- "$cur"))
-  elif [[ "$verb" == mesh || "$verb" == render ]]; then
+  elif [[ "$verb" == mesh ]]; then
     COMPREPLY=($(compgen -f -X '!*.@(hf|vdb)' -- "$cur") $(compgen -d -- "$cur"))
+  elif [[ "$verb" == render ]]; then
+    COMPREPLY=($(compgen -f -X '!*.@(hf|vdb|ply|obj|stl)' -- "$cur") $(compgen -d -- "$cur"))
   elif [[ "$verb" == pov ]]; then
     COMPREPLY=($(compgen -f -X '!*.@(hf|pov)' -- "$cur") $(compgen -d -- "$cur"))
   else

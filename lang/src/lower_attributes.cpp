@@ -12,9 +12,13 @@ namespace frep::lang::detail {
 
 namespace {
 
-// The attribute functions compiled here; the others (procedural textures) are accepted with a
+// The attribute functions compiled here; the others (hfp's Perlin-noise textures and its look-up
+// tables and spline, whose code has no definite value: docs/language.md) are accepted with a
 // warning and return 1.
-enum class Attr { SetColor, SetAttributes, Union, Lerp, Cerp, Clamp, Pulse, Step, SmoothStep, Modulo, Floor, Ignored };
+enum class Attr {
+  SetColor, SetAttributes, Union, Lerp, Cerp, Clamp, Pulse, Step, SmoothStep, Modulo, Floor,
+  Wave, NoiseG, Crackles, Circles, CheckerBoard, HSVToRGB, RGBToHSV, Ignored
+};
 
 struct AttrSpec {
   Attr kind;
@@ -33,6 +37,13 @@ AttrSpec specOf(const std::string& name) {
   if (name == "hfa_smoothstep") return {Attr::SmoothStep, "SSS"};
   if (name == "hfa_modulo") return {Attr::Modulo, "SS"};
   if (name == "hfa_floor") return {Attr::Floor, "S"};
+  if (name == "hfa_wave") return {Attr::Wave, "SSSS"};
+  if (name == "hfa_noiseg") return {Attr::NoiseG, "ASS"};
+  if (name == "hfa_crackles") return {Attr::Crackles, "AASAA"};
+  if (name == "hfa_circles") return {Attr::Circles, "AAAA"};
+  if (name == "hfa_checkerboard") return {Attr::CheckerBoard, "AAAAAA"};
+  if (name == "hfa_hsvtorgb") return {Attr::HSVToRGB, "AA"};
+  if (name == "hfa_rgbtohsv") return {Attr::RGBToHSV, "AA"};
   return {Attr::Ignored, "*"};
 }
 
@@ -49,9 +60,28 @@ const char* usage(Attr kind) {
     case Attr::SmoothStep: return "hfA_SmoothStep(f, a, b)";
     case Attr::Modulo: return "hfA_Modulo(a, b)";
     case Attr::Floor: return "hfA_Floor(a)";
+    case Attr::Wave: return "hfA_Wave(t, c1, c2, freq)";
+    case Attr::NoiseG: return "hfA_NoiseG(x, freq, phase)";
+    case Attr::Crackles: return "hfA_Crackles(x, s, freq, attributes, map)";
+    case Attr::Circles: return "hfA_Circles(x, s, attributes, map)";
+    case Attr::CheckerBoard: return "hfA_CheckerBoard(x, block, gap, s, s_block, s_gap)";
+    case Attr::HSVToRGB: return "hfA_HSVToRGB(hsv, rgb)";
+    case Attr::RGBToHSV: return "hfA_RGBToHSV(rgb, hsv)";
     case Attr::Ignored: break;
   }
   return "";
+}
+
+// Gardner's solid noise as hfp's attribute library computes it (amplitude 1), scaled from
+// [-c^3, c^3], c = 2.17/1.17, to [0, 1]: a product of three sine series, each axis's second
+// term phase-shifted by the sine of another axis.
+Expr gardnerNoise(const Expr& x, const Expr& y, const Expr& z, const Expr& phase, const Expr& freq) {
+  const Expr sx = sin(freq * x), sy = sin(freq * y), sz = sin(freq * z);
+  const Expr serx = sx + sin(freq * x / Expr(1.35) + phase * sz) / Expr(1.17);
+  const Expr sery = sy + sin(freq * y / Expr(1.35) + phase * sx) / Expr(1.17);
+  const Expr serz = sz + sin(freq * z / Expr(1.35) + phase * sy) / Expr(1.17);
+  const double c = 2.17 / 1.17, cMin = std::pow(-c, 3);
+  return (serx * sery * serz - Expr(cMin)) / Expr(-cMin - cMin);
 }
 
 }  // namespace
@@ -164,6 +194,98 @@ Expr ObjectLowering::callAttribute(const AstExpr& e) {
       return select(lt(r, Expr(0.0)), r + v[1], r);
     }
     case Attr::Floor: return trunc(v[0]);  // hfp's (int) cast: towards zero
+    case Attr::Wave: {  // (1 + sin(freq·t))/2 spread over [min(c1, c2), max(c1, c2)]
+      const Expr w = (Expr(1.0) + sin(v[3] * v[0])) / Expr(2.0);
+      return select(gt(v[1], v[2]), w * (v[1] - v[2]) + v[2], w * (v[2] - v[1]) + v[1]);
+    }
+    case Attr::NoiseG: {
+      const std::vector<Expr> x = attributeArray(e, 0, 3).elems;
+      return gardnerNoise(x[0], x[1], x[2], v[2], v[1]);
+    }
+    case Attr::Crackles:
+    case Attr::Circles: {
+      // A value p in [0, 1) picks attribute set k (attributes[k·n + 1 .. k·n + n], n the size of
+      // s) where map[k+1] <= p < map[k+2]; no interval: s unchanged. Circles: p = |x| mod 1 and
+      // the first interval wins; Crackles: p from Gardner noise, cycled, and the last one wins
+      // (hfp's loop has no break there).
+      const bool circles = spec.kind == Attr::Circles;
+      const size_t mapArg = circles ? 3 : 4, setsArg = circles ? 2 : 3;
+      const std::vector<Expr> x = attributeArray(e, 0, 3).elems, map = attributeArray(e, mapArg, 2).elems,
+                              sets = attributeArray(e, setsArg, 1).elems;
+      Value& s = attributeArray(e, 1, 1);
+      const size_t n = s.elems.size(), intervals = map.size() - 1;
+      if (sets.size() < n * intervals)
+        throw CompileError{e.args[setsArg]->loc, e.spelling + ": the attribute sets need " + std::to_string(n * intervals) +
+                                                     " elements (" + std::to_string(intervals) + " intervals of the map × " +
+                                                     std::to_string(n) + " of s), they have " + std::to_string(sets.size())};
+      Expr p;
+      if (circles) {
+        p = fmod(sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]), Expr(1.0));
+      } else {
+        const Expr phase = (abs(x[0]) + abs(x[1]) + abs(x[2])) / Expr(3.0);
+        const Expr sum = Expr(-3.0) + Expr(2.0) * (gardnerNoise(x[0], x[0], x[2], phase, v[2]) +
+                                                   gardnerNoise(x[1], x[1], x[0], phase, v[2]) +
+                                                   gardnerNoise(x[2], x[2], x[1], phase, v[2]));
+        // hfp's cycle(): the fraction quantised to thousandths (an int cast), through a sine.
+        const Expr thousandths = trunc((sum - floor(sum)) * Expr(1000.0));
+        p = (Expr(1.0) + sin(thousandths * Expr(2.0 * M_PI / 1000.0))) / Expr(2.0);
+      }
+      std::vector<Expr> out = s.elems;
+      for (size_t step = 0; step < intervals; ++step) {
+        const size_t k = circles ? intervals - 1 - step : step;  // the winner is applied last
+        const Expr in = logicalAnd(ge(p, map[k]), lt(p, map[k + 1]));
+        for (size_t j = 0; j < n; ++j) out[j] = select(in, sets[n * k + j], out[j]);
+      }
+      for (size_t j = 0; j < n; ++j) write(s, j, Expr(1.0), out[j]);
+      return Expr(1.0);
+    }
+    case Attr::CheckerBoard: {
+      // Blocks of size block[i] repeating every block[i] + gap[i] from the origin: strictly inside
+      // one on all three axes, s = s_block, else s = s_gap.
+      const std::vector<Expr> x = attributeArray(e, 0, 3).elems, block = attributeArray(e, 1, 3).elems,
+                              gap = attributeArray(e, 2, 3).elems, inBlock = attributeArray(e, 4, 1).elems,
+                              inGap = attributeArray(e, 5, 1).elems;
+      if (inBlock.size() != inGap.size())  // hfp then writes nothing; an error says why
+        throw CompileError{e.loc, e.spelling + ": s_block and s_gap need the same number of elements (" +
+                                      std::to_string(inBlock.size()) + " and " + std::to_string(inGap.size()) + ")"};
+      Value& s = attributeArray(e, 3, inBlock.size());
+      Expr inside(1.0);
+      for (size_t i = 0; i < 3; ++i) {
+        const Expr period = gap[i] + block[i], start = period * floor(x[i] / period);
+        inside = logicalAnd(inside, logicalAnd(gt(x[i], start), lt(x[i], start + block[i])));
+      }
+      for (size_t j = 0; j < inBlock.size(); ++j) write(s, j, Expr(1.0), select(inside, inBlock[j], inGap[j]));
+      return Expr(1.0);
+    }
+    case Attr::HSVToRGB: {  // hue in degrees (any, taken mod 360), saturation and value in [0, 1]
+      const std::vector<Expr> hsv = attributeArray(e, 0, 3).elems;
+      Value& rgb = attributeArray(e, 1, 3);
+      const Expr h = hsv[0] - Expr(360.0) * floor(hsv[0] / Expr(360.0));
+      const Expr below120 = lt(h, Expr(120.0)), below240 = lt(h, Expr(240.0));
+      const Expr r = select(below120, (Expr(120.0) - h) / Expr(60.0), select(below240, Expr(0.0), (h - Expr(240.0)) / Expr(60.0)));
+      const Expr g = select(below120, h / Expr(60.0), select(below240, (Expr(240.0) - h) / Expr(60.0), Expr(0.0)));
+      const Expr b = select(below120, Expr(0.0), select(below240, (h - Expr(120.0)) / Expr(60.0), (Expr(360.0) - h) / Expr(60.0)));
+      const Expr channel[3] = {r, g, b};
+      for (size_t c = 0; c < 3; ++c)
+        write(rgb, c, Expr(1.0), (Expr(1.0) - hsv[1] + hsv[1] * min(channel[c], Expr(1.0))) * hsv[2]);
+      return Expr(1.0);
+    }
+    case Attr::RGBToHSV: {  // hue in degrees, -60 to 300 as hfp leaves it, 0 for greys
+      const std::vector<Expr> rgb = attributeArray(e, 0, 3).elems;
+      Value& hsv = attributeArray(e, 1, 3);
+      const Expr &r = rgb[0], &g = rgb[1], &b = rgb[2];
+      const Expr hi = max(r, max(g, b)), spread = hi - min(r, min(g, b));
+      // Divisors kept off 0 where their quotient is not used (no spurious domain errors).
+      const Expr delta = select(gt(spread, Expr(0.0)), spread, Expr(1.0)), top = select(gt(hi, Expr(0.0)), hi, Expr(1.0));
+      // hfp adds the term of each channel equal to the maximum unless the next one ties it.
+      const Expr h = select(logicalAnd(eq(hi, r), ne(hi, g)), (g - b) / delta, Expr(0.0)) +
+                     select(logicalAnd(eq(hi, g), ne(hi, b)), Expr(2.0) + (b - r) / delta, Expr(0.0)) +
+                     select(logicalAnd(eq(hi, b), ne(hi, r)), Expr(4.0) + (r - g) / delta, Expr(0.0));
+      write(hsv, 0, Expr(1.0), select(gt(spread, Expr(0.0)), Expr(60.0) * h, Expr(0.0)));
+      write(hsv, 1, Expr(1.0), select(gt(hi, Expr(0.0)), spread / top, Expr(0.0)));
+      write(hsv, 2, Expr(1.0), hi);
+      return Expr(1.0);
+    }
     case Attr::Ignored: break;
   }
   return Expr(1.0);

@@ -187,6 +187,38 @@ TEST_F(FrepTest, RenderColourSectionsAreSpectral) {
   EXPECT_EQ(dominant(1), 2);
 }
 
+// Geometric type G: the ball moving along x with x[4] at the listed values -1, 0.2, 1 in one
+// picture. The shaded pixels are the union of three discs of radius 0.5 (the last two overlap in
+// a lens), each drawn in the spectral colour of its index; slice --mask of the same sections
+// covers the same union in the plane z = 0.
+TEST_F(FrepTest, RenderAndSliceGroupSectionsAreTheirUnion) {
+  write("mv.hf", "mv(x[4], a[1]) { mv = 0.25 - (x[1]-x[4])*(x[1]-x[4]) - x[2]*x[2] - x[3]*x[3]; }\n");
+  const double r = 0.5, d = 0.8;  // radius; distance of the discs at 0.2 and 1
+  const double lens = 2 * r * r * std::acos(d / (2 * r)) - 0.5 * d * std::sqrt(4 * r * r - d * d);
+  const double unionArea = 3 * M_PI * r * r - lens;
+  RunResult rr = run("render mv.hf -x X,Y,Z,G --g-values -1,0.2,1 -b 2 --size 241x121 --azimuth -90 --elevation 0 "
+                     "--no-footprint --background 0,0,0 -O g.png");
+  ASSERT_EQ(rr.code, 0) << rr.err;
+  const Image img = readImage(path("g.png"));
+  const double step = pixelStep(rr.out), pixels = unionArea / (step * step);
+  EXPECT_NEAR(double(countNotBackground(img, 0, 0, 0)), pixels, 0.01 * pixels + 4);
+  auto dominant = [&](double x) {  // the box of the union is centred on x = 0
+    const size_t col = size_t(std::lround(x / step + 120)), i = (60 * size_t(img.width) + col) * 3;
+    return int(std::max_element(&img.rgb[i], &img.rgb[i + 3]) - &img.rgb[i]);
+  };
+  EXPECT_EQ(dominant(-1), 0);  // first value: red
+  EXPECT_EQ(dominant(0.1), 1);  // middle: green
+  EXPECT_EQ(dominant(1.1), 2);  // last: blue-violet
+  RunResult sr = run("slice mv.hf -x X,Y,Z,G --g-values -1,0.2,1 -b 2 --res 201 --mask -O s.png");
+  ASSERT_EQ(sr.code, 0) << sr.err;
+  const Image mask = readImage(path("s.png"));
+  ASSERT_EQ(mask.width, 201u);
+  size_t inside = 0;
+  for (size_t i = 0; i < mask.rgb.size(); i += 3) inside += mask.rgb[i] == 255;
+  const double cells = unionArea / (0.02 * 0.02);  // 4 / 200 per pixel
+  EXPECT_NEAR(double(inside), cells, 0.01 * cells + 4);
+}
+
 // frep slice with geometric types: numbered T frames, a V/W grid of sections (in --mask mode
 // the inside pixels of each cell count the disc of radius sqrt(1 - v^2)), and the errors.
 TEST_F(FrepTest, SliceGeometricTypes) {

@@ -130,6 +130,103 @@ TEST(LangAttributes, SetAttributesCopiesWhereInside) {
   EXPECT_CLOSE(attributeAt(m, 1, {-1, 0, 0}), 0.0);
 }
 
+// Gardner's noise as in hfp's attribute library, written out here: scaled to [0, 1].
+double gardner(double x, double y, double z, double phase, double freq) {
+  const double sx = std::sin(freq * x), sy = std::sin(freq * y), sz = std::sin(freq * z);
+  const double product = (sx + std::sin(freq * x / 1.35 + phase * sz) / 1.17) *
+                         (sy + std::sin(freq * y / 1.35 + phase * sx) / 1.17) *
+                         (sz + std::sin(freq * z / 1.35 + phase * sy) / 1.17);
+  const double c3 = std::pow(2.17 / 1.17, 3);
+  return (product + c3) / (2 * c3);
+}
+
+TEST(LangAttributes, WaveAndNoiseValues) {
+  const double wave = 0.2 + 0.6 * (1 + std::sin(3 * 0.5)) / 2;
+  EXPECT_CLOSE(valueOf("hfA_Wave(x[1], 0.2, 0.8, 3)", {0.5, 0, 0}), wave);
+  EXPECT_CLOSE(valueOf("hfA_Wave(x[1], 0.8, 0.2, 3)", {0.5, 0, 0}), wave);  // bounds in either order
+  EXPECT_CLOSE(valueOf("hfA_NoiseG(x, 0.7, 1.4)", {0.3, -2.2, 0.9}), gardner(0.3, -2.2, 0.9, 1.4, 0.7));
+  EXPECT_CLOSE(valueOf("hfA_NoiseG(x, 2, 0.5)", {-1.1, 0.4, 3}), gardner(-1.1, 0.4, 3, 0.5, 2));
+}
+
+// Circles: |x| mod 1 picks a set by the map's intervals; Crackles: the cycled sum of three
+// Gardner noises does. Outside every interval s keeps its value.
+TEST(LangAttributes, CirclesAndCracklesPickAttributeSetsByTheMap) {
+  Model m = compileOk(R"(my_model(x[3], a[1], s[3]) {
+    array sets[6], map[3];
+    sets = [1, 0, 0, 0, 0, 1];  map = [0, 0.5, 0.9];
+    d = hfA_Circles(x, s, sets, map);
+    my_model = 1;
+  })");
+  EXPECT_CLOSE(attributeAt(m, 0, {1.25, 0, 0}), 1.0);  // 0.25: first set
+  EXPECT_CLOSE(attributeAt(m, 0, {0, -1, 0}), 1.0);    // |x| = 1: 0, first set
+  EXPECT_CLOSE(attributeAt(m, 0, {0, 0, 1.7}), 0.0);    // 0.7: second set
+  EXPECT_CLOSE(attributeAt(m, 2, {0, 0, 1.7}), 1.0);
+  EXPECT_CLOSE(attributeAt(m, 0, {0, 0, 2.95}), 0.0);    // 0.95: no interval, s stays 0
+  EXPECT_CLOSE(attributeAt(m, 2, {0, 0, 2.95}), 0.0);
+  Model c = compileOk(R"(my_model(x[3], a[1], s[2]) {
+    array sets[4], map[3];
+    sets = [1, 2, 3, 4];  map = [0, 0.5, 1];
+    d = hfA_Crackles(x, s, 1.5, sets, map);
+    my_model = 1;
+  })");
+  for (const std::vector<double>& x : std::vector<std::vector<double>>{{0.3, -0.7, 1.1}, {2, 1, -0.5}, {-0.2, 0.1, 0.4}}) {
+    const double phase = (std::fabs(x[0]) + std::fabs(x[1]) + std::fabs(x[2])) / 3;
+    const double sum = -3 + 2 * (gardner(x[0], x[0], x[2], phase, 1.5) + gardner(x[1], x[1], x[0], phase, 1.5) +
+                                 gardner(x[2], x[2], x[1], phase, 1.5));
+    const double p = (1 + std::sin(std::trunc((sum - std::floor(sum)) * 1000) * 2 * M_PI / 1000)) / 2;
+    const double first = p < 0.5 ? 1 : p < 1 ? 3 : 0;
+    EXPECT_CLOSE(attributeAt(c, 0, x), first);
+    EXPECT_CLOSE(attributeAt(c, 1, x), first == 0 ? 0 : first + 1);
+  }
+}
+
+TEST(LangAttributes, CheckerBoardBlocksRepeatFromTheOrigin) {
+  Model m = compileOk(R"(my_model(x[3], a[1], s[3]) {
+    array block[3], gap[3], on[3], off[3];
+    block = [1, 1, 2];  gap = [0.5, 0.5, 0];  on = [1, 1, 1];  off = [0, 0, 0.5];
+    d = hfA_CheckerBoard(x, block, gap, s, on, off);
+    my_model = 1;
+  })");
+  // Blocks on (1.5k, 1.5k + 1) in x and y, (2k, 2k + 2) in z: strictly inside on every axis.
+  EXPECT_CLOSE(attributeAt(m, 0, {0.5, 0.5, 0.5}), 1.0);
+  EXPECT_CLOSE(attributeAt(m, 2, {1.2, 0.5, 0.5}), 0.5);   // in the gap along x
+  EXPECT_CLOSE(attributeAt(m, 0, {-1, 1.7, -3}), 1.0);     // blocks (-1.5, -0.5), (1.5, 2.5), (-4, -2)
+  EXPECT_CLOSE(attributeAt(m, 0, {1, 0.5, 0.5}), 0.0);     // on a block's face: outside
+  EXPECT_CLOSE(attributeAt(m, 0, {0.5, 0.5, 2}), 0.0);
+}
+
+TEST(LangAttributes, HsvAndRgbConversions) {
+  Model m = compileOk(R"(my_model(x[3], a[1], s[3]) {
+    array hsv[3];
+    hsv = [x[1], 0.5, 0.8];
+    d = hfA_HSVToRGB(hsv, s);
+    my_model = 1;
+  })");
+  for (double h : {210.0, -150.0, 570.0}) {  // hue taken modulo 360
+    EXPECT_CLOSE(attributeAt(m, 0, {h, 0, 0}), 0.4);
+    EXPECT_CLOSE(attributeAt(m, 1, {h, 0, 0}), 0.6);
+    EXPECT_CLOSE(attributeAt(m, 2, {h, 0, 0}), 0.8);
+  }
+  EXPECT_CLOSE(attributeAt(m, 0, {0, 0, 0}), 0.8);  // red: (1, 0.5, 0.5) * 0.8
+  EXPECT_CLOSE(attributeAt(m, 1, {0, 0, 0}), 0.4);
+  Model r = compileOk(R"(my_model(x[3], a[1], s[3]) {
+    array rgb[3];
+    rgb = [x[1], x[2], x[3]];
+    d = hfA_RGBToHSV(rgb, s);
+    my_model = 1;
+  })");
+  auto hsv = [&](std::vector<double> c) {
+    return std::vector<double>{attributeAt(r, 0, c), attributeAt(r, 1, c), attributeAt(r, 2, c)};
+  };
+  const std::vector<double> blue = hsv({0.4, 0.6, 0.8}), grey = hsv({0.3, 0.3, 0.3}), pink = hsv({0.8, 0.2, 0.4});
+  EXPECT_CLOSE(blue[0], 210.0);
+  EXPECT_CLOSE(blue[1], 0.5);
+  EXPECT_CLOSE(blue[2], 0.8);
+  EXPECT_EQ(grey, (std::vector<double>{0, 0, 0.3}));
+  EXPECT_CLOSE(pink[0], -20.0);  // not wrapped, as hfp
+  EXPECT_CLOSE(pink[1], 0.75);
+}
+
 TEST(LangAttributes, WrongCallsAreErrorsAtTheirPlace) {
   CompileResult r = compile("my_model(x[3], a[1]) {\n  d = hfA_SetColor(x[1], s, 1, 0, 0);\n  my_model = 1;\n}\n", "c.hf");
   EXPECT_FALSE(r.ok);
@@ -144,6 +241,15 @@ TEST(LangAttributes, WrongCallsAreErrorsAtTheirPlace) {
               " d = hfA_Union(x[1], x[2], s, c, c, x[3]);\n my_model = 1;\n}\n", "c.hf");
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.diagnostics.at(0).message, "hfA_Union: the operation must be a constant 0 to 4");
+  r = compile("my_model(x[3], a[1], s[3]) {\n array b[3], on[3], off[2];\n b = [1,1,1]; on = [1,1,1]; off = [0,0];\n"
+              " d = hfA_CheckerBoard(x, b, b, s, on, off);\n my_model = 1;\n}\n", "c.hf");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.diagnostics.at(0).message, "hfA_CheckerBoard: s_block and s_gap need the same number of elements (3 and 2)");
+  r = compile("my_model(x[3], a[1], s[3]) {\n array sets[3], map[3];\n sets = [1,1,1]; map = [0,0.5,1];\n"
+              " d = hfA_Circles(x, s, sets, map);\n my_model = 1;\n}\n", "c.hf");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.diagnostics.at(0).message,
+            "hfA_Circles: the attribute sets need 6 elements (2 intervals of the map × 3 of s), they have 3");
 }
 
 }  // namespace

@@ -309,12 +309,12 @@ TEST(LangStatements, SelectionPrefersMyModelThenWarnsOnUnknownName) {
   EXPECT_EQ(r.diagnostics[0].message, "no object named 'nothere'; using 'my_model'");
 }
 
-// hfA_SetColor is compiled (lang_attributes_test.cpp); the procedural textures (hfA_Wave) warn.
+// hfA_SetColor is compiled (lang_attributes_test.cpp); the Perlin-noise textures (hfA_Turbulence) warn.
 TEST(LangStatements, AttributeFunctionsWarnOnceAndKeepGeometry) {
   CompileResult r = compile(R"(m(x[3], a[1], s[3]) {
     m = x[1];
     d = hfA_SetColor(m, s, 1, 0, 0);
-    d = HFA_Wave(m, s, 2);
+    d = HFA_Turbulence(m, s, 2);
     s[2] = 0.5;
     s = [1, 2, 3];
   })", "attr.hf");
