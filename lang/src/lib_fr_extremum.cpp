@@ -21,6 +21,7 @@
 #include "frep/extremum/extremum.h"
 #include "frep/evaluators/interval.h"
 #include "frep/expressions/tape.h"
+#include "frep/relations/relations.h"
 #include "lib_fr_minkowski.h"
 #include "lib_hf_util.h"
 
@@ -530,6 +531,68 @@ Expr frSweepKeys(std::vector<Arg>& a) {
   return through(r, xs, n);
 }
 
+// Relations as compile-time constants (Pasko-Survey, relations; Vyatkin-Perturbation, collision
+// detection by recursive subdivision; core relations.h, as `frep relate` runs them):
+//   frIntersects(A, B [, o])  1: a common point (fa >= 0 and fb >= 0) was found; 0: proved
+//                             disjoint; -1: undecided (touching, or closer than the smallest box)
+//   frInside(A, B [, o])      1: A proved inside B's interior (A meets no point with fb <= 0);
+//                             0: a point of A with fb <= 0 was found; -1: undecided
+// o = [lo1, hi1, ..., lon, hin [, minSize]] (constants): the box searched; by default the
+// intersection of the two automatic boxes (frIntersects) or A's automatic box (frInside), which
+// contain every point that matters; minSize defaults to 1e-4 of the box's largest edge.
+Expr relation(const char* fn, std::vector<Arg>& a, bool inside) {
+  if (a.size() != 2 && !(a.size() == 3 && a[2].isArray))
+    throw LibraryError(std::string(fn) + " takes (A, B [, o]) (got " + std::to_string(a.size()) + " arguments)");
+  const Arg& A = objectArg(fn, a, 0, "A");
+  const Arg& B = objectArg(fn, a, 1, "B");
+  if (A.objectDims != B.objectDims)
+    throw LibraryError(std::string(fn) + ": objects '" + A.name + "' and '" + B.name + "' have different dimensions", 1);
+  const size_t n = static_cast<size_t>(A.objectDims);
+  std::vector<Interval> box(n);
+  double minSize = 0.0;
+  if (a.size() == 3) {
+    std::vector<Expr>& v = *a[2].array;
+    if (v.size() != 2 * n && v.size() != 2 * n + 1)
+      throw LibraryError(std::string(fn) + ": the options array needs " + std::to_string(2 * n) + " or " +
+                             std::to_string(2 * n + 1) + " elements [lo1, hi1, ..., minSize] (got " +
+                             std::to_string(v.size()) + ")",
+                         2);
+    for (size_t k = 0; k < v.size(); ++k)
+      if (!v[k].isConst()) throw LibraryError(std::string(fn) + ": the options must be constants", 2);
+    for (size_t d = 0; d < n; ++d) {
+      double lo = v[2 * d].constValue(), hi = v[2 * d + 1].constValue();
+      if (!(lo <= hi) || !std::isfinite(lo) || !std::isfinite(hi))
+        throw LibraryError(std::string(fn) + ": box coordinate " + std::to_string(d + 1) + " needs finite lo <= hi", 2);
+      box[d] = Interval(lo, hi);
+    }
+    if (v.size() == 2 * n + 1) minSize = v[2 * n].constValue();
+  } else {
+    Bounds ba = autoBox(fn, A, 0);
+    for (size_t d = 0; d < n; ++d) box[d] = Interval(ba.lo[d], ba.hi[d]);
+    if (!inside) {
+      Bounds bb = autoBox(fn, B, 1);
+      for (size_t d = 0; d < n; ++d) {
+        double lo = std::max(ba.lo[d], bb.lo[d]), hi = std::min(ba.hi[d], bb.hi[d]);
+        if (!(lo <= hi)) return Expr(0.0);  // the sound enclosures do not meet
+        box[d] = Interval(lo, hi);
+      }
+    }
+  }
+  double extent = 0.0;
+  for (const Interval& iv : box) extent = std::max(extent, iv.width());
+  if (!(minSize > 0.0)) minSize = extent > 0.0 ? 1e-4 * extent : 1e-9;
+  const uint32_t dims = static_cast<uint32_t>(n);
+  TapePtr ta = Tape::compile(A.value, dims);
+  TapePtr tb = Tape::compile(inside ? -B.value : B.value, dims);
+  IntersectionResult r = mayIntersect(*ta, *tb, box.data(), minSize);
+  // Inside: A meets {-fb >= 0} (a point of A not in B's interior) disproves it.
+  if (inside) return Expr(r.contact == Contact::Disjoint ? 1.0 : r.contact == Contact::Intersecting ? 0.0 : -1.0);
+  return Expr(r.contact == Contact::Intersecting ? 1.0 : r.contact == Contact::Disjoint ? 0.0 : -1.0);
+}
+
+Expr frIntersects(std::vector<Arg>& a) { return relation("frIntersects", a, false); }
+Expr frInside(std::vector<Arg>& a) { return relation("frInside", a, true); }
+
 const bool registered = registerAll({
     {"frMinkowski", "*", "A + B: max over u in box(B) of A(X - u) & B(u)", frMinkowski},
     {"frMinkowskiSum", "*", "A1 + A2 + ... + Ak: exact algebra for basic-set operands, else folded searches", frMinkowskiSum},
@@ -539,6 +602,8 @@ const bool registered = registerAll({
     {"frProject", "*", "max over the given coordinates (1-based) of A", frProject},
     {"frSweep", "*", "max over t in [t0, t1] of A(M(t)^-1 X), M from motion objects of t", frSweep},
     {"frSweepKeys", "*", "frSweep along keyframes: (x, A, times, positions [, angles] [, options])", frSweepKeys},
+    {"frIntersects", "*", "1 / 0 / -1: objects A and B proved to intersect / proved disjoint / undecided (constant)", frIntersects},
+    {"frInside", "*", "1 / 0 / -1: object A proved inside B's interior / a point of A outside it found / undecided (constant)", frInside},
     {"frKeyframe", "*", "piecewise-linear interpolation through (times[i], values[i]) at t", frKeyframe},
 });
 

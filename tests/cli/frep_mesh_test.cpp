@@ -152,3 +152,18 @@ TEST_F(FrepTest, MeshRejectsBadArguments) {
   EXPECT_EQ(run("mesh s.hf --res 16 -O nodir/s.ply").code, 3);
   EXPECT_EQ(listing(), "s.hf");
 }
+
+// Domain errors met while meshing reach the report (issue 14): sqrt of a negative on the half
+// x < 0 of the box, where the factor 1 + 0.1 sqrt(x) is 1 (the documented value 0), so the solid
+// stays the unit ball.
+TEST_F(FrepTest, MeshReportCountsDomainErrors) {
+  write("d.hf", "my_model(x[3], a[1]) {\n  my_model = (1 - x[1]^2 - x[2]^2 - x[3]^2) * (1 + 0.1 * sqrt(x[1]));\n}\n");
+  RunResult r = run("mesh d.hf -b 1.5 --res 24 -O d.ply");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "(sqrt of a negative ")) << r.out;
+  std::string report = readText(path("d.ply.report.json"));
+  size_t at = report.find("\"sqrt of a negative\": ");
+  ASSERT_NE(at, std::string::npos) << report;
+  EXPECT_GT(std::atol(report.c_str() + at + std::strlen("\"sqrt of a negative\": ")), 100) << report;
+  EXPECT_TRUE(contains(report, "\"division by zero\": 0")) << report;
+}
