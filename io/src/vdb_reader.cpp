@@ -144,7 +144,8 @@ constexpr uint64_t kMaxVdbBytes = uint64_t(16) << 30;  // frep mesh reads at mos
 // values (at most 256 KiB for a float tree) or a compressed block (at most the file).
 size_t allocationCapFor(uint64_t fileBytes) { return size_t(64 << 20) + size_t(fileBytes); }
 
-uint64_t checkLayout(const std::string& path) {
+// Returns the file's size; `contentHash` gets SampledVdb::contentHash.
+uint64_t checkLayout(const std::string& path, std::string& contentHash) {
   struct stat st;
   if (::stat(path.c_str(), &st) != 0) throw ioError("cannot read VDB '" + path + "': " + std::strerror(errno));
   if (!S_ISREG(st.st_mode)) throw ioError("cannot read VDB '" + path + "': not a regular file");
@@ -155,6 +156,7 @@ uint64_t checkLayout(const std::string& path) {
   std::string bytes(size_t(st.st_size), '\0');
   if (!in.read(bytes.data(), std::streamsize(bytes.size())) || in.peek() != EOF)
     throw ioError("cannot read VDB '" + path + "': the file changed or could not be read to its end");
+  contentHash = vdbChecksum(bytes, bytes.size());  // no digits counted as '0'
   LayoutCheck(path, std::move(bytes)).run();
   return uint64_t(st.st_size);
 }
@@ -165,7 +167,7 @@ SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) 
   openvdb::initialize();
   SampledVdb out;
   openvdb::FloatGrid::Ptr grid;
-  const uint64_t fileBytes = checkLayout(path);
+  const uint64_t fileBytes = checkLayout(path, out.contentHash);
   try {
     const AllocationCap cap(allocationCapFor(fileBytes));
     openvdb::io::File file(path);
