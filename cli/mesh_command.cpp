@@ -76,8 +76,9 @@ int runMeshVdb(const MeshRequest& request) {
                  "mesh has holes there; sample with a band of at least 1 voxel",
                  sm.incompleteCells);
   if (mesh.triangles.empty()) spdlog::warn("grid '{}' has no sign change between active voxels: the mesh is empty", vdb.gridName);
-  std::string comment = "frep mesh of grid '" + vdb.gridName + "' in " + request.model.path +
-                        " (sampled values); normals point outward (decreasing f)";
+  // The file's content hash, not its path: the mesh's bytes do not depend on how it was spelt.
+  std::string comment = "frep mesh of grid '" + vdb.gridName + "' of a .vdb (content hash " + vdb.contentHash +
+                        ", sampled values); normals point outward (decreasing f)";
   jsonPhase("write");
   std::array<double, 6> box{0, 0, 0, 0, 0, 0};
   for (size_t i = 0; i < mesh.positions.size(); ++i)
@@ -169,9 +170,13 @@ int runMesh(const MeshRequest& request) {
   report.triangles = mesh.triangles.size();
   const double simplifySeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - meshSeconds;
+  // Provenance as frep sample's: the model's hash and the resolved options, never the path.
+  char modelHash[17];
+  std::snprintf(modelHash, sizeof modelHash, "%016llx", static_cast<unsigned long long>(m.model.sourceHash));
   std::string comment = "frep mesh of '" + m.model.objectName + "', grid " + std::to_string(grid.dims[0]) + "x" +
                         std::to_string(grid.dims[1]) + "x" + std::to_string(grid.dims[2]) + " voxel " +
-                        formatNumber(grid.voxel) + "; normals point outward (decreasing f)";
+                        formatNumber(grid.voxel) + "; normals point outward (decreasing f); model hash " + modelHash +
+                        ", " + canonicalModel(m);
   jsonPhase("write");
   // Colours after the merge and the simplification, at the final vertices half a voxel inside:
   // the same for any split of the job (colour.h).

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -88,6 +89,20 @@ LoadedModel loadModel(const ModelRequest& request, bool toView) {
   m.field = lang::fieldOf(m.model, m.spec);
   m.colour = lang::colourOf(m.model, m.spec);
   return m;
+}
+
+std::string canonicalModel(const LoadedModel& m) {
+  auto exact = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::string(buf);
+  };
+  std::string s = "object=" + m.model.objectName + " params=";
+  for (size_t i = 0; i < m.spec.params.size(); ++i) s += (i ? "," : "") + exact(m.spec.params[i]);
+  s += " iso=" + exact(m.spec.iso) + " map=";
+  for (size_t i = 0; i < m.spec.axis.size(); ++i)
+    s += (i ? "," : "") + (m.spec.axis[i] >= 0 ? std::string(1, char('X' + m.spec.axis[i])) : exact(m.spec.constant[i]));
+  return s;
 }
 
 }  // namespace frep::cli

@@ -36,4 +36,9 @@ struct LoadedModel {
 // remain; without it and without -x the field keeps all the model's coordinates.
 LoadedModel loadModel(const ModelRequest& request, bool toView);
 
+// The model options as resolved, for provenance in output files: "object=NAME params=... iso=...
+// map=..." (numbers exact, %.17g). The same text however the command was spelt (argv[0], the
+// model's path, option order), so files that carry it do not depend on the spelling.
+std::string canonicalModel(const LoadedModel& m);
+
 }  // namespace frep::cli

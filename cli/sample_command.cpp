@@ -32,16 +32,11 @@ std::string baseName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-// The job as resolved (object, bound parameters, iso, axis mapping, world lattice, band, store):
+// The job as resolved (canonicalModel, then the world lattice, band and store):
 // the same text however the command was spelt (argv[0], the model's path, option order, -g or
 // --res for the same lattice), so the file's bytes do not depend on the spelling.
 std::string jobDescription(const LoadedModel& m, const GridSpec& g, int band, const std::string& store) {
-  std::string s = "sample object=" + m.model.objectName + " params=";
-  for (size_t i = 0; i < m.spec.params.size(); ++i) s += (i ? "," : "") + exact(m.spec.params[i]);
-  s += " iso=" + exact(m.spec.iso) + " map=";
-  for (size_t i = 0; i < m.spec.axis.size(); ++i)
-    s += (i ? "," : "") + (m.spec.axis[i] >= 0 ? std::string(1, char('X' + m.spec.axis[i])) : exact(m.spec.constant[i]));
-  s += " voxel=" + exact(g.voxel) + " lattice=";
+  std::string s = "sample " + canonicalModel(m) + " voxel=" + exact(g.voxel) + " lattice=";
   for (int a = 0; a < 3; ++a) s += (a ? "," : "") + std::to_string(std::llround(g.origin[a] / g.voxel));
   s += ":";
   for (int a = 0; a < 3; ++a) s += (a ? "," : "") + std::to_string(std::llround(g.origin[a] / g.voxel) + g.dims[a] - 1);

@@ -130,6 +130,7 @@ VdbLayout checkVdbLayout(const std::string& path) {
     throw ioError("cannot read VDB '" + path + "': the file changed or could not be read to its end");
   VdbLayout layout;
   layout.bytes = uint64_t(st.st_size);
+  layout.contentHash = vdbChecksum(bytes, bytes.size());  // no digits counted as '0'
   layout.sealed = LayoutCheck(path, std::move(bytes)).run();
   return layout;
 }

@@ -14,6 +14,7 @@ constexpr uint64_t kMaxVdbBytes = uint64_t(16) << 30;  // frep mesh reads at mos
 struct VdbLayout {
   uint64_t bytes = 0;   // the file's size
   bool sealed = false;  // it carries frep_grid_checksum and its contents match it
+  std::string contentHash;  // vdbChecksum of the whole file but the UUID: its identity in provenance
 };
 
 // Throws Error(kExitIoError) naming the path and what is wrong.

@@ -49,7 +49,9 @@ SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) 
   openvdb::initialize();
   SampledVdb out;
   openvdb::FloatGrid::Ptr grid;
-  const uint64_t fileBytes = checkVdbLayout(path).bytes;
+  const VdbLayout layout = checkVdbLayout(path);
+  const uint64_t fileBytes = layout.bytes;
+  out.contentHash = layout.contentHash;
   try {
     const AllocationCap cap(allocationCapFor(fileBytes));
     openvdb::io::File file(path);

@@ -214,3 +214,33 @@ TEST_F(FrepTest, MeshFromVdbRejectsBadInputs) {
   ASSERT_EQ(run("mesh two.vdb -o density -O e.ply").code, 0);
   EXPECT_TRUE(readText(path("d.ply")) == readText(path("e.ply")));
 }
+
+TEST_F(FrepTest, MeshBytesDoNotDependOnHowTheCommandIsSpelt) {
+  // As frep sample's (SampleBytesDoNotDependOnHowTheCommandIsSpelt): another spelling of the
+  // input's path, options in another order, -g for the same grid, another argv[0]; the files'
+  // comments name the model by its hash (.hf) or the .vdb by its content hash.
+  write("s.hf", kSphere);
+  ASSERT_EQ(run("sample s.hf -b 1.5 --res 33 -O s.vdb").code, 0);
+  ASSERT_EQ(std::system(("mkdir -p '" + path("sub") + "' && ln -s '" FREP_BINARY "' '" + path("frep-link") + "'").c_str()), 0);
+  auto spelt = [&](const std::string& args) {
+    return std::system(("cd '" + path("sub") + "' && ../frep-link " + args + " --no-progress >/dev/null 2>&1").c_str());
+  };
+  ASSERT_EQ(run("mesh s.hf -b 2 --res 33 -O a.ply --stl a.stl").code, 0);
+  ASSERT_EQ(spelt("mesh --stl ../b.stl -O ../b.ply -g 32 ../sub/../s.hf -b -2,2"), 0);
+  ASSERT_EQ(run("mesh s.vdb -O va.ply --stl va.stl").code, 0);
+  ASSERT_EQ(spelt("mesh --stl ../vb.stl -O ../vb.ply ../sub/../s.vdb"), 0);
+  for (const char* ext : {".ply", ".stl"}) {
+    EXPECT_TRUE(readText(path(std::string("a") + ext)) == readText(path(std::string("b") + ext))) << ext << " of s.hf differs";
+    EXPECT_TRUE(readText(path(std::string("va") + ext)) == readText(path(std::string("vb") + ext))) << ext << " of s.vdb differs";
+  }
+  const std::string stl = readText(path("a.stl")), vstl = readText(path("va.stl"));
+  EXPECT_TRUE(contains(stl.substr(0, stl.find('\n')), "model hash ")) << stl.substr(0, 200);
+  EXPECT_TRUE(contains(vstl.substr(0, vstl.find('\n')), "content hash ")) << vstl.substr(0, 200);
+  EXPECT_FALSE(contains(vstl, "s.vdb")) << vstl.substr(0, 200);
+  // A different job, or a different file, must differ (the same geometry: a[1] is unused, band 2).
+  ASSERT_EQ(run("mesh s.hf -b 2 --res 33 -a 1 -O c.ply").code, 0);
+  EXPECT_FALSE(readText(path("a.ply")) == readText(path("c.ply"))) << "-a 1 must show in the provenance";
+  ASSERT_EQ(run("sample s.hf -b 1.5 --res 33 --band 2 -O t.vdb").code, 0);
+  ASSERT_EQ(run("mesh t.vdb -O vc.ply").code, 0);
+  EXPECT_FALSE(readText(path("va.ply")) == readText(path("vc.ply"))) << "another .vdb must show in the provenance";
+}

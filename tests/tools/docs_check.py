@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """The man page (docs/frep.1) and the bash completion (deploy/completion/frep.bash) against the
 binaries: every verb and every option that `frep VERB --help` and `frep-worker --help` list is
-described in the man page and offered by the completion; the man page renders without warnings.
+described in the man page and offered by the completion; the man page renders without warnings;
+docs/mesh.md has every option, file extension and --format value of `frep mesh --help`.
 
 usage: docs_check.py SOURCE_DIR FREP FREP_WORKER  (run from ctest; exit 0 = pass)"""
 import os
@@ -74,6 +75,28 @@ check(version.returncode == 0 and version.stdout.startswith("frep-worker "), "fr
 check(complete("frep", "sample", "--store", "") == {"sdf", "raw", "fog"}, "completion of --store values")
 check("debug" in complete("frep", "--log-level", "d"), "completion of --log-level values")
 check(complete("frep", "slice", "m.hf", "--axis", "") == {"x", "y", "z"}, "completion of --axis values")
+
+# docs/mesh.md against frep mesh --help: every option (in one of its spellings), every -O
+# extension and every --format value, and no feature that exists called "planned".
+mesh_help = help_text(FREP, "mesh")
+mesh_doc = open(SRC + "/docs/mesh.md").read()
+for line in mesh_help.splitlines():
+    m = re.match(r"^\s+(-[^\s]+)", line)
+    spellings = [o for o in m.group(1).split(",") if o.startswith("-")] if m else []
+    if spellings and "--help" not in spellings:
+        check(any(re.search(r"(?<![\w-])%s(?![\w-])" % re.escape(o), mesh_doc) for o in spellings),
+              "docs/mesh.md has frep mesh's option " + "/".join(spellings))
+out_line = next(l for l in mesh_help.splitlines() if "-O,--out" in l)
+extensions = re.findall(r"(?<![\w.])\.([a-z0-9]+)\b", out_line)
+check(len(extensions) >= 9, "-O's extensions from frep mesh --help: " + " ".join(extensions))
+missing = [e for e in extensions if "`.%s`" % e not in mesh_doc]
+check(not missing, "docs/mesh.md names every mesh file extension" + (": missing " + " ".join(missing) if missing else ""))
+format_line = next(l for l in mesh_help.splitlines() if l.strip().startswith("--format"))
+formats = [f.strip() for f in format_line.split(":", 1)[1].split(",")]
+missing = [f for f in formats if not re.search(r"(?<![\w-])%s(?![\w-])" % re.escape(f), mesh_doc)]
+check(len(formats) >= 9 and not missing, "docs/mesh.md names every --format value" + (": missing " + " ".join(missing) if missing else ""))
+planned = [l for l in mesh_doc.splitlines() if "planned" in l and "--" in l]
+check(not planned, "docs/mesh.md calls no existing option planned" + (": " + " | ".join(planned) if planned else ""))
 
 r = subprocess.run(["groff", "-man", "-Tutf8", "-ww", "-z", MAN], capture_output=True, text=True)
 check(r.returncode == 0 and r.stderr == "", "groff renders the man page without warnings" + (": " + r.stderr if r.stderr else ""))
