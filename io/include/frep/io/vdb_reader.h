@@ -25,7 +25,7 @@ struct SampledVdb {
   // by its inverse transpose, the winding reversed by a mirroring transform).
   std::function<void(Mesh&)> toWorld;
   std::string transformDescription;  // e.g. "voxel 0.03 at (-1.1, -1.1, -1.1)"
-  // FNV-1a 64 of the file's bytes after the header's UUID (16 hex digits): the file's content,
+  // FNV-1a 64 of every byte of the file but the header's UUID (16 hex digits): the file's content,
   // whatever its path is spelt (provenance in frep mesh's outputs). The UUID is left out, as
   // OpenVDB stamps a random one into every file it writes.
   std::string contentHash;
