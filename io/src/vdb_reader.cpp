@@ -161,6 +161,8 @@ uint64_t checkLayout(const std::string& path) {
 
 }  // namespace
 
+void checkVdbLayout(const std::string& path) { checkLayout(path); }
+
 SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) {
   openvdb::initialize();
   SampledVdb out;
