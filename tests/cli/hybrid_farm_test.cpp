@@ -111,6 +111,13 @@ TEST_F(HybridFarm, MeshRoundTripIsWithinHalfAVoxel) {
   EXPECT_LT(worst2, 0.5 * voxel);
 }
 
+TEST_F(HybridFarm, ThePaperExamplesCompile) {
+  for (const char* m : {"bezier9", "polygon12", "naca0011", "aircraft"}) {
+    RunResult r = run(std::string("check '" FREP_EXAMPLES_DIR "/hybrid/") + m + ".hf'");
+    EXPECT_EQ(r.code, 0) << m << ": " << r.err;
+  }
+}
+
 TEST_F(HybridFarm, MissingFileIsAModelErrorAtTheCall) {
   write("bad.hf", "m(x[3], a[1]) {\n  m = frMesh(x, \"parts/none.stl\");\n}\n");
   RunResult r = run("check bad.hf");

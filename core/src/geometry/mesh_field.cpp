@@ -1,6 +1,8 @@
-// Signed distance to a triangle mesh: exact closest point on triangles through a BVH; sign
-// from the closest feature's angle-weighted pseudonormal on closed meshes, from the
-// generalised winding number on open ones (distance_fields.h).
+// Signed distance to a triangle mesh (Choporov-Hybrid eq. 8-9: dist = min over the triangles of
+// the distance to each, f = sign * dist as eq. 1-3): exact closest point on triangles through a
+// BVH instead of the paper's scan of every triangle; sign from the closest feature's
+// angle-weighted pseudonormal on closed meshes and from the generalised winding number on open
+// ones, instead of the ray parity of eq. 7 (distance_fields.h).
 #include <cmath>
 #include <cstring>
 #include <map>

@@ -1,5 +1,7 @@
-// Signed distance to a closed polygon: exact segment distance (Choporov-Hybrid eq. 6) through a
-// BVH, sign from the pseudonormal of the closest feature instead of the parity test (eq. 7).
+// Signed distance to a closed polygon (Choporov-Hybrid eq. 1-3 with the polyline distance of
+// eq. 5-6: the minimum over the edges of the point-segment distance) through a BVH, sign from the
+// pseudonormal of the closest feature instead of the parity test (eq. 7). tessellateBezierLoop
+// below is the paper's nonuniform-curve-mesh, which gives eq. 5's polyline for a Bezier curve.
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
