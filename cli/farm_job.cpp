@@ -25,6 +25,7 @@ farm::JobSpec makeJob(const LoadedModel& m, const std::string& modelPath, const 
     farm::ModelFile* f = job.add_model_files();
     f->set_path(path);
     f->set_contents(contents);
+    f->set_hash(farm::modelFileHash(contents));
   }
   job.set_object(m.model.objectName);
   for (double p : m.spec.params) job.add_params(p);

@@ -10,6 +10,7 @@
 #include "json_events.h"
 #include "status_line.h"
 #include "exit_codes.h"
+#include "frep/io/geometry_files.h"
 #include "hfp_invocation.h"
 
 #ifndef FREP_VERSION
@@ -91,6 +92,7 @@ std::string setUpLogging(const std::string& level, bool levelGiven) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  frep::io::installGeometryLoader();  // frMesh / frVolume read files through frep_io
   // hfp's command line (no verb): `frep model.hf -g 60 -stl out.stl` runs frep mesh.
   std::vector<std::string> hfpArgs;
   std::vector<char*> hfpArgv;

@@ -12,7 +12,7 @@
 namespace frep::farm {
 
 constexpr uint32_t kProtoMajor = 1;
-constexpr uint32_t kProtoMinor = 1;  // 1: "render" jobs (RenderSpec)
+constexpr uint32_t kProtoMinor = 2;  // 1: "render" jobs (RenderSpec); 2: ModelFile.hash (checked)
 
 struct Incoming {
   std::string routingId;  // empty on the DEALER side

@@ -18,6 +18,7 @@
 #include "frep/evaluators/eval.h"
 #include "frep/io/atomic_output.h"
 #include "frep/io/error.h"
+#include "frep/io/geometry_files.h"
 #include "frep/io/mesh_writer.h"
 #include "frep/io/vdb_writer.h"
 #include "frep/io/world_lattice.h"
@@ -232,6 +233,7 @@ void writeMeshFile(const PyMesh& m, const std::string& path) {
 PYBIND11_MODULE(frepfarm, mod) {
   mod.doc() = "frepfarm: F-rep solids in the HyperFun language (inside is f >= 0)";
   mod.attr("__version__") = FREP_VERSION;
+  io::installGeometryLoader();  // frMesh / frVolume in models
   // frep_io installs handlers for SIGINT/SIGTERM/SIGHUP when it is loaded (for the frep
   // command's exit code 6); in Python, Ctrl-C must stay KeyboardInterrupt.
   py::module_ signal = py::module_::import("signal");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 
@@ -46,8 +47,30 @@ uint64_t jobIdOf(const JobSpec& job) {
   return h;
 }
 
+uint64_t modelFileHash(const std::string& contents) {
+  uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : contents) h = (h ^ c) * 1099511628211ULL;
+  return h;
+}
+
+void checkModelFiles(const JobSpec& job) {
+  auto hex = [](uint64_t h) {
+    char b[17];
+    std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h));
+    return std::string(b);
+  };
+  for (const auto& f : job.model_files()) {
+    const uint64_t got = modelFileHash(f.contents());
+    if (got != f.hash())
+      throw std::runtime_error("model file '" + f.path() + "': its " + std::to_string(f.contents().size()) +
+                               " bytes hash to " + hex(got) + " but the job says " + hex(f.hash()) +
+                               "; refusing it (damaged in transit, or a master from another release)");
+  }
+}
+
 namespace {
 Expr jobField(const JobSpec& job, uint32_t* dimsOut) {
+  checkModelFiles(job);
   lang::CompileOptions opt;
   opt.object = job.object();
   for (const auto& f : job.model_files()) opt.files[f.path()] = f.contents();

@@ -40,6 +40,12 @@ struct BrickOutput {
 GridSpec gridOf(const JobSpec& job);
 void setGrid(JobSpec& job, const GridSpec& grid);
 
+// The content hash of a model file (ModelFile.hash): 64-bit FNV-1a of its bytes.
+uint64_t modelFileHash(const std::string& contents);
+// Throws std::runtime_error naming the first model file whose contents do not hash to its
+// ModelFile.hash (a worker refuses such a job: damaged in transit, or a mismatched master).
+void checkModelFiles(const JobSpec& job);
+
 // Stable 64-bit id of a job (FNV-1a over its serialized spec): results are keyed by it.
 uint64_t jobIdOf(const JobSpec& job);
 

@@ -5,9 +5,11 @@
 
 #include <cstdlib>
 
+#include "frep/io/geometry_files.h"
 #include "worker.h"
 
 int main(int argc, char** argv) {
+  frep::io::installGeometryLoader();  // frMesh / frVolume read files through frep_io
   CLI::App app{"frep-worker: computes bricks for a frepfarm master.\n"
                "Exit codes: 0 done or stopped by SIGTERM, 2 bad arguments, 75 no master reachable,\n"
                "78 refused by the master (e.g. protocol version)."};

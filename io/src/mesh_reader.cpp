@@ -71,9 +71,7 @@ class PlyBinary {
   const std::string& path_;
 };
 
-Mesh readPly(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open the file");
+Mesh readPly(std::istream& in, const std::string& path) {
   std::string line, format;
   std::getline(in, line);
   if (line != "ply" && line != "ply\r") fail(path, "not a PLY file (no 'ply' magic)");
@@ -144,9 +142,7 @@ Mesh readPly(const std::string& path) {
 
 // ---- OBJ ----
 
-Mesh readObj(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) fail(path, "cannot open the file");
+Mesh readObj(std::istream& in, const std::string& path) {
   Mesh m;
   std::string line;
   for (size_t lineNo = 1; std::getline(in, line); ++lineNo) {
@@ -176,10 +172,7 @@ Mesh readObj(const std::string& path) {
 
 // ---- STL ----
 
-Mesh readStl(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open the file");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+Mesh readStl(const std::string& bytes, const std::string& path) {
   Mesh m;
   auto addTriangle = [&](const std::array<std::array<double, 3>, 3>& t, const std::string& where) {
     for (const auto& p : t) {
@@ -231,12 +224,28 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
-Mesh readMesh(const std::string& path) {
+Mesh parseMesh(const std::string& path, const std::string& bytes) {
   const std::string ext = lowerExtension(path);
-  Mesh m = ext == "ply" ? readPly(path) : ext == "obj" ? readObj(path) : ext == "stl" ? readStl(path)
-                        : throw ioError(path + ": not a mesh file (expected .ply, .obj or .stl)");
+  if (ext != "ply" && ext != "obj" && ext != "stl") throw ioError(path + ": not a mesh file (expected .ply, .obj or .stl)");
+  Mesh m;
+  if (ext == "stl") {
+    m = readStl(bytes, path);
+  } else {
+    std::istringstream in(bytes, std::ios::binary);
+    m = ext == "ply" ? readPly(in, path) : readObj(in, path);
+  }
   if (m.triangles.empty()) fail(path, "no triangles");
   return m;
+}
+
+Mesh readMesh(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  if (ext != "ply" && ext != "obj" && ext != "stl") throw ioError(path + ": not a mesh file (expected .ply, .obj or .stl)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open the file");
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) fail(path, "cannot read the file");
+  return parseMesh(path, bytes);
 }
 
 }  // namespace frep::io

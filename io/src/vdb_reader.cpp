@@ -45,6 +45,8 @@ size_t allocationCapFor(uint64_t fileBytes) { return size_t(64 << 20) + size_t(f
 
 }  // namespace
 
+void checkVdbLayout(const std::string& path) { checkLayout(path); }
+
 SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) {
   openvdb::initialize();
   SampledVdb out;

@@ -112,7 +112,7 @@ std::string ObjectLowering::describeSignature(const std::string& sig) {
   std::string out;
   for (size_t i = 0; i < sig.size(); ++i) {
     if (i) out += ", ";
-    out += sig[i] == 'A' ? "array" : sig[i] == 'O' ? "object" : sig[i] == 'F' ? "file name" : "scalar";
+    out += sig[i] == 'A' ? "array" : sig[i] == 'O' ? "object" : sig[i] == 'F' ? "file name" : sig[i] == 'T' ? "string" : "scalar";
   }
   return out;
 }
@@ -124,7 +124,8 @@ Expr ObjectLowering::callLibrary(const AstExpr& e, const LibraryFunction& f) {
     for (const auto& a : e.args) {
       auto it = a->kind == AstExpr::Kind::Name ? env_.find(a->name) : env_.end();
       bool isVar = it != env_.end() && (it->second.isArray || it->second.state != Def::Undefined);
-      if (it != env_.end() && it->second.isArray) sig += 'A';
+      if (a->kind == AstExpr::Kind::String) sig += sig.find('F') == std::string::npos ? 'F' : 'T';
+      else if (it != env_.end() && it->second.isArray) sig += 'A';
       else if (a->kind == AstExpr::Kind::Name && !isVar && findObject(a->name) >= 0) sig += 'O';
       else sig += 'S';
     }
@@ -148,6 +149,14 @@ Expr ObjectLowering::callLibrary(const AstExpr& e, const LibraryFunction& f) {
                                       " must be a file name in double quotes"};
       args[i].name = a.name;
       args[i].file = &readModelFile(a);
+      continue;
+    }
+    if (sig[i] == 'T') {
+      if (a.kind != AstExpr::Kind::String)
+        throw CompileError{a.loc, "argument " + std::to_string(i + 1) + " of " + f.name +
+                                      " must be a string in double quotes"};
+      args[i].isText = true;
+      args[i].name = a.name;
       continue;
     }
     if (a.kind == AstExpr::Kind::Name) {
@@ -182,6 +191,7 @@ Expr ObjectLowering::callLibrary(const AstExpr& e, const LibraryFunction& f) {
   } catch (const std::exception& ex) {
     throw CompileError{e.loc, "internal error in " + f.name + ": " + ex.what()};
   }
+  for (const std::string& w : takeFileWarnings()) sh_.diags.warning(e.loc, w);
   for (Value* arr : arrays) {
     if (arr->elems.size() != arr->elemState.size())
       throw CompileError{e.loc, "internal error: " + f.name + " changed the size of array '" +

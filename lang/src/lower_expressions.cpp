@@ -70,7 +70,7 @@ Expr ObjectLowering::lower(const AstExpr& e) {
     }
     case AstExpr::Kind::Not: return logicalNot(truth(lower(*e.args[0])));
     case AstExpr::Kind::String:
-      throw CompileError{e.loc, "a string is only allowed as a file name argument (frVolumeSplineFile)"};
+      throw CompileError{e.loc, "a string is only allowed as a file name argument (frVolumeSplineFile, frMesh, frVolume) or a grid name (frVolume)"};
   }
   return Expr(0.0);
 }

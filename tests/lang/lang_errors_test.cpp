@@ -23,7 +23,7 @@ const ErrorCase kCases[] = {
     {"BangEquals", "m(x[3], a[1]) {\n  if x[1] != 0 then m = 1; endif;\n}", 2, 11,
      "unexpected '!='; HyperFun writes 'not equal' as '/='"},
     {"StringLiteral", "m(x[3], a[1]) {\n  m = \"s\";\n}", 2, 7,
-     "a string is only allowed as a file name argument (frVolumeSplineFile)"},
+     "a string is only allowed as a file name argument (frVolumeSplineFile, frMesh, frVolume) or a grid name (frVolume)"},
     {"UnterminatedString", "m(x[3], a[1]) {\n  m = \"s;\n}", 2, 7,
      "unterminated string (a string ends with '\"' on the same line)"},
     // syntax

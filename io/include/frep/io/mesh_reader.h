@@ -1,4 +1,4 @@
-// Reading triangle meshes for frep render: PLY (ascii, binary little or big endian; vertex x, y,
+// Reading triangle meshes for frep render and frMesh: PLY (ascii, binary little or big endian; vertex x, y,
 // z of any scalar type, other properties skipped; faces as lists, polygons fanned), OBJ (v and f
 // lines, negative indices, v/vt/vn forms; polygons fanned; other lines ignored) and STL (binary,
 // or ASCII when it starts with "solid" and has facets). Only positions and triangles are read.
@@ -13,6 +13,9 @@ namespace frep::io {
 // Throws Error(kExitIoError) naming the file (and the line or element) when it cannot be read,
 // is truncated, or is malformed (an index out of range, a non-finite coordinate, no triangles).
 Mesh readMesh(const std::string& path);
+// The same from bytes already read (frMesh: a model file's contents); `path` gives the format
+// by its extension and names the file in messages.
+Mesh parseMesh(const std::string& path, const std::string& bytes);
 
 // The path's extension in lower case ("" if none): "Part.STL" -> "stl".
 std::string lowerExtension(const std::string& path);

@@ -2,7 +2,9 @@
 // extensions. Each function lowers its call to core expressions at compile time.
 #pragma once
 
+#include <cstdint>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -28,6 +30,9 @@ struct Arg {
   // File arguments (signature letter 'F', a string literal): `name` is the path as written,
   // `file` its contents (read relative to the model file's directory).
   const std::string* file = nullptr;
+  // Text arguments (signature letter 'T', a string literal that is not a file: a grid name) are
+  // in `name`.
+  bool isText = false;
 };
 
 // Thrown by a library function on bad arguments (wrong array size, ...). The lowering turns it
@@ -40,14 +45,38 @@ struct LibraryError : std::runtime_error {
 struct LibraryFunction {
   std::string name;       // canonical spelling, e.g. "hfSphere" (lookup is case-insensitive)
   // One letter per argument: 'A' array, 'S' scalar, 'O' object name, 'F' file name (a string),
-  // e.g. "AAS"; "*": any
-  // arguments (bare array names pass as arrays, earlier objects' names as objects, the rest as
-  // scalars; the function checks them).
+  // 'T' text (a string that is not a file, e.g. a grid name), e.g. "AAS"; "*": any arguments
+  // (bare array names pass as arrays, earlier objects' names as objects, the first string as a
+  // file 'F' and later ones as text 'T', the rest as scalars; the function checks them).
   std::string signature;
   std::string summary;    // one line: formula or effect (docs/language.md, `frep check` help)
   // Returns the call's value: a primitive's field, or 1 for transformations.
   std::function<Expr(std::vector<Arg>& args)> lower;
 };
+
+// Geometry read from files (frMesh, frVolume). lang does not link the readers (OpenVDB's headers
+// are slow and large): the program installs a loader (frep::io::installGeometryLoader,
+// io/geometry_files.h). The file's bytes come from the lowering (the disk relative to the model,
+// or CompileOptions::files on a farm worker), so the loader never opens a file itself.
+struct FileFieldRequest {
+  std::string path;                    // as written in the model (messages)
+  const std::string* bytes = nullptr;  // its contents
+  std::string kind;                    // "mesh" or "volume"
+  std::string grid;                    // volume: the grid's name ("": the file's first float grid)
+};
+struct LoadedFileField {
+  std::shared_ptr<const FieldFunction> field;
+  uint64_t fileHash = 0;              // FNV-1a of the bytes (the process cache's key)
+  std::vector<std::string> warnings;  // e.g. open edges of a mesh, how its sign is then defined
+};
+// Throws std::exception (message naming the file) when the file cannot be used.
+using FileFieldLoader = std::function<LoadedFileField(const FileFieldRequest&)>;
+void setFileFieldLoader(FileFieldLoader loader);
+const FileFieldLoader& fileFieldLoader();  // empty when none is installed
+// Loads through the installed loader; throws LibraryError(message, argIndex). The loader's
+// warnings are queued for the lowering, which reports them at the call (takeFileWarnings).
+LoadedFileField loadFileForCall(const std::string& fn, const FileFieldRequest& request, int argIndex);
+std::vector<std::string> takeFileWarnings();  // this thread's queued warnings, cleared
 
 // Registration happens at static-init time from each library source file.
 void registerLibraryFunction(LibraryFunction fn);

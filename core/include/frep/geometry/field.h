@@ -1,0 +1,46 @@
+// Geometry that is not a formula (triangle meshes, polygons, sampled volumes) as an operand of a
+// model: FieldFunction implementations (frep/expressions/field_function.h, the one Op::Field
+// node of issue 14) whose value is a signed distance, f = sign * dist (Choporov-Hybrid eq. 1-3,
+// positive inside). They read their point from the node's three child expressions (a planar
+// field ignores the third), so they compose with every operation and transformation.
+//
+// The interval bound of a distance field is its Lipschitz bound: dist is 1-Lipschitz in the
+// Euclidean norm, so over a box with centre c and half-diagonal r, f lies in f(c) +- L r. It is
+// sound and tight to within the box's half-diagonal, so sparse sampling, pruning and meshing cost
+// in proportion to the surface, not the volume.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "frep/expressions/field_function.h"
+
+namespace frep {
+
+class DistanceField : public FieldFunction {
+ public:
+  // Returns f(p) and its gradient. Default: central differences of value().
+  double gradient(const double p[3], double g[3]) const override;
+  // f(centre) +- lipschitz() * half-diagonal over the dims() coordinates the field reads.
+  Interval bound(const Interval box[3]) const override;
+  // Same dynamic type, same content hash and sameGeometry().
+  bool sameContent(const FieldFunction& other) const override;
+
+  // Lipschitz constant of f in the Euclidean norm (1 for an exact distance).
+  virtual double lipschitz() const { return 1.0; }
+  // Coordinates the field reads (2: a planar field ignores p[2], so its bound ignores box[2]).
+  virtual int dims() const { return 3; }
+
+ protected:
+  // Called only for another object of the same dynamic type and content hash.
+  virtual bool sameGeometry(const DistanceField& other) const = 0;
+};
+using DistanceFieldPtr = std::shared_ptr<const DistanceField>;
+
+// The node f(x, y, z) of a geometry field (planar fields: z = 0).
+inline Expr fieldExpr(DistanceFieldPtr field, const Expr& x, const Expr& y, const Expr& z = Expr(0.0)) {
+  return fieldCall(std::move(field), x, y, z);
+}
+
+}  // namespace frep
