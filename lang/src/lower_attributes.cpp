@@ -4,6 +4,7 @@
 // (hfA_SetColor colours where f >= 0) is a select() on the old value, so s[] ends the body as
 // one expression per element over x and a (docs/language.md, "Attributes"). Semantics re-derived
 // from HyperFun's attribute library documentation (hfA_* in hfp); arguments are in call order.
+#include <algorithm>
 #include <cmath>
 
 #include "frep/lang/lower_object.h"
@@ -12,12 +13,12 @@ namespace frep::lang::detail {
 
 namespace {
 
-// The attribute functions compiled here; the others (hfp's Perlin-noise textures and its look-up
-// tables and spline, whose code has no definite value: docs/language.md) are accepted with a
-// warning and return 1.
+// The attribute functions compiled here; the others (hfp's Perlin-noise textures, whose code has
+// no definite value: docs/language.md) are accepted with a warning and return 1.
 enum class Attr {
   SetColor, SetAttributes, Union, Lerp, Cerp, Clamp, Pulse, Step, SmoothStep, Modulo, Floor,
-  Wave, NoiseG, Crackles, Circles, CheckerBoard, HSVToRGB, RGBToHSV, Ignored
+  Wave, NoiseG, Crackles, Circles, CheckerBoard, HSVToRGB, RGBToHSV, LookUpTable, SmoothLookUpTable,
+  Spline, Ignored
 };
 
 struct AttrSpec {
@@ -44,6 +45,9 @@ AttrSpec specOf(const std::string& name) {
   if (name == "hfa_checkerboard") return {Attr::CheckerBoard, "AAAAAA"};
   if (name == "hfa_hsvtorgb") return {Attr::HSVToRGB, "AA"};
   if (name == "hfa_rgbtohsv") return {Attr::RGBToHSV, "AA"};
+  if (name == "hfa_lookuptable") return {Attr::LookUpTable, "SAAA"};
+  if (name == "hfa_smoothlookuptable") return {Attr::SmoothLookUpTable, "SAAA"};
+  if (name == "hfa_spline") return {Attr::Spline, "AASSS"};
   return {Attr::Ignored, "*"};
 }
 
@@ -67,6 +71,9 @@ const char* usage(Attr kind) {
     case Attr::CheckerBoard: return "hfA_CheckerBoard(x, block, gap, s, s_block, s_gap)";
     case Attr::HSVToRGB: return "hfA_HSVToRGB(hsv, rgb)";
     case Attr::RGBToHSV: return "hfA_RGBToHSV(rgb, hsv)";
+    case Attr::LookUpTable: return "hfA_LookUpTable(t, s, sets, map)";
+    case Attr::SmoothLookUpTable: return "hfA_SmoothLookUpTable(t, s, sets, map)";
+    case Attr::Spline: return "hfA_Spline(s, knots, t, tmin, tmax)";
     case Attr::Ignored: break;
   }
   return "";
@@ -284,6 +291,71 @@ Expr ObjectLowering::callAttribute(const AstExpr& e) {
       write(hsv, 0, Expr(1.0), select(gt(spread, Expr(0.0)), Expr(60.0) * h, Expr(0.0)));
       write(hsv, 1, Expr(1.0), select(gt(hi, Expr(0.0)), spread / top, Expr(0.0)));
       write(hsv, 2, Expr(1.0), hi);
+      return Expr(1.0);
+    }
+    case Attr::LookUpTable:
+    case Attr::SmoothLookUpTable: {
+      // A table of attribute sets indexed by t through the map m[1..M] (increasing): set k
+      // (sets[(k-1)·n + 1 .. k·n], n the size of s) belongs to m[k]. LookUpTable: s = set k
+      // for m[k] <= t < m[k+1]; SmoothLookUpTable: the linear mix of sets k and k+1 there.
+      // Below m[1]: the first set; at or past m[M] (or in no interval of an unordered map):
+      // set M. With M - 1 sets (hfp's documented example) set M is the last one given.
+      // The first matching interval wins (hfp stops there).
+      const bool smooth = spec.kind == Attr::SmoothLookUpTable;
+      const std::vector<Expr> map = attributeArray(e, 3, 2).elems, sets = attributeArray(e, 2, 1).elems;
+      Value& s = attributeArray(e, 1, 1);
+      const size_t n = s.elems.size(), entries = map.size();
+      if (sets.size() < n * (entries - 1))
+        throw CompileError{e.args[2]->loc, e.spelling + ": the attribute sets need " + std::to_string(n * (entries - 1)) +
+                                               " elements (a set of " + std::to_string(n) + " for each of the map's " +
+                                               std::to_string(entries) + " entries, the last one may be left out), they have " +
+                                               std::to_string(sets.size())};
+      const size_t given = std::min(entries, sets.size() / n);
+      auto set = [&](size_t k, size_t j) { return sets[n * std::min(k, given - 1) + j]; };
+      const Expr& t = v[0];
+      std::vector<Expr> out(n);
+      for (size_t j = 0; j < n; ++j) out[j] = set(entries - 1, j);
+      for (size_t k = entries - 1; k-- > 0;) {
+        const Expr in = logicalAnd(ge(t, map[k]), lt(t, map[k + 1]));
+        // The width kept off 0 where the interval is empty (its mix is then never used).
+        const Expr width = map[k + 1] - map[k], l = (t - map[k]) / select(gt(width, Expr(0.0)), width, Expr(1.0));
+        const bool mixes = smooth && std::min(k + 1, given - 1) != std::min(k, given - 1);
+        for (size_t j = 0; j < n; ++j)
+          out[j] = select(in, mixes ? (Expr(1.0) - l) * set(k, j) + l * set(k + 1, j) : set(k, j), out[j]);
+      }
+      for (size_t j = 0; j < n; ++j) write(s, j, Expr(1.0), select(lt(t, map[0]), set(0, j), out[j]));
+      return Expr(1.0);
+    }
+    case Attr::Spline: {
+      // Catmull-Rom through knots 2 .. K-1 of the K sets of n (the size of s) in knots, knots 1
+      // and K only steering the end tangents: u = (t - tmin)/(tmax - tmin) spread over the K - 3
+      // spans. u < 0: s = knot 1; u > 1: s = knot K (as hfp, a step at either end).
+      const std::vector<Expr> knots = attributeArray(e, 1, 1).elems;
+      Value& s = attributeArray(e, 0, 1);
+      const size_t n = s.elems.size(), count = knots.size() / n;
+      if (count < 4)
+        throw CompileError{e.args[1]->loc, e.spelling + ": the knots need at least 4 sets of " + std::to_string(n) +
+                                               " (the size of s), " + std::to_string(4 * n) + " elements; they have " +
+                                               std::to_string(knots.size())};
+      const size_t spans = count - 3;
+      const Expr u = (v[2] - v[3]) / (v[4] - v[3]);
+      const Expr w = u * Expr(double(spans));
+      // Span i covers i <= w < i + 1, the last one also w = spans (u = 1).
+      auto segment = [&](size_t i, size_t j) {
+        const Expr &k0 = knots[(i + 0) * n + j], &k1 = knots[(i + 1) * n + j], &k2 = knots[(i + 2) * n + j],
+                   &k3 = knots[(i + 3) * n + j];
+        const Expr c3 = Expr(-0.5) * k0 + Expr(1.5) * k1 - Expr(1.5) * k2 + Expr(0.5) * k3;
+        const Expr c2 = k0 - Expr(2.5) * k1 + Expr(2.0) * k2 - Expr(0.5) * k3;
+        const Expr c1 = Expr(0.5) * (k2 - k0);
+        const Expr r = w - Expr(double(i));
+        return ((c3 * r + c2) * r + c1) * r + k1;
+      };
+      for (size_t j = 0; j < n; ++j) {
+        Expr value = segment(spans - 1, j);
+        for (size_t i = spans - 1; i-- > 0;) value = select(lt(w, Expr(double(i + 1))), segment(i, j), value);
+        write(s, j, Expr(1.0),
+              select(lt(u, Expr(0.0)), knots[j], select(gt(u, Expr(1.0)), knots[(count - 1) * n + j], value)));
+      }
       return Expr(1.0);
     }
     case Attr::Ignored: break;

@@ -1,6 +1,7 @@
 // HyperFun attributes: s[] at the end of the body as expressions, the compiled hfA_* functions
 // against their formulas at points, and the diagnostics of wrong calls.
 #include <cmath>
+#include <cstdio>
 
 #include "lang/lang_test_util.h"
 
@@ -227,6 +228,109 @@ TEST(LangAttributes, HsvAndRgbConversions) {
   EXPECT_CLOSE(pink[1], 0.75);
 }
 
+// Look-up tables: set k belongs to map[k]; below map[1] the first set, at or past the last entry
+// the last set. LookUpTable picks set k on [map[k], map[k+1]); SmoothLookUpTable mixes k and k+1.
+TEST(LangAttributes, LookUpTablesPickOrMixTheSetsOfTheMap) {
+  const char* table = R"(my_model(x[3], a[1], s[2]) {
+    array sets[6], map[3];
+    sets = [1, 2, 3, 4, 5, 6];  map = [0.2, 0.5, 0.9];
+    d = %s(x[1], s, sets, map);
+    my_model = 1;
+  })";
+  char text[512];
+  std::snprintf(text, sizeof text, table, "hfA_LookUpTable");
+  Model m = compileOk(text);
+  EXPECT_TRUE(m.hasAttributes);
+  auto pair = [](const Model& model, double t) {
+    return std::vector<double>{attributeAt(model, 0, {t, 0, 0}), attributeAt(model, 1, {t, 0, 0})};
+  };
+  EXPECT_EQ(pair(m, -3), (std::vector<double>{1, 2}));  // below the map: the first set
+  EXPECT_EQ(pair(m, 0.2), (std::vector<double>{1, 2}));
+  EXPECT_EQ(pair(m, 0.49), (std::vector<double>{1, 2}));
+  EXPECT_EQ(pair(m, 0.5), (std::vector<double>{3, 4}));
+  EXPECT_EQ(pair(m, 0.89), (std::vector<double>{3, 4}));
+  EXPECT_EQ(pair(m, 0.9), (std::vector<double>{5, 6}));  // at or past the last entry: its set
+  EXPECT_EQ(pair(m, 7), (std::vector<double>{5, 6}));
+  std::snprintf(text, sizeof text, table, "hfA_SmoothLookUpTable");
+  Model smooth = compileOk(text);
+  auto mix = [](double a, double b, double l) { return (1 - l) * a + l * b; };
+  EXPECT_EQ(pair(smooth, 0.1), (std::vector<double>{1, 2}));
+  for (double t : {0.2, 0.3, 0.45}) {
+    const double l = (t - 0.2) / 0.3;
+    EXPECT_CLOSE(pair(smooth, t)[0], mix(1, 3, l));
+    EXPECT_CLOSE(pair(smooth, t)[1], mix(2, 4, l));
+  }
+  for (double t : {0.5, 0.8}) {
+    const double l = (t - 0.5) / 0.4;
+    EXPECT_CLOSE(pair(smooth, t)[0], mix(3, 5, l));
+    EXPECT_CLOSE(pair(smooth, t)[1], mix(4, 6, l));
+  }
+  EXPECT_EQ(pair(smooth, 0.9), (std::vector<double>{5, 6}));
+  EXPECT_EQ(pair(smooth, 4), (std::vector<double>{5, 6}));
+  // One set fewer than the map's entries (hfp's documented example): the last set is held from
+  // the last interval on; the smooth table mixes towards it and holds it.
+  Model short_ = compileOk(R"(my_model(x[3], a[1], s[2]) {
+    array sets[4], map[3];
+    sets = [1, 2, 3, 4];  map = [0.2, 0.5, 0.9];
+    d = hfA_LookUpTable(x[1], s, sets, map);
+    my_model = 1;
+  })");
+  EXPECT_EQ(pair(short_, 0.3), (std::vector<double>{1, 2}));
+  EXPECT_EQ(pair(short_, 0.6), (std::vector<double>{3, 4}));
+  EXPECT_EQ(pair(short_, 0.95), (std::vector<double>{3, 4}));
+  Model shortSmooth = compileOk(R"(my_model(x[3], a[1], s[2]) {
+    array sets[4], map[3];
+    sets = [1, 2, 3, 4];  map = [0.2, 0.5, 0.9];
+    d = hfA_SmoothLookUpTable(x[1], s, sets, map);
+    my_model = 1;
+  })");
+  EXPECT_CLOSE(pair(shortSmooth, 0.35)[0], mix(1, 3, 0.5));
+  EXPECT_EQ(pair(shortSmooth, 0.6), (std::vector<double>{3, 4}));
+  EXPECT_EQ(pair(shortSmooth, 2), (std::vector<double>{3, 4}));
+}
+
+// Catmull-Rom through p1, p2 with p0 and p3 steering the tangents, in its textbook form.
+double catmullRom(double p0, double p1, double p2, double p3, double r) {
+  return 0.5 * (2 * p1 + (p2 - p0) * r + (2 * p0 - 5 * p1 + 4 * p2 - p3) * r * r + (3 * p1 - p0 - 3 * p2 + p3) * r * r * r);
+}
+
+TEST(LangAttributes, SplineIsCatmullRomThroughTheInnerKnots) {
+  // Five knots of one element (two spans) and of two elements; t = x[1] over [1, 3].
+  Model m = compileOk(R"(my_model(x[3], a[1], s[2]) {
+    array knots[10];
+    knots = [0, 5, 1, 6, 4, 2, 2, 8, 3, 1];
+    d = hfA_Spline(s, knots, x[1], 1, 3);
+    my_model = 1;
+  })");
+  EXPECT_TRUE(m.hasAttributes);
+  const double k[2][5] = {{0, 1, 4, 2, 3}, {5, 6, 2, 8, 1}};
+  for (size_t j = 0; j < 2; ++j) {
+    EXPECT_CLOSE(attributeAt(m, j, {0.5, 0, 0}), k[j][0]);  // below tmin: the first knot
+    EXPECT_CLOSE(attributeAt(m, j, {3.5, 0, 0}), k[j][4]);  // above tmax: the last
+    EXPECT_CLOSE(attributeAt(m, j, {1, 0, 0}), k[j][1]);    // the curve runs from the second knot
+    EXPECT_CLOSE(attributeAt(m, j, {2, 0, 0}), k[j][2]);
+    EXPECT_CLOSE(attributeAt(m, j, {3, 0, 0}), k[j][3]);    // to the last but one (u = 1 included)
+    for (double t : {1.3, 1.5, 1.9}) {
+      const double r = (t - 1) / 2 * 2;
+      EXPECT_CLOSE(attributeAt(m, j, {t, 0, 0}), catmullRom(k[j][0], k[j][1], k[j][2], k[j][3], r));
+    }
+    for (double t : {2.1, 2.6, 2.99}) {
+      const double r = (t - 1) / 2 * 2 - 1;
+      EXPECT_CLOSE(attributeAt(m, j, {t, 0, 0}), catmullRom(k[j][1], k[j][2], k[j][3], k[j][4], r));
+    }
+  }
+  // Four knots: one span; the colour array as in hfp's documentation.
+  Model rgb = compileOk(R"(my_model(x[3], a[1], s[3]) {
+    array colours[12];
+    colours = [0, 0, 0,  1, 0, 0,  0, 0, 1,  1, 1, 1];
+    d = hfA_Spline(s, colours, x[3], -1, 1);
+    my_model = 1;
+  })");
+  EXPECT_CLOSE(attributeAt(rgb, 0, {0, 0, 0}), catmullRom(0, 1, 0, 1, 0.5));
+  EXPECT_CLOSE(attributeAt(rgb, 2, {0, 0, 0}), catmullRom(0, 0, 1, 1, 0.5));
+  EXPECT_CLOSE(attributeAt(rgb, 2, {0, 0, 1}), 1.0);
+}
+
 TEST(LangAttributes, WrongCallsAreErrorsAtTheirPlace) {
   CompileResult r = compile("my_model(x[3], a[1]) {\n  d = hfA_SetColor(x[1], s, 1, 0, 0);\n  my_model = 1;\n}\n", "c.hf");
   EXPECT_FALSE(r.ok);
@@ -250,6 +354,26 @@ TEST(LangAttributes, WrongCallsAreErrorsAtTheirPlace) {
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.diagnostics.at(0).message,
             "hfA_Circles: the attribute sets need 6 elements (2 intervals of the map × 3 of s), they have 3");
+  r = compile("my_model(x[3], a[1], s[3]) {\n array sets[3], map[3];\n sets = [1,1,1]; map = [0,0.5,1];\n"
+              " d = hfA_SmoothLookUpTable(x[1], s, sets, map);\n my_model = 1;\n}\n", "c.hf");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.diagnostics.at(0).line, 4);
+  EXPECT_EQ(r.diagnostics.at(0).column, 37);
+  EXPECT_EQ(r.diagnostics.at(0).message,
+            "hfA_SmoothLookUpTable: the attribute sets need 6 elements (a set of 3 for each of the map's 3 entries, "
+            "the last one may be left out), they have 3");
+  r = compile("my_model(x[3], a[1], s[3]) {\n array sets[3], map[1];\n sets = [1,1,1]; map = [0];\n"
+              " d = hfA_LookUpTable(x[1], s, sets, map);\n my_model = 1;\n}\n", "c.hf");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.diagnostics.at(0).message, "hfA_LookUpTable: 'map' needs at least 2 elements, it has 1");
+  r = compile("my_model(x[3], a[1], s[3]) {\n d = hfA_LookUpTable(x[1], s, s);\n my_model = 1;\n}\n", "c.hf");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.diagnostics.at(0).message, "hfA_LookUpTable takes 4 arguments, hfA_LookUpTable(t, s, sets, map); got 3");
+  r = compile("my_model(x[3], a[1], s[3]) {\n array k[11];\n k = [1,1,1,1,1,1,1,1,1,1,1];\n"
+              " d = hfA_Spline(s, k, x[1], 0, 1);\n my_model = 1;\n}\n", "c.hf");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.diagnostics.at(0).message,
+            "hfA_Spline: the knots need at least 4 sets of 3 (the size of s), 12 elements; they have 11");
 }
 
 }  // namespace
