@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "allocation_cap.h"
-#include "vdb_layout.h"
+#include "checked_grid.h"
 
 #include "frep/io/format_number.h"
 #include "frep/io/error.h"
@@ -45,54 +45,71 @@ size_t allocationCapFor(uint64_t fileBytes) { return size_t(64 << 20) + size_t(f
 
 }  // namespace
 
-void checkVdbLayout(const std::string& path) { checkLayout(path); }
-
-SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) {
+CheckedGrid readCheckedFloatGrid(const std::string& path, const GridRequest& request) {
   openvdb::initialize();
-  SampledVdb out;
-  openvdb::FloatGrid::Ptr grid;
-  const VdbLayout layout = checkVdbLayout(path);
-  const uint64_t fileBytes = layout.bytes;
-  out.contentHash = layout.contentHash;
+  const std::string& shown = request.shown;
+  auto named = [&](std::string msg) {  // messages of the layout check name the path read
+    if (shown == path) return msg;
+    for (size_t at = msg.find(path); at != std::string::npos; at = msg.find(path, at + shown.size()))
+      msg.replace(at, path.size(), shown);
+    return msg;
+  };
+  CheckedGrid out;
   try {
-    const AllocationCap cap(allocationCapFor(fileBytes));
+    out.layout = checkVdbLayout(path);
+  } catch (const Error& e) {
+    throw Error(e.code, named(e.what()));
+  }
+  std::string chosenName;
+  try {
+    const AllocationCap cap(allocationCapFor(out.layout.bytes));
     openvdb::io::File file(path);
     file.open(false);  // read everything now: a corrupt file fails here, not half way through
     openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();
     openvdb::GridBase::ConstPtr chosen;
     for (const auto& g : *metas) {
-      if (gridName.empty() ? g->isType<openvdb::FloatGrid>() : g->getName() == gridName) {
+      if (request.gridName.empty() ? g->isType<openvdb::FloatGrid>() : g->getName() == request.gridName) {
         chosen = g;
         break;
       }
     }
     if (!chosen) {
       file.close();
-      if (gridName.empty())
-        throw Error(kExitModelError, path + ": no float grid to mesh (" + gridList(*metas) +
-                                            "); frep mesh reads the FloatGrid written by frep sample");
-      throw Error(kExitModelError, path + ": no grid named '" + gridName + "' (-o/--object); " + gridList(*metas));
+      if (request.gridName.empty())
+        throw Error(kExitModelError, shown + ": no float grid to " + request.verb + " (" + gridList(*metas) + "); " +
+                                         request.user + " reads a FloatGrid such as frep sample writes");
+      throw Error(kExitModelError, shown + ": no grid named '" + request.gridName + "' (" + request.nameSource +
+                                       "); " + gridList(*metas));
     }
     if (!chosen->isType<openvdb::FloatGrid>()) {
       file.close();
-      throw Error(kExitModelError, path + ": grid '" + chosen->getName() + "' holds " + chosen->valueType() +
-                                          " values; frep mesh needs a float grid (as written by frep sample)");
+      throw Error(kExitModelError, shown + ": grid '" + chosen->getName() + "' holds " + chosen->valueType() +
+                                       " values; " + request.user + " needs a float grid (as frep sample writes)");
     }
-    out.gridName = chosen->getName();
-    grid = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(out.gridName));
+    chosenName = chosen->getName();
+    out.grid = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(chosenName));
     file.close();
   } catch (const openvdb::Exception& e) {
-    throw ioError("cannot read VDB '" + path + "': " + e.what());
+    throw ioError("cannot read VDB '" + shown + "': " + named(e.what()));
   } catch (const std::ios_base::failure& e) {
-    throw ioError("cannot read VDB '" + path + "': " + e.what());
+    throw ioError("cannot read VDB '" + shown + "': " + named(e.what()));
   } catch (const std::bad_alloc&) {
-    throw ioError("cannot read VDB '" + path + "': out of memory (sizes in the file are damaged, or it is too large)");
+    throw ioError("cannot read VDB '" + shown + "': out of memory (sizes in the file are damaged, or it is too large)");
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {  // e.g. std::length_error from a damaged size: bad input, not a bug
-    throw ioError("cannot read VDB '" + path + "': damaged (" + std::string(e.what()) + ")");
+    throw ioError("cannot read VDB '" + shown + "': damaged (" + named(e.what()) + ")");
   }
-  if (!grid) throw ioError("cannot read VDB '" + path + "': grid '" + out.gridName + "' could not be loaded");
+  if (!out.grid) throw ioError("cannot read VDB '" + shown + "': grid '" + chosenName + "' could not be loaded");
+  return out;
+}
+
+SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) {
+  SampledVdb out;
+  CheckedGrid checked = readCheckedFloatGrid(path, {path, gridName, "-o/--object", "mesh", "frep mesh"});
+  const openvdb::FloatGrid::Ptr grid = checked.grid;
+  out.gridName = grid->getName();
+  out.contentHash = checked.layout.contentHash;
   if (grid->getGridClass() != openvdb::GRID_LEVEL_SET)
     spdlog::warn("{}: grid '{}' is not a level set (class {}); meshing where its values change sign, negative inside",
                  path, out.gridName, openvdb::GridBase::gridClassToString(grid->getGridClass()));

@@ -11,6 +11,7 @@
 #include "frep/io/error.h"
 #include "frep/io/geometry_files.h"
 #include "frep/io/vdb_reader.h"
+#include "checked_grid.h"
 
 namespace frep::io {
 namespace {
@@ -103,54 +104,14 @@ class TempFile {
   std::string path_;
 };
 
-std::string renamed(std::string msg, const std::string& from, const std::string& to) {
-  for (size_t at = msg.find(from); at != std::string::npos; at = msg.find(from, at + to.size())) msg.replace(at, from.size(), to);
-  return msg;
-}
-
 }  // namespace
 
 std::shared_ptr<const DistanceField> readVolumeField(const std::string& path, const std::string& bytes,
                                                      const std::string& gridName, uint64_t fileHash) {
   openvdb::initialize();
   TempFile tmp(bytes);
-  try {
-    checkVdbLayout(tmp.path());
-  } catch (const Error& e) {
-    throw Error(e.code, renamed(e.what(), tmp.path(), path));
-  }
-  openvdb::FloatGrid::Ptr grid;
-  try {
-    openvdb::io::File file(tmp.path());
-    file.open(false);
-    openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();
-    std::string names;
-    openvdb::GridBase::Ptr chosen;
-    for (const auto& g : *metas) {
-      names += std::string(names.empty() ? "" : ", ") + "'" + g->getName() + "' (" + g->valueType() + ")";
-      if (!chosen && (gridName.empty() ? g->isType<openvdb::FloatGrid>() : g->getName() == gridName)) chosen = g;
-    }
-    if (names.empty()) names = "none";
-    if (!chosen) {
-      file.close();
-      if (gridName.empty()) throw Error(kExitModelError, path + ": no float grid (its grids: " + names + ")");
-      throw Error(kExitModelError, path + ": no grid named '" + gridName + "' (its grids: " + names + ")");
-    }
-    if (!chosen->isType<openvdb::FloatGrid>()) {
-      file.close();
-      throw Error(kExitModelError, path + ": grid '" + chosen->getName() + "' holds " + chosen->valueType() +
-                                       " values; frVolume needs a float grid");
-    }
-    grid = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(chosen->getName()));
-    file.close();
-  } catch (const openvdb::Exception& e) {
-    throw ioError("cannot read VDB '" + path + "': " + renamed(e.what(), tmp.path(), path));
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw ioError("cannot read VDB '" + path + "': damaged (" + std::string(e.what()) + ")");
-  }
-  if (!grid) throw ioError("cannot read VDB '" + path + "': the grid could not be loaded");
+  const openvdb::FloatGrid::Ptr grid =
+      readCheckedFloatGrid(tmp.path(), {path, gridName, "frVolume's grid argument", "read", "frVolume"}).grid;
   if (!grid->transform().isLinear())
     throw Error(kExitModelError, path + ": grid '" + grid->getName() + "' has a non-linear transform (frVolume needs a linear one)");
   // frep sample writes value = -f (metadata frep_sign); OpenVDB level sets are negative inside:

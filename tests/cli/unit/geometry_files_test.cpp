@@ -242,7 +242,7 @@ TEST(GeometryFiles, VdbFromTheSamplerReadsBackWithinHalfAVoxel) {
   lang::CompileResult bad = compileModel(d, "  m = frVolume(x, \"ball.vdb\", \"nope\");");
   ASSERT_FALSE(bad.ok);
   EXPECT_EQ(bad.diagnostics[0].column, 31);
-  EXPECT_NE(bad.diagnostics[0].message.find("no grid named 'nope' (its grids: 'ball' (float))"), std::string::npos)
+  EXPECT_NE(bad.diagnostics[0].message.find("no grid named 'nope' (frVolume's grid argument); it holds 'ball' (float)"), std::string::npos)
       << bad.diagnostics[0].message;
 }
 

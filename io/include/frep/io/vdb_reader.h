@@ -37,8 +37,4 @@ struct SampledVdb {
 // grids.
 SampledVdb readSampledVdb(const std::string& path, const std::string& gridName);
 
-// The file's layout checked before OpenVDB reads it (OpenVDB trusts every length it reads):
-// throws Error(kExitIoError) naming the file when it is not a complete, well-formed VDB file.
-void checkVdbLayout(const std::string& path);
-
 }  // namespace frep::io
