@@ -401,7 +401,7 @@ class Master {
     auto it = peers_.find(in.routingId);
     if (e.body_case() == Envelope::kHello) {
       const std::string wid = e.hello().worker_id().empty() ? printable(in.routingId) : e.hello().worker_id();
-      if (it == peers_.end() && !adoptReconnected(wid, in.routingId) && peers_.size() >= kMaxPeers) {
+      if (it == peers_.end() && !adoptReconnected(wid, in.routingId, e.hello()) && peers_.size() >= kMaxPeers) {
         ++report_.refused;
         Envelope r;
         r.mutable_reject()->set_reason("the farm is full (" + std::to_string(kMaxPeers) + " workers)");
@@ -453,32 +453,41 @@ class Master {
   }
 
   // A hello with the worker id of a peer under another routing id: the worker reconnected
-  // (its master went silent, e.g. stopped). It keeps its leases and what it computes.
-  bool adoptReconnected(const std::string& workerId, const std::string& rid) {
+  // (its master went silent, e.g. stopped). It keeps the leases of the bricks it says it still
+  // has (hello.holding); the others' results went out on the connection it closed and may be
+  // lost, so those bricks go back to the queue (a late copy is a former holder's duplicate).
+  // Keeping them leased would hold the worker's credit for results that never come: with every
+  // worker reconnected, the job would wait for ever.
+  bool adoptReconnected(const std::string& workerId, const std::string& rid, const Hello& hello) {
     auto old = std::find_if(peers_.begin(), peers_.end(), [&](auto& kv) { return kv.second.workerId == workerId; });
     if (old == peers_.end()) return false;
     std::string oldRid = old->first;
     Peer moved = std::move(old->second);
     peers_.erase(old);
+    const std::set<uint64_t> still(hello.holding().begin(), hello.holding().end());
+    std::vector<uint64_t> lost;
     for (uint64_t id : moved.inflight) {
       auto& h = bricks_[id].holders;
-      if (auto node = h.extract(oldRid)) {
+      auto node = h.extract(oldRid);
+      if (node && still.count(id)) {
         node.key() = rid;
         h.insert(std::move(node));
+      } else {
+        lost.push_back(id);
       }
     }
+    for (uint64_t id : lost) {
+      moved.inflight.erase(id);
+      Brick& b = bricks_[id];
+      if (b.phase == BrickPhase::Leased && b.holders.empty())
+        requeue(b, "its result was lost when worker " + workerId + " reconnected", false);
+    }
     peers_[rid] = std::move(moved);
-    // What it sent on the old connection while the master was deaf may be lost (it closed
-    // that connection): its leases are issued once more elsewhere, whichever copy comes first.
-    for (uint64_t id : peers_[rid].inflight)
-      if (Brick& b = bricks_[id]; b.phase == BrickPhase::Leased && !b.leaseReissued) {
-        b.leaseReissued = true;
-        reissue_.push_back(id);
-      }
     if (aliases_.size() >= kMaxAliases) aliases_.clear();
     aliases_[oldRid] = rid;
     ++report_.reconnects;
-    spdlog::info("worker {} reconnected: it keeps its {} lease(s)", workerId, peers_[rid].inflight.size());
+    spdlog::info("worker {} reconnected: it keeps {} lease(s), {} brick(s) go back to the queue", workerId,
+                 peers_[rid].inflight.size(), lost.size());
     return true;
   }
 

@@ -12,7 +12,7 @@
 namespace frep::farm {
 
 constexpr uint32_t kProtoMajor = 1;
-constexpr uint32_t kProtoMinor = 2;  // 1: "render" jobs (RenderSpec); 2: ModelFile.hash (checked)
+constexpr uint32_t kProtoMinor = 3;  // 1: "render" jobs (RenderSpec); 2: ModelFile.hash (checked); 3: Hello.holding
 
 struct Incoming {
   std::string routingId;  // empty on the DEALER side

@@ -81,6 +81,18 @@ class ComputeThread {
     if (running_) v.push_back(*running_);
     return v;
   }
+  // Every brick still here: queued, running, or computed and not yet sent (a reconnect's hello).
+  std::vector<uint64_t> holding() {
+    std::lock_guard<std::mutex> l(mutex_);
+    std::vector<uint64_t> v;
+    for (const Task& t : queue_) v.push_back(t.brick_id());
+    if (running_) v.push_back(running_->brick_id());
+    for (const Outgoing& o : done_) {
+      if (o.env.has_result()) v.push_back(o.env.result().brick_id());
+      else if (o.env.has_failed()) v.push_back(o.env.failed().brick_id());
+    }
+    return v;
+  }
   size_t pending() {
     std::lock_guard<std::mutex> l(mutex_);
     return queue_.size() + (running_ ? 1 : 0);
@@ -227,6 +239,7 @@ int runWorker(const WorkerOptions& opt) {
     h->set_build(std::string("frepfarm ") + FREP_VERSION);
     h->set_threads(uint32_t(threads));
     h->set_worker_id(workerId);
+    for (uint64_t id : compute.holding()) h->add_holding(id);
     send(sock, "", hello);
     spdlog::info("worker {}: connecting to {}", workerId, opt.endpoint);
     auto heard = Clock::now();

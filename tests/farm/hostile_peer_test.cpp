@@ -296,3 +296,39 @@ TEST(HostilePeer, GarbageFromAWelcomedPeerDropsThePeerNotItsBricks) {
   EXPECT_EQ(r.bricksComputed, 8u);
   expectSameLeaves(ref, master.outcome.result);
 }
+
+// A worker whose master went silent reconnects under a new routing id and lists the bricks it
+// still has (Hello.holding): the leases it no longer holds (their results went out on the
+// closed connection) go back to the queue and come to it again. Before, it kept them: with every
+// worker reconnected, no credit was left for their reissue and the job waited for ever.
+TEST(HostilePeer, AReconnectedWorkerGetsBackTheBricksItNoLongerHas) {
+  JobSpec j = sphereJob();
+  SampleResult ref = reference(j);
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
+  zmq::context_t ctx(1);
+  std::vector<Envelope> held;
+  {
+    ScriptedPeer first(ctx, ep, "first", false);
+    first.sayHello("w");
+    held = first.collect(Envelope::kTask, 2);
+    ASSERT_EQ(held.size(), 2u);
+  }  // the old connection closes with the two leases
+  const uint64_t kept = held[0].task().brick_id(), lost = held[1].task().brick_id();
+  ScriptedPeer again(ctx, ep, "again", false);
+  Envelope h;
+  h.mutable_hello()->set_worker_id("w");
+  h.mutable_hello()->add_holding(kept);
+  send(again.s, "", h);
+  std::vector<Envelope> more = again.collect(Envelope::kTask, 1);
+  ASSERT_EQ(more.size(), 1u) << "the reconnected worker got no brick: its lost lease still held its credit";
+  EXPECT_EQ(more[0].task().brick_id(), lost);
+  held.push_back(more[0]);
+  again.handBackAndLeave(jobIdOf(j), held);
+  EXPECT_EQ(runRealWorker(ep), 0);
+  master.join();
+  ASSERT_EQ(master.error, "");
+  EXPECT_EQ(master.outcome.report.reconnects, 1u);
+  EXPECT_TRUE(master.outcome.report.poisoned.empty());
+  expectSameLeaves(ref, master.outcome.result);
+}
