@@ -237,6 +237,52 @@ TEST_F(FrepTest, EveryExampleChecksCleanly) {
   }
 }
 
+// examples/convolution/ (frConv<Kernel><Skeleton>, docs/language.md): every file checks without
+// a warning, and a point each header describes is inside its solid and one is outside.
+TEST_F(FrepTest, EveryConvolutionExampleChecksCleanly) {
+  const std::string dir = FREP_EXAMPLES_DIR "/convolution";
+  DIR* d = ::opendir(dir.c_str());
+  ASSERT_NE(d, nullptr);
+  std::vector<std::string> models;
+  while (dirent* e = ::readdir(d)) {
+    std::string name = e->d_name;
+    if (name.size() > 3 && name.compare(name.size() - 3, 3, ".hf") == 0) models.push_back(name);
+  }
+  ::closedir(d);
+  EXPECT_GE(models.size(), 3u);
+  for (const std::string& m : models) {
+    RunResult r = run("check '" + dir + "/" + m + "'");
+    EXPECT_EQ(r.code, 0) << m << "\n" << r.err;
+    EXPECT_EQ(r.err, "") << m;  // not even a warning
+    EXPECT_TRUE(contains(r.out, ": ok, 1 object")) << m << "\n" << r.out;
+  }
+  struct Probe {
+    const char* file;
+    const char* at;
+    bool in;
+  };
+  const Probe probes[] = {
+      {"soft_letter.hf", "-0.4,-0.5,0", true},     // the stem (tube radius 0.15)
+      {"soft_letter.hf", "-0.3,-0.5,0", false},
+      {"soft_letter.hf", "0.4,0.5,0", true},       // the bowl's arc, at its right-most point
+      {"soft_letter.hf", "0.1,0.5,0", false},      // the bowl's hole
+      {"triangle_blob.hf", "0,0,0", true},         // the faces fill the inside
+      {"triangle_blob.hf", "-0.7,-0.7,-0.7", false},  // the corner the tetrahedron does not have
+      {"kernel_compare.hf", "-2.7,0.05,0", true},  // an arm in each panel
+      {"kernel_compare.hf", "-0.3,0.05,0", true},
+      {"kernel_compare.hf", "2.1,0.05,0", true},
+      {"kernel_compare.hf", "-2.4,1,0", false},    // between the arms' tops
+      {"kernel_compare.hf", "2.4,1,0", false},
+      {"kernel_compare.hf", "0,-0.1,0", true},    // the inverse square webs the inner corner higher
+      {"kernel_compare.hf", "2.4,-0.1,0", false},  // than the soft kernel (its web ends at y = -0.16)
+  };
+  for (const Probe& p : probes) {
+    RunResult r = run("eval '" + dir + "/" + p.file + "' --at " + p.at);
+    EXPECT_EQ(r.code, 0) << p.file << "\n" << r.err;
+    EXPECT_TRUE(contains(r.out, p.in ? "status: in" : "status: out")) << p.file << " at " << p.at << "\n" << r.out;
+  }
+}
+
 TEST_F(FrepTest, SliceHoldsHigherCoordinatesAtZeroOrAtTheirMapping) {
   // A 4D ball: at x[4] = 0 the slice z = 0 is the unit disc; at x[4] = 0.8 its radius is 0.6.
   write("s4.hf", "my_model(x[4], a[1]) { my_model = 1 - x[1]^2 - x[2]^2 - x[3]^2 - x[4]^2; }\n");

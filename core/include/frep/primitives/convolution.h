@@ -41,8 +41,8 @@
 // bound exactly from the range of |h|. value() is clamped into the same bound at the point
 // itself (a zero-width box), which only moves rounding noise, so a box bound encloses every point
 // value in it (the bound's floating-point operations are monotone in the box).
-// Boxes smaller than a piece (where that bound stops shrinking: renders would show a fat surface)
-// also get the value at the box's centre +- a slope bound (sum of measure * S * sup |h'| beyond
+// Segment and arc boxes smaller than a piece (where that bound stops shrinking: renders would
+// show a fat surface) also get the value at the box's centre +- a slope bound (sum of measure * S * sup |h'| beyond
 // each piece's nearest distance) times the half-diagonal, with a margin for the value's error.
 #pragma once
 
