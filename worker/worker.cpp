@@ -312,6 +312,8 @@ int runWorker(const WorkerOptions& opt) {
               break;
             case Envelope::kReset:
               spdlog::info("worker {}: master asks for a new hello", workerId);
+              h->clear_holding();
+              for (uint64_t id : compute.holding()) h->add_holding(id);
               send(sock, "", hello);
               break;
             case Envelope::kBye:
