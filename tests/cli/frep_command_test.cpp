@@ -219,43 +219,43 @@ TEST_F(FrepTest, SliceAlongXShowsTheYZPlane) {
   EXPECT_TRUE(cool(png.at(4, 6)));  // z = -0.5
 }
 
-TEST_F(FrepTest, EveryExampleChecksCleanly) {
-  DIR* d = ::opendir(FREP_EXAMPLES_DIR);
-  ASSERT_NE(d, nullptr);
+// The .hf files directly in `dir`.
+std::vector<std::string> hfFilesIn(const std::string& dir) {
   std::vector<std::string> models;
-  while (dirent* e = ::readdir(d)) {
-    std::string name = e->d_name;
-    if (name.size() > 3 && name.compare(name.size() - 3, 3, ".hf") == 0) models.push_back(name);
+  if (DIR* d = ::opendir(dir.c_str())) {
+    while (dirent* e = ::readdir(d)) {
+      std::string name = e->d_name;
+      if (name.size() > 3 && name.compare(name.size() - 3, 3, ".hf") == 0) models.push_back(name);
+    }
+    ::closedir(d);
   }
-  ::closedir(d);
-  EXPECT_GE(models.size(), 5u);
+  return models;
+}
+
+// Each checks with exit 0, one object and not even a warning (`run` is FrepTest::run).
+template <typename Run>
+void expectChecksCleanly(const Run& run, const std::string& dir, const std::vector<std::string>& models) {
   for (const std::string& m : models) {
-    RunResult r = run("check '" FREP_EXAMPLES_DIR "/" + m + "'");
+    RunResult r = run("check '" + dir + "/" + m + "'");
     EXPECT_EQ(r.code, 0) << m << "\n" << r.err;
-    EXPECT_EQ(r.err, "") << m;  // not even a warning
+    EXPECT_EQ(r.err, "") << m;
     EXPECT_TRUE(contains(r.out, ": ok, 1 object")) << m << "\n" << r.out;
   }
+}
+
+TEST_F(FrepTest, EveryExampleChecksCleanly) {
+  const std::vector<std::string> models = hfFilesIn(FREP_EXAMPLES_DIR);
+  EXPECT_GE(models.size(), 5u);
+  expectChecksCleanly([&](const std::string& a) { return run(a); }, FREP_EXAMPLES_DIR, models);
 }
 
 // examples/convolution/ (frConv<Kernel><Skeleton>, docs/language.md): every file checks without
 // a warning, and a point each header describes is inside its solid and one is outside.
 TEST_F(FrepTest, EveryConvolutionExampleChecksCleanly) {
   const std::string dir = FREP_EXAMPLES_DIR "/convolution";
-  DIR* d = ::opendir(dir.c_str());
-  ASSERT_NE(d, nullptr);
-  std::vector<std::string> models;
-  while (dirent* e = ::readdir(d)) {
-    std::string name = e->d_name;
-    if (name.size() > 3 && name.compare(name.size() - 3, 3, ".hf") == 0) models.push_back(name);
-  }
-  ::closedir(d);
+  const std::vector<std::string> models = hfFilesIn(dir);
   EXPECT_GE(models.size(), 3u);
-  for (const std::string& m : models) {
-    RunResult r = run("check '" + dir + "/" + m + "'");
-    EXPECT_EQ(r.code, 0) << m << "\n" << r.err;
-    EXPECT_EQ(r.err, "") << m;  // not even a warning
-    EXPECT_TRUE(contains(r.out, ": ok, 1 object")) << m << "\n" << r.out;
-  }
+  expectChecksCleanly([&](const std::string& a) { return run(a); }, dir, models);
   struct Probe {
     const char* file;
     const char* at;
