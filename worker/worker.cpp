@@ -234,13 +234,17 @@ int runWorker(const WorkerOptions& opt) {
                                            std::to_string(Clock::now().time_since_epoch().count() % 1000000));
     if (!opt.curveDir.empty()) applyCurveClient(sock, keys);
     sock.connect(opt.endpoint);
-    Envelope hello;
-    Hello* h = hello.mutable_hello();
-    h->set_build(std::string("frepfarm ") + FREP_VERSION);
-    h->set_threads(uint32_t(threads));
-    h->set_worker_id(workerId);
-    for (uint64_t id : compute.holding()) h->add_holding(id);
-    send(sock, "", hello);
+    // The hello, with the bricks the worker has when it is sent (a reconnect's leases).
+    auto sayHello = [&] {
+      Envelope hello;
+      Hello* h = hello.mutable_hello();
+      h->set_build(std::string("frepfarm ") + FREP_VERSION);
+      h->set_threads(uint32_t(threads));
+      h->set_worker_id(workerId);
+      for (uint64_t id : compute.holding()) h->add_holding(id);
+      send(sock, "", hello);
+    };
+    sayHello();
     spdlog::info("worker {}: connecting to {}", workerId, opt.endpoint);
     auto heard = Clock::now();
     auto lastBeat = Clock::now();
@@ -312,9 +316,7 @@ int runWorker(const WorkerOptions& opt) {
               break;
             case Envelope::kReset:
               spdlog::info("worker {}: master asks for a new hello", workerId);
-              h->clear_holding();
-              for (uint64_t id : compute.holding()) h->add_holding(id);
-              send(sock, "", hello);
+              sayHello();
               break;
             case Envelope::kBye:
               spdlog::info("worker {}: master says bye ({})", workerId, e.bye().reason());

@@ -588,6 +588,7 @@ std::shared_ptr<const Convolution> Convolution::make(ConvKernel kernel, ConvSkel
     }
     for (double x : el.geometry) h = mixBits(h, x);
     h = mixBits(h, el.S);
+    for (const Piece& pc : pieces) c->largestPiece_ = std::max(c->largestPiece_, pc.radius);
     c->pieces_.push_back(std::move(pieces));
   }
   c->elements_ = std::move(elements);
@@ -737,12 +738,9 @@ Interval Convolution::bound(const Interval box[3]) const {
     c[k] = 0.5 * (lo[k] + hi[k]);
     r2 += 0.25 * (hi[k] - lo[k]) * (hi[k] - lo[k]);
   }
-  double largestPiece = 0.0;
-  for (const auto& ps : pieces_)
-    for (const Piece& pc : ps) largestPiece = std::max(largestPiece, pc.radius);
   const double r = std::sqrt(r2);
   // Not for triangles: their value is a fan of adaptive quadratures, too dear to pay per box.
-  if ((skeleton_ == ConvSkeleton::Segment || skeleton_ == ConvSkeleton::Arc) && r < largestPiece &&
+  if ((skeleton_ == ConvSkeleton::Segment || skeleton_ == ConvSkeleton::Arc) && r < largestPiece_ &&
       std::isfinite(sh)) {
     double slope = 0.0;
     for (size_t i = 0; i < elements_.size(); ++i)

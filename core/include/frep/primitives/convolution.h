@@ -107,6 +107,7 @@ class Convolution final : public FieldFunction {
   ConvSkeleton skeleton_ = ConvSkeleton::Point;
   std::vector<ConvElement> elements_;
   std::vector<std::vector<Piece>> pieces_;  // per element (not planes)
+  double largestPiece_ = 0.0;               // the largest piece radius (bound())
   uint64_t hash_ = 0;
 };
 
