@@ -268,8 +268,7 @@ TEST(FrExtremum, SweepKeysWithAngles) {
 
 // The paper examples in examples/extremum/ compile, and a point of each is right.
 std::string exampleDir() {
-  std::string f = __FILE__;  // .../tests/lang/lib_fr_extremum_test.cpp
-  return f.substr(0, f.rfind("/tests/lang/")) + "/examples/extremum/";
+  return std::string(FREP_SOURCE_DIR) + "/examples/extremum/";
 }
 
 Model compileExample(const std::string& name, const std::string& object = "") {
