@@ -138,35 +138,7 @@ void stlAscii(Bytes& b, const Mesh& m, const std::string& name, const std::strin
 // frep_mesh; include it and write `object { frep_mesh ... }`.
 void pov(Bytes& b, const Mesh& m, const std::string& comment) {
   if (!comment.empty()) b.text("// " + oneLine(comment) + "\n");
-  char line[160];
-  b.text("#declare frep_mesh = mesh2 {\n  vertex_vectors { " + std::to_string(m.positions.size()) + "\n");
-  for (const auto& p : m.positions) {
-    std::snprintf(line, sizeof line, "    <%.9g, %.9g, %.9g>\n", double(float(p[0])), double(float(p[1])), double(float(p[2])));
-    b.text(line, std::strlen(line));
-  }
-  b.text("  }\n  normal_vectors { " + std::to_string(m.normals.size()) + "\n");
-  for (const auto& n : m.normals) {
-    std::snprintf(line, sizeof line, "    <%.9g, %.9g, %.9g>\n", double(float(n[0])), double(float(n[1])), double(float(n[2])));
-    b.text(line, std::strlen(line));
-  }
-  const bool colours = !m.colours.empty();
-  if (colours) {  // one texture per vertex; mesh2 interpolates them across each triangle
-    b.text("  }\n  texture_list { " + std::to_string(m.colours.size()) + "\n");
-    for (const auto& c : m.colours) {
-      std::snprintf(line, sizeof line, "    texture { pigment { rgb <%.9g, %.9g, %.9g> } }\n", double(c[0]), double(c[1]),
-                    double(c[2]));
-      b.text(line, std::strlen(line));
-    }
-  }
-  b.text("  }\n  face_indices { " + std::to_string(m.triangles.size()) + "\n");
-  for (const auto& t : m.triangles) {
-    if (colours)
-      std::snprintf(line, sizeof line, "    <%u, %u, %u>, %u, %u, %u\n", t[0], t[1], t[2], t[0], t[1], t[2]);
-    else
-      std::snprintf(line, sizeof line, "    <%u, %u, %u>\n", t[0], t[1], t[2]);
-    b.text(line, std::strlen(line));
-  }
-  b.text("  }\n  inside_vector <0, 0, 1>\n}\n");
+  b.text(povMesh2(m, "frep_mesh"));
 }
 
 // The mesh in the file's axes: (x, y, z) -> (x, z, -y) for Y-up (a rotation: windings kept).
@@ -182,6 +154,42 @@ Mesh yUp(const Mesh& m) {
 }
 
 }  // namespace
+
+std::string povMesh2(const Mesh& m, const std::string& name) {
+  char line[160];
+  std::string b;
+  auto text = [&b](const std::string& t) { b += t; };
+  text("#declare " + name + " = mesh2 {\n  vertex_vectors { " + std::to_string(m.positions.size()) + "\n");
+  for (const auto& p : m.positions) {
+    std::snprintf(line, sizeof line, "    <%.9g, %.9g, %.9g>\n", double(float(p[0])), double(float(p[1])), double(float(p[2])));
+    b.append(line, std::strlen(line));
+  }
+  text("  }\n  normal_vectors { " + std::to_string(m.normals.size()) + "\n");
+  for (const auto& n : m.normals) {
+    std::snprintf(line, sizeof line, "    <%.9g, %.9g, %.9g>\n", double(float(n[0])), double(float(n[1])), double(float(n[2])));
+    b.append(line, std::strlen(line));
+  }
+  const bool colours = !m.colours.empty();
+  if (colours) {  // one texture per vertex; mesh2 interpolates them across each triangle
+    text("  }\n  texture_list { " + std::to_string(m.colours.size()) + "\n");
+    for (const auto& c : m.colours) {
+      std::snprintf(line, sizeof line, "    texture { pigment { rgb <%.9g, %.9g, %.9g> } }\n", double(c[0]), double(c[1]),
+                    double(c[2]));
+      b.append(line, std::strlen(line));
+    }
+  }
+  text("  }\n  face_indices { " + std::to_string(m.triangles.size()) + "\n");
+  for (const auto& t : m.triangles) {
+    if (colours)
+      std::snprintf(line, sizeof line, "    <%u, %u, %u>, %u, %u, %u\n", t[0], t[1], t[2], t[0], t[1], t[2]);
+    else
+      std::snprintf(line, sizeof line, "    <%u, %u, %u>\n", t[0], t[1], t[2]);
+    b.append(line, std::strlen(line));
+  }
+  text("  }\n  inside_vector <0, 0, 1>\n}\n");
+  return b;
+}
+
 
 MeshFormat meshFormatFromPath(const std::string& field, const std::string& path) {
   auto dot = path.find_last_of('.');

@@ -4,9 +4,14 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <vector>
 
+#include "frep/expressions/tape.h"
+#include "frep/io/mesh_writer.h"
+#include "frep/meshing/mesh.h"
 #include "frep/minkowski_algebra/bidisc.h"
+#include "frep/minkowski_algebra/disc_sum_distance.h"
 #include "frep/minkowski_algebra/registry.h"
 
 namespace frep::io {
@@ -26,6 +31,14 @@ std::string num(double v) {
   return b;
 }
 std::string vec(const Vec3& v) { return "<" + num(v[0]) + ", " + num(v[1]) + ", " + num(v[2]) + ">"; }
+
+// The POV name of a tridiscsphere's mesh2 (one per distinct size).
+std::string tridiscsphereName(const Piece& p) {
+  const uint64_t h = minkowski::DiscSumField({0, 0, 0}, p.discs, p.ball).contentHash();
+  char b[48];
+  std::snprintf(b, sizeof b, "frep_tridiscsphere_%016llx", static_cast<unsigned long long>(h));
+  return b;
+}
 
 std::string pieceText(const Piece& p, double thin) {
   switch (p.kind) {
@@ -71,9 +84,31 @@ std::string pieceText(const Piece& p, double thin) {
         for (int c = 0; c < 3; ++c) t += (c == rows[r] ? "1" : "0") + std::string(", ");
       return t + "0, 0, 0> translate " + vec(p.base) + " }";
     }
-    case PieceKind::Bidisc: break;  // expanded by minkowski::primitives()
+    case PieceKind::Tridiscsphere: return "object { " + tridiscsphereName(p) + " translate " + vec(p.base) + " }";
+    case PieceKind::Bidisc:
+    case PieceKind::DiscSum: break;  // expanded by minkowski::primitives()
   }
   return "";
+}
+
+// A tridiscsphere (discs on three axes and/or a ball, the hull of Theorem 5's R12–R16 surfaces,
+// whose equations the paper does not give) has no POV primitive: it is declared once as a mesh2,
+// polygonised from its exact field (disc_sum_distance.h) by frep's mesher with 40 voxels across
+// (vertices on the surface by root finding; the flat disc faces and their rims to within a voxel).
+constexpr int kTridiscsphereVoxels = 40;
+
+std::string tridiscsphereDeclaration(const Piece& p) {
+  Vec3 ext;
+  for (int i = 0; i < 3; ++i) ext[i] = p.discs[0] + p.discs[1] + p.discs[2] - p.discs[i] + p.ball;
+  const double margin = 2.0 * std::max({ext[0], ext[1], ext[2]}) / kTridiscsphereVoxels;
+  const auto field = std::make_shared<minkowski::DiscSumField>(Vec3{0, 0, 0}, p.discs, p.ball);
+  const TapePtr tape = Tape::compile(fieldExpr(field, Expr::x(0), Expr::x(1), Expr::x(2)), 3);
+  const GridSpec grid = GridSpec::fromBounds({-ext[0] - margin, -ext[1] - margin, -ext[2] - margin},
+                                             {ext[0] + margin, ext[1] + margin, ext[2] + margin},
+                                             kTridiscsphereVoxels + 4);
+  MeshOptions o;
+  o.threads = 1;
+  return povMesh2(meshGrid(tape, grid, o), tridiscsphereName(p));
 }
 
 // POV's matrix maps a point P to P·M + T (row vector): M's rows are R's columns.
@@ -226,8 +261,14 @@ std::string translateTerm(Cursor& c, double thin) {
 
 std::string povUnion(const Reduction& r, double thin) {
   const std::vector<Piece> prims = minkowski::primitives(r);
-  std::string s = "union { // " + r.sum.describe() + ": " + std::to_string(prims.size()) +
-                  " primitives (Roerdink-Minkowski)\n";
+  std::string s;
+  std::map<std::string, bool> declared;
+  for (const Piece& p : prims)
+    if (p.kind == PieceKind::Tridiscsphere && !declared[tridiscsphereName(p)]) {
+      declared[tridiscsphereName(p)] = true;
+      s += tridiscsphereDeclaration(p);
+    }
+  s += "union { // " + r.sum.describe() + ": " + std::to_string(prims.size()) + " primitives (Roerdink-Minkowski)\n";
   for (const Piece& p : prims) s += "  " + pieceText(p, thin) + "\n";
   return s + "  " + frameText(r.sum) + "\n}";
 }

@@ -28,6 +28,7 @@
 #include "frep/minkowski_algebra/reduction.h"
 
 #include "frep/minkowski_algebra/bidisc.h"
+#include "frep/minkowski_algebra/disc_sum_distance.h"
 
 #include <algorithm>
 #include <cmath>
@@ -47,6 +48,8 @@ int Piece::dimension() const {
     case PieceKind::Torus: return minor > 0 ? 3 : (radius > 0 ? 1 : 0);
     case PieceKind::Bidisc:
     case PieceKind::Bicircle: return radius > 0 && minor > 0 ? 3 : 0;
+    case PieceKind::DiscSum:
+    case PieceKind::Tridiscsphere: return 3;  // two disc radii > 0 at least (reduce())
   }
   return 0;
 }
@@ -68,13 +71,34 @@ bool samePiece(const Piece& a, const Piece& b) {
     if (!eq(a.lo[i], b.lo[i]) || !eq(a.hi[i], b.hi[i]) || !eq(a.base[i], b.base[i])) return false;
   if (a.kind != PieceKind::Block && a.kind != PieceKind::Sphere && a.axis != b.axis) return false;
   if ((a.kind == PieceKind::Bidisc || a.kind == PieceKind::Bicircle) && a.axis2 != b.axis2) return false;
-  return eq(a.radius, b.radius) && eq(a.length, b.length) && eq(a.minor, b.minor);
+  for (int i = 0; i < 3; ++i)
+    if (!eq(a.discs[i], b.discs[i])) return false;
+  return eq(a.radius, b.radius) && eq(a.length, b.length) && eq(a.minor, b.minor) && eq(a.ball, b.ball);
 }
 
 // ---- exact signed distances, for Expr and double alike ----
 template <class T>
 T sq(const T& a) {
   return a * a;
+}
+
+// The disc-sum pieces' signed distance: a geometry field node (Expr) or its value (double), at the
+// point relative to the block's corner (DiscSum) or the centre (Tridiscsphere).
+DiscSumField discSumField(const Piece& p) {
+  Vec3 len{0, 0, 0};
+  if (p.kind == PieceKind::DiscSum)
+    for (int i = 0; i < 3; ++i) len[i] = p.hi[i] - p.lo[i];
+  return DiscSumField(len, p.discs, p.ball);
+}
+const Vec3& discSumCorner(const Piece& p) { return p.kind == PieceKind::DiscSum ? p.lo : p.base; }
+double discSumSdf(const Piece& p, const double q[3]) {
+  const Vec3& c = discSumCorner(p);
+  const double x[3] = {q[0] - c[0], q[1] - c[1], q[2] - c[2]};
+  return -discSumField(p).value(x);
+}
+Expr discSumSdf(const Piece& p, const Expr q[3]) {
+  const Vec3& c = discSumCorner(p);
+  return -fieldExpr(std::make_shared<DiscSumField>(discSumField(p)), q[0] - c[0], q[1] - c[1], q[2] - c[2]);
 }
 
 template <class T>
@@ -123,6 +147,8 @@ T pieceSdf(const Piece& p, const T q[3]) {
       const T quad = x * x - y * y + z * z + T(c);
       return quad * quad - T(4.0) * z * z * (T(a * a) - y * y);
     }
+    case PieceKind::DiscSum:
+    case PieceKind::Tridiscsphere: return discSumSdf(p, q);
   }
   return zero;
 }
@@ -152,7 +178,9 @@ T pieceFarthest(const Piece& p, const T y[3]) {
       return sqrt(sq(y[0] - T(p.base[0])) + sq(y[1] - T(p.base[1])) + sq(y[2] - T(p.base[2]))) +
              T(p.radius);
     case PieceKind::Bidisc:
-    case PieceKind::Bicircle: break;  // no closed form; erosionExpr refuses these
+    case PieceKind::Bicircle:
+    case PieceKind::DiscSum:
+    case PieceKind::Tridiscsphere: break;  // no closed form; erosionExpr refuses these
   }
   return T(0.0);
 }
@@ -201,6 +229,16 @@ double pieceSupport(const Piece& p, const Vec3& m) {
       return h + p.radius * std::sqrt(std::max(0.0, 1.0 - m[p.axis] * m[p.axis])) +
              p.minor * std::sqrt(std::max(0.0, 1.0 - m[p.axis2] * m[p.axis2]));
     }
+    case PieceKind::DiscSum:
+    case PieceKind::Tridiscsphere: {
+      // h(block or centre) + h(discs) + ball (support of a sum = sum of supports).
+      double h = 0;
+      if (p.kind == PieceKind::DiscSum)
+        for (int i = 0; i < 3; ++i) h += std::max(m[i] * p.lo[i], m[i] * p.hi[i]);
+      else
+        h = m[0] * p.base[0] + m[1] * p.base[1] + m[2] * p.base[2];
+      return h + DiscSum{p.discs}.support(m) + p.ball;
+    }
   }
   return 0;
 }
@@ -222,6 +260,9 @@ std::string Piece::describe() const {
     case PieceKind::Bicircle:
       return std::string(1, kAxis[3 - axis - axis2]) + "bicircle " + num(radius) + ", " + num(minor) + " at " +
              vec(base);
+    case PieceKind::DiscSum:
+      return "block " + vec(lo) + " - " + vec(hi) + " + discs " + vec(discs) + " + ball " + num(ball);
+    case PieceKind::Tridiscsphere: return "tridiscsphere discs " + vec(discs) + ", ball " + num(ball) + " at " + vec(base);
   }
   return "?";
 }
@@ -313,16 +354,66 @@ std::vector<Piece> bidiscPrimitives(const Piece& bd) {
       }
   return keepLargest(all);
 }
+
+// Block [lo, hi] ⊕ C, C = discs ⊕ ball, as ray-tracer primitives. X is in the sum iff its excess
+// e over the block lies in C (C is convex and symmetric in the coordinate planes). Where e_k = 0
+// for some axis k, e lies in C's section by x_k = 0, which is the rectangle of half-widths
+// (r_j, r_i) along (i, j) (the discs normal to j and i cut there in segments) ⊕ the disc of
+// radius r_k + s: extruded over the block's k range that is 2 blocks and 4 k-cylinders of radius
+// r_k + s. Where every e_i > 0, X − (nearest corner) is in C: a tridiscsphere at each corner.
+// 6 blocks, 12 cylinders, 8 tridiscspheres (Appendix B's B* takes 3 + 24 + 8: see docs/pov.md).
+std::vector<Piece> discSumPrimitives(const Piece& ds) {
+  std::vector<Piece> all;
+  const Vec3& o = ds.lo;
+  Vec3 L;
+  for (int c = 0; c < 3; ++c) L[c] = ds.hi[c] - ds.lo[c];
+  const Vec3& r = ds.discs;
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    const double wi = r[j], wj = r[i], round = r[k] + ds.ball;
+    for (int b = 0; b < 2; ++b) {
+      Piece p;
+      p.kind = PieceKind::Block;
+      const double ei = wi + (b == 0 ? round : 0), ej = wj + (b == 1 ? round : 0);
+      p.lo[i] = o[i] - ei, p.hi[i] = o[i] + L[i] + ei;
+      p.lo[j] = o[j] - ej, p.hi[j] = o[j] + L[j] + ej;
+      p.lo[k] = o[k], p.hi[k] = o[k] + L[k];
+      all.push_back(p);
+    }
+    for (double a : {-wi, L[i] + wi})
+      for (double b : {-wj, L[j] + wj}) {
+        Piece p;
+        p.kind = PieceKind::Cylinder;
+        p.axis = k;
+        p.base[i] = o[i] + a, p.base[j] = o[j] + b, p.base[k] = o[k];
+        p.radius = round;
+        p.length = L[k];
+        all.push_back(p);
+      }
+  }
+  for (double x : {0.0, L[0]})
+    for (double y : {0.0, L[1]})
+      for (double z : {0.0, L[2]}) {
+        Piece p;
+        p.kind = PieceKind::Tridiscsphere;
+        p.base = {o[0] + x, o[1] + y, o[2] + z};
+        p.discs = ds.discs;
+        p.ball = ds.ball;
+        all.push_back(p);
+      }
+  return keepLargest(all);
+}
 }  // namespace
 
 std::vector<Piece> primitives(const Reduction& r) {
   std::vector<Piece> out;
   for (const Piece& p : r.pieces) {
-    if (p.kind != PieceKind::Bidisc) {
+    if (p.kind == PieceKind::Bidisc)
+      for (const Piece& q : bidiscPrimitives(p)) out.push_back(q);
+    else if (p.kind == PieceKind::DiscSum)
+      for (const Piece& q : discSumPrimitives(p)) out.push_back(q);
+    else
       out.push_back(p);
-      continue;
-    }
-    for (const Piece& q : bidiscPrimitives(p)) out.push_back(q);
   }
   return out;
 }
@@ -340,11 +431,14 @@ Reduction reduce(const Sum& sum) {
     return red;
   }
   if (sum.discAxes() == 3 || (sum.discAxes() == 2 && sum.ball > 0)) {
-    red.reason = sum.discAxes() == 3
-                     ? "discs along three axes (the tricircle surfaces, Theorem 5's R15-R16, have degree "
-                       "above 4 and no closed form)"
-                     : "a sphere with discs along two axes (the bicircle-sphere surface, Theorem 5's "
-                       "R12-R14, has degree above 4 and no closed form)";
+    // The bicircle-sphere / tricircle(-sphere) cases (R12–R16): one exact convex-projection piece.
+    Piece p;
+    p.kind = PieceKind::DiscSum;
+    p.hi = sum.lengths;
+    p.discs = sum.disc;
+    p.ball = sum.ball;
+    red.pieces.push_back(p);
+    red.ok = true;
     return red;
   }
   if (sum.discAxes() == 2) {
@@ -462,9 +556,9 @@ bool erosionExpr(const Sum& c0, const Reduction& r, const std::vector<Expr>& coo
   const bool isBlock = c0.discAxes() == 0 && c0.ball == 0;
   const bool isBall = c0.discAxes() == 0 && c0.lengths == Vec3{0, 0, 0};
   bool bidisc = false;
-  for (const Piece& p : r.pieces) bidisc = bidisc || p.kind == PieceKind::Bidisc;
+  for (const Piece& p : r.pieces) bidisc = bidisc || p.kind == PieceKind::Bidisc || p.kind == PieceKind::DiscSum;
   if (r.ok && isBall && c0.ball > 0 && bidisc) {
-    if (reason) *reason = "a sphere eroded by a bidisc sum (the farthest point has no closed form)";
+    if (reason) *reason = "a sphere eroded by a sum of discs on two or more axes (the farthest point has no closed form)";
     return false;
   }
   if (!r.ok || !(isBlock || isBall)) {

@@ -17,8 +17,8 @@
 // Its zero set is exact (error bound 0); the value is not the Euclidean distance.
 //
 // There is no closed form once a sphere or a third disc axis joins (the bicircle-sphere,
-// tricircle and tricircle-sphere surfaces R12–R16 have degree above four, §IV.E): such sums are
-// not reduced (the caller falls back to the certified search).
+// tricircle and tricircle-sphere surfaces R12–R16 have degree above four, §IV.E): such sums take
+// the convex-projection distance of disc_sum_distance.h.
 #pragma once
 
 #include <vector>

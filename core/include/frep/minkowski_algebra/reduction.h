@@ -1,14 +1,15 @@
 // The reduction of a secondary Minkowski object into a union of ray-tracer primitives
 // (Roerdink-Minkowski §III.D eq. 16, §IV.B, §IV.D, Theorem 5) and its exact F-rep.
 //
-// Implemented for sums whose circle part has at most one disc axis (after discs of one axis
-// are added): block ⊕ disc ⊕ sphere and all its degenerate cases (segments, rectangles,
-// blocks, discs, cylinders, discus, rounded blocks, ...), in any frame; and for two disc axes
-// without a sphere: block ⊕ bidisc (bidisc.h), one closed-form piece whose ray-tracer form is
-// bicircles, cylinders and blocks (primitives()). A sphere with two disc axes, or three disc
-// axes, needs the bicircle-sphere / tricircle(-sphere) surfaces (degree above 4, R12–R16), for
-// which no closed form exists; reduce() reports them as not reducible and the caller falls back
-// to the certified extremum search.
+// Sums whose circle part has at most one disc axis (after discs of one axis are added):
+// block ⊕ disc ⊕ sphere and all its degenerate cases (segments, rectangles, blocks, discs,
+// cylinders, discus, rounded blocks, ...), in any frame, reduce to closed-form primitives; two disc
+// axes without a sphere: block ⊕ bidisc (bidisc.h), one closed-form piece whose ray-tracer form is
+// bicircles, cylinders and blocks (primitives()). A sphere with two disc axes, or three disc axes
+// (the bicircle-sphere, tricircle and tricircle-sphere surfaces R12–R16, degree above 4, §IV.E):
+// one DiscSum piece, the exact distance of disc_sum_distance.h (convex projection by support
+// functions, no search); its ray-tracer form is 6 blocks, 12 cylinders and 8 tridiscspheres (the
+// convex hulls of the tricircle-spheres at the block's corners, Appendix B), see primitives().
 //
 // Grouping (§IV.D): the lines form one group (the block), the circles and the sphere another
 // (the core K = disc ⊕ ball), and the pieces are the offset by the ball of the faces, edges and
@@ -23,20 +24,25 @@
 
 namespace frep::minkowski {
 
-enum class PieceKind { Block, Cylinder, Sphere, Torus, Bidisc, Bicircle };
+enum class PieceKind { Block, Cylinder, Sphere, Torus, Bidisc, Bicircle, DiscSum, Tridiscsphere };
 
 // One ray-tracer primitive in the sum's local frame (see Sum): a block [lo, hi]; a cylinder
 // of radius `radius` around the segment from `base` along `axis` of length `length`; a
 // sphere (centre `base`, radius); a torus around `axis` through `base` (major radius `radius`,
 // minor `minor`); block [lo, hi] ⊕ bidisc (disc of radius `radius` normal to `axis`, disc of
 // radius `minor` normal to `axis2`; an F-rep piece, see bidisc.h); the bicircle solid of that
-// bidisc centred at `base` (a ray-tracer primitive only: a POV quartic).
+// bidisc centred at `base` (a ray-tracer primitive only: a POV quartic); block [lo, hi] ⊕
+// xdisc(discs[0]) ⊕ ydisc(discs[1]) ⊕ zdisc(discs[2]) ⊕ ball(ball) (DiscSum, an F-rep piece:
+// disc_sum_distance.h); the same discs and ball centred at `base` (Tridiscsphere, a ray-tracer
+// primitive: POV mesh2).
 struct Piece {
   PieceKind kind = PieceKind::Block;
   int axis = 0, axis2 = 1;
   Vec3 lo{0, 0, 0}, hi{0, 0, 0};
   Vec3 base{0, 0, 0};
   double radius = 0, length = 0, minor = 0;
+  Vec3 discs{0, 0, 0};
+  double ball = 0;
   int dimension() const;  // 0..3: a block of zero thickness, a cylinder of length 0, ...
   std::string describe() const;
 };
@@ -51,10 +57,11 @@ struct Reduction {
 
 Reduction reduce(const Sum& sum);
 
-// The ray-tracer primitives of the union (Theorem 5's R1–R11): the pieces with each Bidisc
+// The ray-tracer primitives of the union (Theorem 5's R1–R16): the pieces with each Bidisc
 // expanded into blocks, cylinders and bicircles (4 blocks, 16 cylinders and 8 bicircles for
-// block ⊕ bidisc; bicircle + 2 cylinders for a bidisc alone, §IV.B). Their count is the one the
-// job report and `frep pov` give.
+// block ⊕ bidisc; bicircle + 2 cylinders for a bidisc alone, §IV.B) and each DiscSum into blocks,
+// cylinders and tridiscspheres (6 blocks, 12 cylinders, 8 tridiscspheres for Appendix B's B*;
+// one tridiscsphere without a block). Their count is the one the job report and `frep pov` give.
 std::vector<Piece> primitives(const Reduction& r);
 // Whether a local point lies in one primitive (tests: the primitives' union is the sum).
 bool primitiveHolds(const Piece& p, const Vec3& local);

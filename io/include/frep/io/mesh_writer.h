@@ -33,6 +33,9 @@ MeshFormat meshFormatFromPath(const std::string& field, const std::string& path)
 // From a name (--format): ply, obj, stl, stl-ascii, pov, wrl, 3mf, glb. Throws like the above.
 MeshFormat meshFormatFromName(const std::string& field, const std::string& name);
 const char* meshFormatName(MeshFormat format);
+// `#declare name = mesh2 { ... }` of the mesh (the .inc/.pov format's text; frep pov's
+// tridiscsphere pieces).
+std::string povMesh2(const Mesh& mesh, const std::string& name);
 bool formatHoldsColours(MeshFormat format);
 // The up axis a format gets for UpAxis::Default: Y for .glb, Z for the others.
 UpAxis resolvedUpAxis(MeshFormat format, UpAxis up);
