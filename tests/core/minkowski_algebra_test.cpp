@@ -64,12 +64,15 @@ void worldBox(const Reduction& r, Vec3& lo, Vec3& hi) {
   }
 }
 
-Shape randomMember(std::mt19937& rng, int discAxis, const Mat3& rot) {
+// discAxis: −1 no discs, 0..2 discs on that axis only, kAnyAxis discs on random axes.
+constexpr int kAnyAxis = 3;
+Shape randomMember(std::mt19937& rng, int discAxis, const Mat3& rot, int kind = -1) {
   std::uniform_real_distribution<double> u(0, 1);
   Shape s;
   s.rot = rot;
   for (int i = 0; i < 3; ++i) s.pos[i] = 0.3 * (u(rng) - 0.5);
-  int kind = std::uniform_int_distribution<int>(0, discAxis >= 0 ? 4 : 3)(rng);
+  if (kind < 0) kind = std::uniform_int_distribution<int>(0, discAxis >= 0 ? 4 : 3)(rng);
+  if (discAxis == kAnyAxis) discAxis = std::uniform_int_distribution<int>(0, 2)(rng);
   if (kind < 3) {
     s.kind = ShapeKind::Segment;
     s.axis = kind;
@@ -88,19 +91,23 @@ Shape randomMember(std::mt19937& rng, int discAxis, const Mat3& rot) {
 // For random sums C1 ⊕ … ⊕ Ck (k = 2..6, random axes, sizes, placements and a common random
 // rotation), the exact union of the whole sum against the certified search of
 // (exact union of C1..C(k−1)) ⊕ Ck, Ck given by its independent formula: one 3D B&B per point.
+// Every third sum has discs on random axes, its first two on different axes, so the
+// bicircle-sphere, tricircle and tricircle-sphere cases (the convex-projection field) are drawn.
 TEST(MinkowskiAlgebra, RandomSumsAgreeInSignWithTheCertifiedSearch) {
   std::mt19937 rng(12345);
   std::uniform_real_distribution<double> u(0, 1);
   const double band = 0.03, tol = 4e-3;
-  int compared = 0, sums = 0;
+  int compared = 0, sums = 0, discSums = 0;
   PointEvaluator pe;
-  for (int trial = 0; trial < 60; ++trial) {
+  for (int trial = 0; trial < 75; ++trial) {
     const int k = 2 + trial % 5;
-    const int discAxis = std::uniform_int_distribution<int>(-1, 2)(rng);
+    const bool anyAxes = trial % 3 == 2;
+    const int discAxis = anyAxes ? kAnyAxis : std::uniform_int_distribution<int>(-1, 2)(rng);
     Mat3 rot = trial % 3 == 0 ? identityRotation()
                               : rotationXYZ(6.28 * u(rng), 6.28 * u(rng), 6.28 * u(rng));
     std::vector<Shape> m;
-    for (int i = 0; i < k; ++i) m.push_back(randomMember(rng, discAxis, rot));
+    for (int i = 0; i < k; ++i) m.push_back(randomMember(rng, discAxis, rot, anyAxes && i < 2 ? 4 : -1));
+    if (anyAxes) m[1].axis = (m[0].axis + 1 + trial % 2) % 3;
     Sum head, all;
     for (int i = 0; i < k; ++i) {
       ASSERT_TRUE(all.add(m[i]));
@@ -108,7 +115,8 @@ TEST(MinkowskiAlgebra, RandomSumsAgreeInSignWithTheCertifiedSearch) {
     }
     Reduction rAll = reduce(all), rHead = reduce(head);
     ASSERT_TRUE(rAll.ok && rHead.ok) << rAll.reason;
-    EXPECT_LE(rAll.pieces.size(), 35u);  // Theorem 5 / §IV.F
+    EXPECT_LE(primitives(rAll).size(), 35u);  // Theorem 5 / §IV.F
+    discSums += rAll.count(PieceKind::DiscSum);
     MinkowskiOptions opt;
     opt.tolerance = tol;
     Expr search = minkowskiSum(unionExpr(rHead), memberExpr(m.back()), 3, memberBox(m.back(), 0.1), opt);
@@ -131,7 +139,8 @@ TEST(MinkowskiAlgebra, RandomSumsAgreeInSignWithTheCertifiedSearch) {
     ++sums;
   }
   EXPECT_GE(compared, 10000);
-  EXPECT_EQ(sums, 60);
+  EXPECT_EQ(sums, 75);
+  EXPECT_GE(discSums, 10);  // bicircle-sphere / tricircle(-sphere) sums among them (12)
 }
 
 // The lower-dimensional members alone: minus the distance, 0 on the set.

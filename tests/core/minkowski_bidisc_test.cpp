@@ -295,21 +295,5 @@ TEST(MinkowskiBidisc, SupportFunctionForErosionIsTheBruteForceMax) {
   EXPECT_NE(why.find("bidisc"), std::string::npos);
 }
 
-// A sphere with two disc axes, or three disc axes: not reduced (no closed form), with the reason.
-TEST(MinkowskiBidisc, HigherSurfacesAreNotReduced) {
-  Sum bs;
-  bs.add(member(ShapeKind::Disc, 0, 0.5));
-  bs.add(member(ShapeKind::Disc, 1, 0.5));
-  bs.add(member(ShapeKind::Sphere, 0, 0.1));
-  EXPECT_FALSE(reduce(bs).ok);
-  EXPECT_NE(reduce(bs).reason.find("bicircle-sphere"), std::string::npos);
-  Sum tri;
-  tri.add(member(ShapeKind::Disc, 0, 0.5));
-  tri.add(member(ShapeKind::Disc, 1, 0.5));
-  tri.add(member(ShapeKind::Disc, 2, 0.5));
-  EXPECT_FALSE(reduce(tri).ok);
-  EXPECT_NE(reduce(tri).reason.find("tricircle"), std::string::npos);
-}
-
 }  // namespace
 }  // namespace frep::minkowski

@@ -62,8 +62,8 @@ TEST(FrMinkowskiAlgebra, OtherOperandsFallBackToTheSearch) {
                       "dx(x[3], a[1]) { dx = frXDisc(x, 0.5); }\n"
                       "my_model(x[3], a[1]) { my_model = frMinkowski(x, dsc, bal) | frMinkowski(x, dx, bal); }");
   EXPECT_FALSE(hasExtremum(b.field));
-  // Discs along two axes (a bidisc) are exact too; a sphere on top of them (a bicircle-sphere)
-  // has no closed form: the search runs.
+  // Discs along two axes (a bidisc) are exact too, and so are a sphere on top of them (a
+  // bicircle-sphere) and discs on three axes (tricircle-sphere): the convex-projection field.
   Model bi = compileOk(kParts +
                        "dx(x[3], a[1]) { dx = frXDisc(x, 0.5); }\n"
                        "my_model(x[3], a[1]) { my_model = frMinkowski(x, dsc, dx); }");
@@ -72,7 +72,25 @@ TEST(FrMinkowskiAlgebra, OtherOperandsFallBackToTheSearch) {
                        "dx(x[3], a[1]) { dx = frXDisc(x, 0.5); }\n"
                        "bd(x[3], a[1]) { bd = frMinkowski(x, dsc, dx); }\n"
                        "my_model(x[3], a[1]) { array o[2]; o = [0, 0.01]; my_model = frMinkowski(x, bd, bal, o); }");
-  EXPECT_TRUE(hasExtremum(bs.field));
+  EXPECT_FALSE(hasExtremum(bs.field));
+  // Over the flat faces: the xdisc face at x = 0.5 (the zdisc's reach) and the zdisc face at
+  // z = 0.5, each 0.25 further out by the ball.
+  EXPECT_NEAR(at(bs, {1.0, 0.1, 0.2}), -0.25, 1e-12);
+  EXPECT_NEAR(at(bs, {0.1, -0.2, 1.5}), -0.75, 1e-12);
+  EXPECT_NEAR(at(bs, {0, 0, 0}), 0.25 + 0.5, 1e-12);  // inside: ball + inradius (γ = 0)
+  Model tri = compileOk(kParts +
+                        "dx(x[3], a[1]) { dx = frXDisc(x, 0.5); }\n"
+                        "dy(x[3], a[1]) { dy = frYDisc(x, 0.3); }\n"
+                        "blk(x[3], a[1]) { blk = frBlock(x, 2, 1, 1); }\n"
+                        "my_model(x[3], a[1]) { my_model = frMinkowskiSum(x, blk, dsc, dx, dy, bal); }");
+  EXPECT_FALSE(hasExtremum(tri.field));
+  auto lines = minkowski::describeExact(tri.field);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("error bound 0"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[0].find("26 primitives"), std::string::npos) << lines[0];
+  // Beyond the block along x: the x face is the block's face ⊕ the xdisc (0.5) at 2 + 0.5 + 0.3.
+  EXPECT_NEAR(at(tri, {2 + 0.8 + 0.25 + 0.4, 0.5, 0.5}), -0.4, 1e-12);
+  EXPECT_NEAR(at(tri, {1, 0.5, 0.5}), 0.25 + 0.8, 1e-12);  // in the block: ball + inradius min(0.8, 1, 0.8)
 }
 
 TEST(FrMinkowskiAlgebra, SubtractionChainsAreExact) {

@@ -558,7 +558,7 @@ bool erosionExpr(const Sum& c0, const Reduction& r, const std::vector<Expr>& coo
   bool bidisc = false;
   for (const Piece& p : r.pieces) bidisc = bidisc || p.kind == PieceKind::Bidisc || p.kind == PieceKind::DiscSum;
   if (r.ok && isBall && c0.ball > 0 && bidisc) {
-    if (reason) *reason = "a sphere eroded by a sum of discs on two or more axes (the farthest point has no closed form)";
+    if (reason) *reason = "a sphere eroded by a bidisc or tridisc sum (the farthest point has no closed form)";
     return false;
   }
   if (!r.ok || !(isBlock || isBall)) {
