@@ -1,18 +1,22 @@
-// Roerdink's exact Minkowski algebra against the certified extremum search (issue 12): the
-// 4-term sum xline(1.6) ⊕ yline(1.0) ⊕ zdisc(0.4) ⊕ sphere(0.25), in a rotated frame, sampled
-// with frep::sample on one thread at 256³ over [-1.5, 1.5]³.
-//   exact:  the union of the reduction's 28 primitives (no search, error bound 0);
-//   search: the cheapest search form of the same solid, ONE 3D branch-and-bound per voxel:
-//           (exact union of xline ⊕ yline ⊕ zdisc) ⊕ sphere, gap 1e-3 (the fold that
-//           frMinkowskiSum would run without the algebra nests three searches: one point of it
-//           took 233 CPU s in a trial run, so it is not measured). The search is run on the
+// Roerdink's exact Minkowski algebra against the certified extremum search (issue 12): a 4-term
+// sum in a rotated frame, sampled with frep::sample on one thread at 256³ over [-1.5, 1.5]³.
+//   default:   xline(1.6) ⊕ yline(1.0) ⊕ zdisc(0.4) ⊕ sphere(0.25) (one disc axis: one closed form,
+//              the discus distance at the excess over the block);
+//   --bidisc:  xline ⊕ yline ⊕ zdisc(0.4) ⊕ xdisc(0.25) (two disc axes: the bidisc gauge);
+//   --discs:   xline(1.6) ⊕ zdisc(0.4) ⊕ xdisc(0.25) ⊕ sphere(0.15) (two disc axes and a sphere, the
+//              bicircle-sphere R12: the convex-projection field of disc_sum_distance.h).
+//   exact:  unionExpr of the reduction (no search, error bound 0);
+//   search: the cheapest search form of the same solid, ONE 3D branch-and-bound per voxel: (exact
+//           field of the first three terms) ⊕ (the fourth by its own formula), gap 1e-3 (the fold
+//           that frMinkowskiSum would run without the algebra nests three searches: one point of it
+//           took 233 CPU s in a trial run, so it is not measured). In the default mode the first
+//           three terms are given two ways: as the union of their ray-tracer pieces (max of 6
+//           SDFs, the head of earlier runs) and as the one closed form. The search is run on the
 //           pencil y, z ∈ [res/2, res/2 + 8) (all x), where its interval bounds cannot prune and
 //           it samples every voxel; the whole grid is extrapolated as its CPU time per sampled
 //           voxel × the voxels the EXACT run samples (the narrow band): a lower bound for the
 //           search, which prunes no better than the exact field. --full-search runs it all.
-// --bidisc: the fourth term is xdisc(0.25) instead of the sphere (discs on two axes: the
-// closed-form bidisc gauge, bidisc.h); the search adds that disc to the same one-axis union.
-// CPU seconds of this process (bench_timing.h); the ratio uses the same run's figures.
+// CPU seconds of this process (bench_timing.h); the ratios use the same run's figures.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -60,31 +64,32 @@ Run runSample(const Expr& f, const GridSpec& g, int zlo, int zhi) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool fullSearch = false, bidisc = false;
+  bool fullSearch = false, bidisc = false, discs = false;
   int res = 256;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--full-search")) fullSearch = true;
     if (!std::strcmp(argv[i], "--bidisc")) bidisc = true;
+    if (!std::strcmp(argv[i], "--discs")) discs = true;
     if (!std::strcmp(argv[i], "--res") && i + 1 < argc) res = std::atoi(argv[++i]);
   }
   const Mat3 rot = rotationXYZ(0.3, -0.2, 0.5);
   Sum head, all;
-  for (const Shape& s : {member(ShapeKind::Segment, 0, 1.6, rot), member(ShapeKind::Segment, 1, 1.0, rot),
-                         member(ShapeKind::Disc, 2, 0.4, rot)})
-    head.add(s);
+  std::vector<Shape> first = {member(ShapeKind::Segment, 0, 1.6, rot), member(ShapeKind::Segment, 1, 1.0, rot),
+                              member(ShapeKind::Disc, 2, 0.4, rot)};
+  if (discs) first[1] = member(ShapeKind::Disc, 0, 0.25, rot);
+  for (const Shape& s : first) head.add(s);
   all = head;
-  all.add(bidisc ? member(ShapeKind::Disc, 0, 0.25, rot) : member(ShapeKind::Sphere, 0, 0.25, rot));
-  for (Sum* s : {&head, &all})
-    for (int i = 0; i < 3; ++i) s->offset[i] = 0;
+  const double ballRadius = discs ? 0.15 : 0.25;
+  all.add(bidisc ? member(ShapeKind::Disc, 0, 0.25, rot) : member(ShapeKind::Sphere, 0, ballRadius, rot));
   // Centre the solid: move the local origin to -R·(L/2).
-  Vec3 half{-0.8, -0.5, 0};
+  Vec3 half{-0.8, discs ? 0.0 : -0.5, 0};
   for (int i = 0; i < 3; ++i) {
     double w = rot[i * 3] * half[0] + rot[i * 3 + 1] * half[1] + rot[i * 3 + 2] * half[2];
     head.offset[i] = all.offset[i] = w;
   }
   Reduction rAll = reduce(all), rHead = reduce(head);
   Expr exact = unionExpr(rAll);
-  Expr ball = 0.25 - sqrt(square(Expr::x(0)) + square(Expr::x(1)) + square(Expr::x(2)));
+  Expr ball = ballRadius - sqrt(square(Expr::x(0)) + square(Expr::x(1)) + square(Expr::x(2)));
   if (bidisc) {  // minus the distance to xdisc(0.25) in the rotated frame
     const Expr h = Expr::x(0) * rot[0] + Expr::x(1) * rot[3] + Expr::x(2) * rot[6];
     const Expr rho = sqrt(square(Expr::x(0) - h * rot[0]) + square(Expr::x(1) - h * rot[3]) +
@@ -93,7 +98,16 @@ int main(int argc, char** argv) {
   }
   MinkowskiOptions mo;
   mo.tolerance = 1e-3;
-  Expr search = minkowskiSum(unionExpr(rHead), ball, 3, Bounds{{-0.3, -0.3, -0.3}, {0.3, 0.3, 0.3}}, mo);
+  const Bounds box{{-0.3, -0.3, -0.3}, {0.3, 0.3, 0.3}};
+  const std::vector<Expr> xyz{Expr::x(0), Expr::x(1), Expr::x(2)};
+  struct Baseline {
+    const char* name;
+    Expr field;
+  };
+  std::vector<Baseline> searches = {{"search (head: one closed form / gauge)", minkowskiSum(unionExpr(rHead), ball, 3, box, mo)}};
+  if (!bidisc && !discs)
+    searches.insert(searches.begin(), {"search (head: union of its 6 pieces)",
+                                       minkowskiSum(piecesUnionExpr(rHead, xyz), ball, 3, box, mo)});
   std::printf("sum: %s, %zu primitives\n", all.describe().c_str(), primitives(rAll).size());
 
   GridSpec g = GridSpec::fromBounds({-1.5, -1.5, -1.5}, {1.5, 1.5, 1.5}, res);
@@ -102,20 +116,24 @@ int main(int argc, char** argv) {
               (unsigned long long)ex.voxels, 1e9 * ex.seconds / double(ex.voxels));
   const int zlo = (res / 2) / 8 * 8, zhi = zlo + 8;
   Run exSlab = runSample(exact, g, zlo, zhi);
-  Run se = fullSearch ? runSample(search, g, -1, -1) : runSample(search, g, zlo, zhi);
-  double searchFull = fullSearch ? se.seconds : se.seconds / double(se.voxels) * double(ex.voxels);
   std::printf("exact  pencil: %.4f CPU s on %llu voxels\n", exSlab.seconds, (unsigned long long)exSlab.voxels);
-  std::printf("search %d^3%s: %.3f CPU s on %llu voxels%s\n", res,
-              fullSearch ? "" : (" pencil y, z in [" + std::to_string(zlo) + ", " + std::to_string(zhi) + ")").c_str(),
-              se.seconds, (unsigned long long)se.voxels,
-              fullSearch ? "" : (" (" + std::to_string(1e6 * se.seconds / double(se.voxels)) + " us each); x the exact run's " +
-                                std::to_string(ex.voxels) + " band voxels: " + std::to_string(searchFull) + " CPU s").c_str());
-  std::printf("ratio search / exact: %.0fx (error bound: exact 0, search %.0e)\n", searchFull / ex.seconds, mo.tolerance);
+  for (const Baseline& b : searches) {
+    Run se = fullSearch ? runSample(b.field, g, -1, -1) : runSample(b.field, g, zlo, zhi);
+    double searchFull = fullSearch ? se.seconds : se.seconds / double(se.voxels) * double(ex.voxels);
+    std::printf("%s %d^3%s: %.3f CPU s on %llu voxels", b.name, res,
+                fullSearch ? "" : (" pencil y, z in [" + std::to_string(zlo) + ", " + std::to_string(zhi) + ")").c_str(),
+                se.seconds, (unsigned long long)se.voxels);
+    if (!fullSearch)
+      std::printf(" (%.2f us each); x the exact run's %llu band voxels: %.3f CPU s", 1e6 * se.seconds / double(se.voxels),
+                  (unsigned long long)ex.voxels, searchFull);
+    std::printf("\n  ratio search / exact: %.0fx (error bound: exact 0, search %.0e)\n", searchFull / ex.seconds,
+                mo.tolerance);
+  }
 
-  // Sign agreement at random points away from the search's gap, and the nested fold's cost.
+  // Sign agreement at random points away from the search's gap.
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.5, 1.5);
-  TapePtr te = Tape::compile(exact, 3), ts = Tape::compile(search, 3);
+  TapePtr te = Tape::compile(exact, 3), ts = Tape::compile(searches.back().field, 3);
   PointEvaluator pe;
   int compared = 0, disagree = 0;
   for (int i = 0; i < 4000; ++i) {

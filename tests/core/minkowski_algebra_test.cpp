@@ -143,6 +143,39 @@ TEST(MinkowskiAlgebra, RandomSumsAgreeInSignWithTheCertifiedSearch) {
   EXPECT_GE(discSums, 10);  // bicircle-sphere / tricircle(-sphere) sums among them (12)
 }
 
+// With a sphere and at most one disc axis the sum's field is one closed form (the discus distance at the
+// excess over the block); it equals the union of the ray-tracer pieces' SDFs outside (both are
+// the exact distance) and has its sign everywhere.
+TEST(MinkowskiAlgebra, ClosedFormIsThePiecesUnion) {
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> u(0, 1);
+  PointEvaluator pe;
+  int outside = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const int discAxis = std::uniform_int_distribution<int>(-1, 2)(rng);
+    const Mat3 rot = rotationXYZ(6.28 * u(rng), 6.28 * u(rng), 6.28 * u(rng));
+    Sum sum;
+    for (int i = 0; i < 2 + trial % 4; ++i) ASSERT_TRUE(sum.add(randomMember(rng, discAxis, rot)));
+    const Reduction r = reduce(sum);
+    TapePtr closed = Tape::compile(unionExpr(r), 3),
+            pieces = Tape::compile(piecesUnionExpr(r, {Expr::x(0), Expr::x(1), Expr::x(2)}), 3);
+    Vec3 lo, hi;
+    worldBox(r, lo, hi);
+    for (int t = 0; t < 300; ++t) {
+      double p[3];
+      for (int i = 0; i < 3; ++i) p[i] = lo[i] - 0.2 + (hi[i] - lo[i] + 0.4) * u(rng);
+      const double a = pe.eval(*closed, p), b = pe.eval(*pieces, p);
+      if (std::fabs(b) < 1e-9) continue;
+      ASSERT_EQ(a > 0, b > 0) << sum.describe() << " at " << p[0] << " " << p[1] << " " << p[2] << ": " << a << " vs " << b;
+      if (b < 0) {
+        ASSERT_NEAR(a, b, 1e-12) << sum.describe();
+        ++outside;
+      }
+    }
+  }
+  EXPECT_GT(outside, 5000);
+}
+
 // The lower-dimensional members alone: minus the distance, 0 on the set.
 TEST(MinkowskiAlgebra, MembersAloneAreMinusTheirDistance) {
   std::mt19937 rng(7);

@@ -517,7 +517,46 @@ Reduction reduce(const Sum& sum) {
   return red;
 }
 
+namespace {
+// A sum with a sphere and at most one disc axis as one closed form: its signed distance is the
+// discus C = disc(r) ⊕ ball(s)'s at the excess e of the local point over the block (C is convex
+// and symmetric in the coordinate planes, so the block's nearest point is the clamp),
+// |(max(|e_⊥| − r, 0), e_axis)| − s: exact outside, 1-Lipschitz, and > 0 exactly inside because C
+// has an interior (without the sphere it has none, and the pieces' union gives the inside).
+template <class T>
+T discusSdf(const Sum& sum, const T q[3]) {
+  using std::abs;
+  using std::max;
+  using std::sqrt;
+  const T zero(0.0);
+  T e[3];
+  for (int i = 0; i < 3; ++i) {
+    const double h = 0.5 * sum.lengths[i];
+    e[i] = h > 0 ? max(abs(q[i] - T(h)) - T(h), zero) : abs(q[i]);
+  }
+  int d = -1;
+  for (int i = 0; i < 3; ++i)
+    if (sum.disc[i] > 0) d = i;
+  T dist;
+  if (d < 0) {
+    dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+  } else {
+    const T across = max(sqrt(e[(d + 1) % 3] * e[(d + 1) % 3] + e[(d + 2) % 3] * e[(d + 2) % 3]) - T(sum.disc[d]), zero);
+    dist = sqrt(across * across + e[d] * e[d]);
+  }
+  return dist - T(sum.ball);
+}
+}  // namespace
+
 Expr unionExpr(const Reduction& r, const std::vector<Expr>& coords) {
+  const Expr x[3] = {coords[0], coords[1], coords[2]};
+  Expr q[3];
+  toLocal(r.sum, x, q);
+  if (r.sum.discAxes() <= 1 && r.sum.ball > 0) return -discusSdf(r.sum, q);
+  return piecesUnionExpr(r, coords);
+}
+
+Expr piecesUnionExpr(const Reduction& r, const std::vector<Expr>& coords) {
   const Expr x[3] = {coords[0], coords[1], coords[2]};
   Expr q[3];
   toLocal(r.sum, x, q);
@@ -537,6 +576,7 @@ double unionValue(const Reduction& r, const Vec3& world) {
   const double x[3] = {world[0], world[1], world[2]};
   double q[3];
   toLocal(r.sum, x, q);
+  if (r.sum.discAxes() <= 1 && r.sum.ball > 0) return -discusSdf(r.sum, q);
   double f = -INFINITY;
   for (const Piece& p : r.pieces) f = std::max(f, -pieceSdf(p, q));
   return f;

@@ -66,13 +66,17 @@ std::vector<Piece> primitives(const Reduction& r);
 // Whether a local point lies in one primitive (tests: the primitives' union is the sum).
 bool primitiveHolds(const Piece& p, const Vec3& local);
 
-// F-rep of the union (inside >= 0): max over the pieces of minus their exact signed distance,
-// read at the local point R^T (X − offset) of the world coordinates x0, x1, x2. Each piece is
-// an exact SDF, so the union is exact outside and 1-Lipschitz and sign-exact inside. Solids of
-// empty interior (a segment, a disc, a rectangle) come out as minus the distance: 0 on the
-// set, negative elsewhere.
+// F-rep of the sum (inside >= 0), read at the local point R^T (X − offset) of the world
+// coordinates x0, x1, x2: exact outside, 1-Lipschitz and sign-exact inside, error bound 0. Solids
+// of empty interior (a segment, a disc, a rectangle) come out as minus the distance: 0 on the
+// set, negative elsewhere. One closed form for a sphere and at most one disc axis (the discus's
+// distance at the excess over the block), else the pieces' union (piecesUnionExpr: the bidisc gauge, or the
+// DiscSum piece's convex-projection field).
 Expr unionExpr(const Reduction& r);
 Expr unionExpr(const Reduction& r, const std::vector<Expr>& coords);
+// Max over the pieces of minus their signed distance (the union of eq. 16 as an F-rep; the same
+// set and, outside, the same values as unionExpr).
+Expr piecesUnionExpr(const Reduction& r, const std::vector<Expr>& coords);
 // The same value evaluated directly (tests, the POV writer's checks).
 double unionValue(const Reduction& r, const Vec3& world);
 
