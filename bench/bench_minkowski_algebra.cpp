@@ -16,11 +16,14 @@
 //           it samples every voxel; the whole grid is extrapolated as its CPU time per sampled
 //           voxel × the voxels the EXACT run samples (the narrow band): a lower bound for the
 //           search, which prunes no better than the exact field. --full-search runs it all.
-// CPU seconds of this process (bench_timing.h); the ratios use the same run's figures.
+// CPU seconds of this process (bench_timing.h), medians of 5 interleaved runs; the ratios use
+// the same run's figures.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <random>
+#include <vector>
 
 #include "bench_timing.h"
 #include "frep/evaluators/eval.h"
@@ -111,21 +114,39 @@ int main(int argc, char** argv) {
   std::printf("sum: %s, %zu primitives\n", all.describe().c_str(), primitives(rAll).size());
 
   GridSpec g = GridSpec::fromBounds({-1.5, -1.5, -1.5}, {1.5, 1.5, 1.5}, res);
-  Run ex = runSample(exact, g, -1, -1);
-  std::printf("exact  %d^3: %.3f CPU s, %llu sampled voxels (%.1f ns each)\n", res, ex.seconds,
-              (unsigned long long)ex.voxels, 1e9 * ex.seconds / double(ex.voxels));
   const int zlo = (res / 2) / 8 * 8, zhi = zlo + 8;
-  Run exSlab = runSample(exact, g, zlo, zhi);
+  // Each figure is the median of 5 runs, the exact and the search runs interleaved (the machine
+  // is shared: CPU time per run moves with the load).
+  const int reps = fullSearch ? 1 : 5;
+  std::vector<std::vector<double>> times(1 + searches.size());
+  Run ex, exSlab;
+  std::vector<Run> se(searches.size());
+  for (int rep = 0; rep < reps; ++rep) {
+    ex = runSample(exact, g, -1, -1);
+    times[0].push_back(ex.seconds);
+    for (size_t b = 0; b < searches.size(); ++b) {
+      se[b] = fullSearch ? runSample(searches[b].field, g, -1, -1) : runSample(searches[b].field, g, zlo, zhi);
+      times[1 + b].push_back(se[b].seconds);
+    }
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  ex.seconds = median(times[0]);
+  exSlab = runSample(exact, g, zlo, zhi);
+  std::printf("exact  %d^3: %.3f CPU s (median of %d), %llu sampled voxels (%.1f ns each)\n", res, ex.seconds, reps,
+              (unsigned long long)ex.voxels, 1e9 * ex.seconds / double(ex.voxels));
   std::printf("exact  pencil: %.4f CPU s on %llu voxels\n", exSlab.seconds, (unsigned long long)exSlab.voxels);
-  for (const Baseline& b : searches) {
-    Run se = fullSearch ? runSample(b.field, g, -1, -1) : runSample(b.field, g, zlo, zhi);
-    double searchFull = fullSearch ? se.seconds : se.seconds / double(se.voxels) * double(ex.voxels);
-    std::printf("%s %d^3%s: %.3f CPU s on %llu voxels", b.name, res,
+  for (size_t b = 0; b < searches.size(); ++b) {
+    se[b].seconds = median(times[1 + b]);
+    const double searchFull = fullSearch ? se[b].seconds : se[b].seconds / double(se[b].voxels) * double(ex.voxels);
+    std::printf("%s %d^3%s: %.3f CPU s on %llu voxels", searches[b].name, res,
                 fullSearch ? "" : (" pencil y, z in [" + std::to_string(zlo) + ", " + std::to_string(zhi) + ")").c_str(),
-                se.seconds, (unsigned long long)se.voxels);
+                se[b].seconds, (unsigned long long)se[b].voxels);
     if (!fullSearch)
-      std::printf(" (%.2f us each); x the exact run's %llu band voxels: %.3f CPU s", 1e6 * se.seconds / double(se.voxels),
-                  (unsigned long long)ex.voxels, searchFull);
+      std::printf(" (%.2f us each); x the exact run's %llu band voxels: %.3f CPU s",
+                  1e6 * se[b].seconds / double(se[b].voxels), (unsigned long long)ex.voxels, searchFull);
     std::printf("\n  ratio search / exact: %.0fx (error bound: exact 0, search %.0e)\n", searchFull / ex.seconds,
                 mo.tolerance);
   }

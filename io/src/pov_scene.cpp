@@ -103,7 +103,10 @@ std::string tridiscsphereDeclaration(const Piece& p) {
   const double margin = 2.0 * std::max({ext[0], ext[1], ext[2]}) / kTridiscsphereVoxels;
   const auto field = std::make_shared<minkowski::DiscSumField>(Vec3{0, 0, 0}, p.discs, p.ball);
   const TapePtr tape = Tape::compile(fieldExpr(field, Expr::x(0), Expr::x(1), Expr::x(2)), 3);
-  const GridSpec grid = GridSpec::fromBounds({-ext[0] - margin, -ext[1] - margin, -ext[2] - margin},
+  // The lower corner is shifted by a fraction of a voxel so that no grid plane lies on a flat
+  // disc face (grid points on the surface make slivers along the face's rim).
+  const double shift = 0.3183 * margin;
+  const GridSpec grid = GridSpec::fromBounds({-ext[0] - margin - shift, -ext[1] - margin - shift, -ext[2] - margin - shift},
                                              {ext[0] + margin, ext[1] + margin, ext[2] + margin},
                                              kTridiscsphereVoxels + 4);
   MeshOptions o;
