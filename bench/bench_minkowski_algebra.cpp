@@ -16,7 +16,7 @@
 //           it samples every voxel; the whole grid is extrapolated as its CPU time per sampled
 //           voxel × the voxels the EXACT run samples (the narrow band): a lower bound for the
 //           search, which prunes no better than the exact field. --full-search runs it all.
-// CPU seconds of this process (bench_timing.h), medians of 5 interleaved runs; the ratios use
+// CPU seconds of this process (bench_timing.h), medians of 3 interleaved runs; the ratios use
 // the same run's figures.
 #include <algorithm>
 #include <cmath>
@@ -115,9 +115,9 @@ int main(int argc, char** argv) {
 
   GridSpec g = GridSpec::fromBounds({-1.5, -1.5, -1.5}, {1.5, 1.5, 1.5}, res);
   const int zlo = (res / 2) / 8 * 8, zhi = zlo + 8;
-  // Each figure is the median of 5 runs, the exact and the search runs interleaved (the machine
+  // Each figure is the median of 3 runs, the exact and the search runs interleaved (the machine
   // is shared: CPU time per run moves with the load).
-  const int reps = fullSearch ? 1 : 5;
+  const int reps = fullSearch ? 1 : 3;
   std::vector<std::vector<double>> times(1 + searches.size());
   Run ex, exSlab;
   std::vector<Run> se(searches.size());
