@@ -7,11 +7,12 @@
 // {X : e(X) ∈ C}, e the excess of X over the block per axis and C = D ⊕ ball(s), D = the disc sum
 // (C is symmetric in every coordinate plane; reduction.h). With q = e(X) >= 0:
 //   outside D: dist(q, D) = max over unit n of n·q − h(n), h(n) = a|n_yz| + b|n_xz| + c|n_xy| the
-//     support of D (support of a sum = sum of supports). It is found as the maximiser of the
-//     strongly concave dual of the projection, w·q − |w|²/2 − h(w) (damped Newton), and certified
-//     by the duality gap: every unit n gives the lower bound n·q − h(n), and its support point
-//     y(n) ∈ D the upper bound |q − y(n)|; they meet to rounding at the optimum. q over a flat
-//     face (the disc at x = b + c, ...) is answered in closed form;
+//     support of D (support of a sum = sum of supports). Where that is positive, every local
+//     maximum on the sphere is the global one, found by damped Newton in polar coordinates around
+//     the nearest axis (h's cone points are there), and certified by the duality gap: every unit
+//     n gives the lower bound n·q − h(n), and its support point y(n) ∈ D the upper bound
+//     |q − y(n)|; they meet to rounding at the optimum. q over a flat face (the disc at
+//     x = b + c, ...) is answered in closed form;
 //   inside D: r·(1 − γ(q)), γ the gauge of D (γ = max over n of n·q / h(n), by Dinkelbach's
 //     iteration on the same projection) and r = min h = min(a + b, a + c, b + c) (h restricted to
 //     the sphere is concave in the squares of n's components, so its minimum is at an axis); it is
