@@ -16,6 +16,11 @@
 #include <thread>
 #include <zmq.hpp>
 
+#include <malloc.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#include <tbb/task_arena.h>
+
 #include "brick.h"
 #include "curve.h"
 #include "frep/meshing/mesh_merge.h"
@@ -62,6 +67,10 @@ constexpr size_t kMaxBanned = 1024;     // banned routing ids remembered (oldest
 constexpr size_t kMaxPeers = 4096;      // welcomed workers at once; a hello beyond is refused
 constexpr size_t kMaxAliases = 4096;    // routing ids of workers that reconnected
 constexpr int kRouterRcvHwm = 64;       // queued messages per connection (ZMQ_RCVHWM)
+// Results received in a row are verified and decoded together on the decode threads; a batch
+// ends at a message of another kind, at the end of a turn's drain, or at these bounds.
+constexpr size_t kMaxArrivals = 64;
+constexpr size_t kMaxArrivalBytes = 64 << 20;
 
 enum class Departure { Left, Dead, Dropped };
 
@@ -87,6 +96,18 @@ struct Brick {
   size_t maxLeaves = 0;  // upper bound on leaves in the region (payload sanity check)
 };
 
+// A result from its brick's holder, waiting to be verified (CRC, codec, inside the brick) and
+// decoded off the scheduling loop (Master::verifyArrivals).
+struct Arrival {
+  uint64_t brick = 0;
+  std::string routingId, workerId;
+  Result result;
+  zmq::message_t payload;
+  BrickOutput out;
+  std::string error;
+  bool ok = false;
+};
+
 struct Peer {
   std::string workerId;
   uint32_t threads = 1;
@@ -101,7 +122,12 @@ struct Peer {
 class Master {
  public:
   Master(const JobSpec& job, const FarmOptions& opt)
-      : job_(job), opt_(opt), jobId_(jobIdOf(job)), grid_(gridOf(job)), op_(operationOf(job)) {
+      : job_(job),
+        opt_(opt),
+        jobId_(jobIdOf(job)),
+        grid_(gridOf(job)),
+        op_(operationOf(job)),
+        decoders_(opt.decodeThreads > 0 ? opt.decodeThreads : tbb::task_arena::automatic) {
     if (opt.brickVoxels < 8 || opt.brickVoxels % 8 != 0)
       throw std::invalid_argument("--brick must be a positive multiple of 8 voxels");
     if (op_ == Operation::Render && opt.brickVoxels % kRenderTile != 0)  // castRegion's regions
@@ -300,8 +326,11 @@ class Master {
         Incoming in;
         std::string err;
         if (!receive(router, true, in, &err, frameLimit)) break;
+        // Only results in a row share a batch: anything else sees the state they leave.
+        if (!err.empty() || in.envelope.body_case() != Envelope::kResult) verifyArrivals(router);
         handle(router, in, err);
       }
+      verifyArrivals(router);
       auto now = Clock::now();
       // The master's own stall (SIGSTOP, swapping, a slow disk): a turn is at most a poll
       // (a quarter beat) and a bounded drain, so a gap longer than the liveness window means
@@ -550,22 +579,66 @@ class Master {
       ++report_.duplicates;
       return;
     }
-    const auto& payload = *in.payload;
-    BrickOutput out;
-    std::string err;
-    bool ok = crc32Of(payload.data(), payload.size()) == r.payload_crc32() &&
-              decodePayload(op_, payload.data(), payload.size(), out, &err) && insideBrick(out, b);
-    if (!ok) {
+    // Verified and decoded with the results that arrived with it (verifyArrivals).
+    Arrival a;
+    a.brick = id;
+    a.routingId = in.routingId;
+    a.workerId = p.workerId;
+    a.result = std::move(*in.envelope.mutable_result());
+    a.payload = std::move(*in.payload);
+    arrivalBytes_ += a.payload.size();
+    arrivals_.push_back(std::move(a));
+    if (arrivals_.size() >= kMaxArrivals || arrivalBytes_ >= kMaxArrivalBytes) verifyArrivals(router);
+  }
+
+  // The results received in a row: CRC, codec and bounds checked, decoded and journaled in
+  // parallel on the decode threads (pure functions of each payload and its brick), then judged
+  // one by one in the order they arrived, as if each had been decoded on arrival; the merged
+  // output does not depend on that order anyway (outputs_ by brick, sorted in finish).
+  void verifyArrivals(zmq::socket_t& router) {
+    if (arrivals_.empty()) return;
+    decoders_.execute([&] {
+      tbb::parallel_for(size_t(0), arrivals_.size(), [&](size_t i) {
+        Arrival& a = arrivals_[i];
+        const void* data = a.payload.data();
+        a.ok = crc32Of(data, a.payload.size()) == a.result.payload_crc32() &&
+               decodePayload(op_, data, a.payload.size(), a.out, &a.error) && insideBrick(a.out, bricks_[a.brick]);
+        // Journaled before it is merged (judge); a copy that turns out to be a duplicate is
+        // harmless there (a resume merges the first record of a brick).
+        if (a.ok && journal_) journal_->add(a.brick, data, a.payload.size(), a.result.payload_crc32());
+      });
+    });
+    for (Arrival& a : arrivals_) judge(router, a);
+    arrivals_.clear();
+    arrivalBytes_ = 0;
+  }
+
+  void judge(zmq::socket_t& router, Arrival& a) {
+    Brick& b = bricks_[a.brick];
+    const uint64_t id = a.brick;
+    if (banned_.count(a.routingId)) {
+      // Its sender was dropped for garbage after sending it (an earlier result of this batch):
+      // ignored, as a message received after the ban would have been; the brick goes back.
+      if (b.phase == BrickPhase::Leased && b.holders.empty()) requeue(b, "worker " + a.workerId + " dropped", false);
+      return;
+    }
+    if (b.phase == BrickPhase::Done || b.phase == BrickPhase::Poisoned) {
+      ++report_.duplicates;  // another copy of this batch was merged first
+      return;
+    }
+    if (!a.ok) {
       // The holder's own brick came back corrupt: it counts as a failure of the brick (a brick
       // that breaks every worker's encoder is poisoned like one that fails), and the peer,
       // which sent garbage, is dropped.
       ++report_.malformed;
-      std::string why = "corrupt result from " + p.workerId + ": " + (err.empty() ? "crc or bounds" : err);
+      std::string why = "corrupt result from " + a.workerId + ": " + (a.error.empty() ? "crc or bounds" : a.error);
       spdlog::warn("dropped a {}", why);
       if (b.holders.empty()) requeue(b, why, true);
-      ban(router, in.routingId, "corrupt result for brick " + std::to_string(id));
+      ban(router, a.routingId, "corrupt result for brick " + std::to_string(id));
       return;
     }
+    const Result& r = a.result;
+    BrickOutput& out = a.out;
     out.stats.pointEvals = r.point_evals();
     out.stats.intervalEvals = r.interval_evals();
     out.stats.nanValues = r.nan_values();
@@ -573,16 +646,15 @@ class Master {
     out.extremumUncertified = r.extremum_uncertified();
     for (int k = 0; k < r.domain_errors_size() && k < int(kDomainErrorKinds); ++k)
       out.stats.domainErrors.n[k] = r.domain_errors(k);
-    report_.perWorker[p.workerId].computeSeconds += r.compute_seconds();
+    report_.perWorker[a.workerId].computeSeconds += r.compute_seconds();
     brickSeconds_.push_back(r.compute_seconds());
-    if (journal_) journal_->append(id, std::string(static_cast<const char*>(payload.data()), payload.size()));
     // Other holders (straggler backups) may drop the brick.
     for (auto& [rid, t] : b.holders) {
       Envelope c;
       c.mutable_cancel()->set_brick_id(id);
       send(router, rid, c);
     }
-    commit(id, std::move(out), p.workerId, true);
+    commit(id, std::move(out), a.workerId, true);
   }
 
   bool insideBrick(const BrickOutput& out, const Brick& b) const {
@@ -836,6 +908,45 @@ class Master {
     }
   }
 
+  // The bricks' leaves sorted by origin (as sample() sorts them) and their tiles, one slab of
+  // bricks at a time: the bricks are planned x-slab by x-slab and the sort is by x first, so a
+  // slab's leaves follow all the leaves of the slabs before it. Each slab's bricks are freed
+  // once copied, so the master holds about one copy of the leaves, not two.
+  void mergeLeaves(SampleResult& result) {
+    size_t leaves = 0;
+    for (auto& out : outputs_) {
+      leaves += out.leaves.size();
+      result.tiles.insert(result.tiles.end(), out.tiles.begin(), out.tiles.end());
+    }
+    std::vector<LeafBlock> noLeaves;
+    sortByOrigin(noLeaves, result.tiles);
+    result.leaves.reserve(leaves);  // filled slab by slab: pages are touched as the bricks are freed
+    const size_t perSlab = size_t((grid_.dims[1] + opt_.brickVoxels - 1) / opt_.brickVoxels) *
+                           size_t((grid_.dims[2] + opt_.brickVoxels - 1) / opt_.brickVoxels);
+    size_t at = 0, untrimmed = 0;
+    std::vector<const LeafBlock*> order;
+    for (size_t first = 0; first < outputs_.size(); first += perSlab) {
+      const size_t last = std::min(outputs_.size(), first + perSlab);
+      order.clear();
+      for (size_t i = first; i < last; ++i)
+        for (const LeafBlock& l : outputs_[i].leaves) order.push_back(&l);
+      result.leaves.resize(at + order.size());
+      decoders_.execute([&] {
+        tbb::parallel_sort(order.begin(), order.end(),
+                           [](const LeafBlock* a, const LeafBlock* b) { return a->origin < b->origin; });
+        tbb::parallel_for(size_t(0), order.size(), [&](size_t i) { result.leaves[at + i] = *order[i]; });
+      });
+      at += order.size();
+      untrimmed += order.size() * sizeof(LeafBlock);
+      for (size_t i = first; i < last; ++i) std::vector<LeafBlock>().swap(outputs_[i].leaves);
+      if (untrimmed > (size_t(64) << 20)) {
+        malloc_trim(0);  // give the freed pages back now (glibc keeps freed heap pages otherwise)
+        untrimmed = 0;
+      }
+    }
+    outputs_.clear();
+  }
+
   FarmOutcome finish() {
     FarmOutcome o;
     report_.operation = op_ == Operation::Mesh ? "mesh" : op_ == Operation::Render ? "render" : "sample";
@@ -870,18 +981,7 @@ class Master {
     }
     o.result.grid = grid_;
     o.result.bandVoxels = job_.band();
-    // One pass: order pointers to the bricks' leaves, then copy each leaf once (they are 2 KiB).
-    std::vector<const LeafBlock*> order;
-    for (auto& out : outputs_) {
-      for (const LeafBlock& l : out.leaves) order.push_back(&l);
-      o.result.tiles.insert(o.result.tiles.end(), out.tiles.begin(), out.tiles.end());
-    }
-    std::sort(order.begin(), order.end(), [](const LeafBlock* a, const LeafBlock* b) { return a->origin < b->origin; });
-    o.result.leaves.reserve(order.size());
-    for (const LeafBlock* l : order) o.result.leaves.push_back(*l);
-    std::vector<LeafBlock> noLeaves;
-    sortByOrigin(noLeaves, o.result.tiles);
-    outputs_.clear();
+    mergeLeaves(o.result);
     o.result.stats.pointEvals = report_.pointEvals;
     o.result.stats.intervalEvals = report_.intervalEvals;
     o.result.stats.nanValues = report_.nanValues;
@@ -906,6 +1006,9 @@ class Master {
   std::deque<std::string> bannedOrder_;
   std::map<std::string, std::string> aliases_;  // old routing id -> new, of reconnected workers
   std::vector<BrickOutput> outputs_;
+  std::vector<Arrival> arrivals_;  // results received, not yet verified (verifyArrivals)
+  size_t arrivalBytes_ = 0;
+  tbb::task_arena decoders_;       // the decode threads (FarmOptions::decodeThreads)
   std::map<std::string, Peer> peers_;
   std::vector<double> brickSeconds_;
   std::set<uint64_t> leased_;  // bricks in phase Leased (timers scan only these)

@@ -376,11 +376,17 @@ bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* e
     std::array<uint64_t, kLeafVoxels / 64> positive{};
     float magnitude = 0;
     if (!r.bytes(positive.data(), sizeof positive) || !r.get(magnitude)) return fail("payload: truncated leaf");
-    for (int i = 0; i < kLeafVoxels; ++i) {
-      if (l.isActive(i)) {
-        if (!r.get(l.values[size_t(i)])) return fail("payload: truncated leaf values");
-      } else {
-        l.values[size_t(i)] = ((positive[size_t(i >> 6)] >> (i & 63)) & 1u) ? magnitude : -magnitude;
+    size_t activeCount = 0;
+    for (uint64_t word : l.active) activeCount += size_t(__builtin_popcountll(word));
+    if (size_t(r.end - r.p) < activeCount * sizeof(float)) return fail("payload: truncated leaf values");
+    // 64 voxels at a time: every voxel from its sign bit (a loop the compiler vectorises), then
+    // the active ones, in voxel order, from the stream.
+    for (size_t w = 0; w < l.active.size(); ++w) {
+      float* v = l.values.data() + 64 * w;
+      for (int bit = 0; bit < 64; ++bit) v[bit] = ((positive[w] >> bit) & 1u) ? magnitude : -magnitude;
+      for (uint64_t a = l.active[w]; a; a &= a - 1) {
+        std::memcpy(v + __builtin_ctzll(a), r.p, sizeof(float));
+        r.p += sizeof(float);
       }
     }
   }
