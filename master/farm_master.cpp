@@ -17,6 +17,7 @@
 #include <zmq.hpp>
 
 #include <malloc.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
@@ -96,6 +97,32 @@ struct Brick {
   size_t maxLeaves = 0;  // upper bound on leaves in the region (payload sanity check)
 };
 
+// "sample": what the master keeps of a merged brick until the job's end: its verified FRB2
+// payload (compact leaves take about half the bytes of decoded ones), its leaves' origins (where
+// they go in the sorted output) and its tiles. finish() decodes each payload once more, straight
+// into the output (Master::mergeLeaves).
+struct KeptBrick {
+  zmq::message_t payload;
+  std::vector<std::array<int32_t, 3>> origins;  // of its leaves, in payload order
+  std::vector<Tile> tiles;
+};
+
+// A payload held in a message without a copy.
+zmq::message_t messageOf(std::string&& bytes) {
+  auto* held = new std::string(std::move(bytes));
+  return zmq::message_t(held->data(), held->size(), [](void*, void* hint) { delete static_cast<std::string*>(hint); },
+                        held);
+}
+
+KeptBrick keepSample(const BrickOutput& decoded, zmq::message_t&& payload) {
+  KeptBrick k;
+  k.payload = std::move(payload);
+  k.origins.reserve(decoded.leaves.size());
+  for (const LeafBlock& l : decoded.leaves) k.origins.push_back(l.origin);
+  k.tiles = decoded.tiles;
+  return k;
+}
+
 // A result from its brick's holder, waiting to be verified (CRC, codec, inside the brick) and
 // decoded off the scheduling loop (Master::verifyArrivals).
 struct Arrival {
@@ -103,7 +130,8 @@ struct Arrival {
   std::string routingId, workerId;
   Result result;
   zmq::message_t payload;
-  BrickOutput out;
+  BrickOutput out;  // "mesh", "render": the decoded result
+  KeptBrick kept;   // "sample": origins and tiles (the leaves are decoded into scratch, not kept)
   std::string error;
   bool ok = false;
 };
@@ -149,7 +177,8 @@ class Master {
         BrickOutput out;
         std::string err;
         if (!decodePayload(op_, payload.data(), payload.size(), out, &err) || !insideBrick(out, bricks_[id])) return;
-        commit(id, std::move(out), "journal", false);
+        KeptBrick kept = op_ == Operation::Sample ? keepSample(out, messageOf(std::string(payload))) : KeptBrick{};
+        commit(id, std::move(out), "journal", false, std::move(kept));
         ++report_.bricksFromJournal;
       });
       if (report_.bricksFromJournal)
@@ -184,7 +213,8 @@ class Master {
           bricks_.push_back(br);
           pending_.push_back(br.id);
         }
-    outputs_.resize(bricks_.size());
+    if (op_ == Operation::Sample) kept_.resize(bricks_.size());
+    else outputs_.resize(bricks_.size());
     report_.bricks = bricks_.size();
     size_t leaves = 0;
     for (auto& br : bricks_) leaves = std::max(leaves, br.maxLeaves);
@@ -202,8 +232,8 @@ class Master {
     }
   }
 
-  // A brick's result is final: keep it, journal it, count it.
-  void commit(uint64_t id, BrickOutput&& out, const std::string& who, bool computed) {
+  // A brick's result is final: keep it (for "sample", `kept`; out's leaves are not kept), count it.
+  void commit(uint64_t id, BrickOutput&& out, const std::string& who, bool computed, KeptBrick&& kept = {}) {
     Brick& b = bricks_[id];
     b.phase = BrickPhase::Done;
     for (auto& [rid, t] : b.holders)  // cancelled copies no longer take a worker's credit
@@ -212,8 +242,9 @@ class Master {
     leased_.erase(id);
     ++done_;
     if (op_ == Operation::Sample) {
-      report_.leaves += out.leaves.size();
-      report_.tiles += out.tiles.size();
+      report_.leaves += kept.origins.size();
+      report_.tiles += kept.tiles.size();
+      kept_[id] = std::move(kept);
     }
     if (computed) {
       ++report_.bricksComputed;
@@ -229,7 +260,7 @@ class Master {
       ++share.bricks;
       share.pointEvals += out.stats.pointEvals;
     }
-    outputs_[id] = std::move(out);
+    if (op_ != Operation::Sample) outputs_[id] = std::move(out);
   }
 
   void runInProcess() {
@@ -245,8 +276,10 @@ class Master {
       auto t0 = Clock::now();
       BrickOutput out = computeBrick(tape, job_, b.lo, b.hi, opt_.threads);
       report_.perWorker["in-process"].computeSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
-      if (journal_) journal_->append(b.id, encodePayload(op_, out));
-      commit(b.id, std::move(out), "in-process", true);
+      std::string payload = journal_ || op_ == Operation::Sample ? encodePayload(op_, out) : std::string();
+      if (journal_) journal_->append(b.id, payload);
+      KeptBrick kept = op_ == Operation::Sample ? keepSample(out, messageOf(std::move(payload))) : KeptBrick{};
+      commit(b.id, std::move(out), "in-process", true, std::move(kept));
       progress_->update(done_, report_.pointEvals, 1);
     }
   }
@@ -601,8 +634,15 @@ class Master {
       tbb::parallel_for(size_t(0), arrivals_.size(), [&](size_t i) {
         Arrival& a = arrivals_[i];
         const void* data = a.payload.data();
+        // "sample": decoded into this thread's scratch (warm memory), only origins and tiles kept.
+        BrickOutput& out = op_ == Operation::Sample ? scratch_.local() : a.out;
         a.ok = crc32Of(data, a.payload.size()) == a.result.payload_crc32() &&
-               decodePayload(op_, data, a.payload.size(), a.out, &a.error) && insideBrick(a.out, bricks_[a.brick]);
+               decodePayload(op_, data, a.payload.size(), out, &a.error) && insideBrick(out, bricks_[a.brick]);
+        if (a.ok && op_ == Operation::Sample) {
+          a.kept.origins.reserve(out.leaves.size());
+          for (const LeafBlock& l : out.leaves) a.kept.origins.push_back(l.origin);
+          a.kept.tiles = out.tiles;
+        }
         // Journaled before it is merged (judge); a copy that turns out to be a duplicate is
         // harmless there (a resume merges the first record of a brick).
         if (a.ok && journal_) journal_->add(a.brick, data, a.payload.size(), a.result.payload_crc32());
@@ -654,7 +694,8 @@ class Master {
       c.mutable_cancel()->set_brick_id(id);
       send(router, rid, c);
     }
-    commit(id, std::move(out), a.workerId, true);
+    a.kept.payload = std::move(a.payload);
+    commit(id, std::move(out), a.workerId, true, std::move(a.kept));
   }
 
   bool insideBrick(const BrickOutput& out, const Brick& b) const {
@@ -910,41 +951,63 @@ class Master {
 
   // The bricks' leaves sorted by origin (as sample() sorts them) and their tiles, one slab of
   // bricks at a time: the bricks are planned x-slab by x-slab and the sort is by x first, so a
-  // slab's leaves follow all the leaves of the slabs before it. Each slab's bricks are freed
-  // once copied, so the master holds about one copy of the leaves, not two.
+  // slab's leaves follow all the leaves of the slabs before it. Each brick's payload is decoded
+  // (on the decode threads, into warm scratch) and its leaves copied straight to their sorted
+  // places; the slab's payloads are then freed, so the master holds the payloads or the output,
+  // not both.
   void mergeLeaves(SampleResult& result) {
     size_t leaves = 0;
-    for (auto& out : outputs_) {
-      leaves += out.leaves.size();
-      result.tiles.insert(result.tiles.end(), out.tiles.begin(), out.tiles.end());
+    for (const KeptBrick& k : kept_) {
+      leaves += k.origins.size();
+      result.tiles.insert(result.tiles.end(), k.tiles.begin(), k.tiles.end());
     }
     std::vector<LeafBlock> noLeaves;
     sortByOrigin(noLeaves, result.tiles);
-    result.leaves.reserve(leaves);  // filled slab by slab: pages are touched as the bricks are freed
+    result.leaves.reserve(leaves);  // filled slab by slab: pages are touched as payloads are freed
     const size_t perSlab = size_t((grid_.dims[1] + opt_.brickVoxels - 1) / opt_.brickVoxels) *
                            size_t((grid_.dims[2] + opt_.brickVoxels - 1) / opt_.brickVoxels);
+    struct Ref {
+      std::array<int32_t, 3> origin;
+      uint32_t brick, leaf;  // brick within the slab, leaf within the brick
+    };
+    std::vector<Ref> refs;
+    std::vector<size_t> start, where;  // where[start[brick] + leaf]: the leaf's index in the output
     size_t at = 0, untrimmed = 0;
-    std::vector<const LeafBlock*> order;
-    for (size_t first = 0; first < outputs_.size(); first += perSlab) {
-      const size_t last = std::min(outputs_.size(), first + perSlab);
-      order.clear();
-      for (size_t i = first; i < last; ++i)
-        for (const LeafBlock& l : outputs_[i].leaves) order.push_back(&l);
-      result.leaves.resize(at + order.size());
+    for (size_t first = 0; first < kept_.size(); first += perSlab) {
+      const size_t last = std::min(kept_.size(), first + perSlab);
+      refs.clear();
+      start.assign(1, 0);
+      for (size_t i = first; i < last; ++i) {
+        for (size_t l = 0; l < kept_[i].origins.size(); ++l)
+          refs.push_back(Ref{kept_[i].origins[l], uint32_t(i - first), uint32_t(l)});
+        start.push_back(refs.size());
+      }
+      where.resize(refs.size());
+      result.leaves.resize(at + refs.size());
       decoders_.execute([&] {
-        tbb::parallel_sort(order.begin(), order.end(),
-                           [](const LeafBlock* a, const LeafBlock* b) { return a->origin < b->origin; });
-        tbb::parallel_for(size_t(0), order.size(), [&](size_t i) { result.leaves[at + i] = *order[i]; });
+        tbb::parallel_sort(refs.begin(), refs.end(), [](const Ref& a, const Ref& b) { return a.origin < b.origin; });
+        for (size_t r = 0; r < refs.size(); ++r) where[start[refs[r].brick] + refs[r].leaf] = at + r;
+        tbb::parallel_for(first, last, [&](size_t i) {
+          const KeptBrick& k = kept_[i];
+          if (k.origins.empty()) return;
+          BrickOutput& out = scratch_.local();
+          std::string err;
+          if (!decodePayload(op_, k.payload.data(), k.payload.size(), out, &err) || out.leaves.size() != k.origins.size())
+            throw std::logic_error("brick " + std::to_string(i) + ": its verified payload no longer decodes: " + err);
+          for (size_t l = 0; l < out.leaves.size(); ++l) result.leaves[where[start[i - first] + l]] = out.leaves[l];
+        });
       });
-      at += order.size();
-      untrimmed += order.size() * sizeof(LeafBlock);
-      for (size_t i = first; i < last; ++i) std::vector<LeafBlock>().swap(outputs_[i].leaves);
+      at += refs.size();
+      for (size_t i = first; i < last; ++i) {
+        untrimmed += kept_[i].payload.size();
+        kept_[i] = KeptBrick{};
+      }
       if (untrimmed > (size_t(64) << 20)) {
         malloc_trim(0);  // give the freed pages back now (glibc keeps freed heap pages otherwise)
         untrimmed = 0;
       }
     }
-    outputs_.clear();
+    kept_.clear();
   }
 
   FarmOutcome finish() {
@@ -1005,7 +1068,9 @@ class Master {
   std::set<std::string> banned_;   // routing ids that sent garbage
   std::deque<std::string> bannedOrder_;
   std::map<std::string, std::string> aliases_;  // old routing id -> new, of reconnected workers
-  std::vector<BrickOutput> outputs_;
+  std::vector<BrickOutput> outputs_;  // "mesh", "render": the merged bricks' results, by brick
+  std::vector<KeptBrick> kept_;       // "sample": the merged bricks' payloads, by brick
+  tbb::enumerable_thread_specific<BrickOutput> scratch_;  // "sample": decoding, per thread
   std::vector<Arrival> arrivals_;  // results received, not yet verified (verifyArrivals)
   size_t arrivalBytes_ = 0;
   tbb::task_arena decoders_;       // the decode threads (FarmOptions::decodeThreads)
