@@ -277,11 +277,12 @@ int main(int argc, char** argv) {
   // Decoding on the scheduling loop alone (decodeThreads 1) against the decode threads (0: all
   // cores), alternated, 3 runs each; medians.
   const int fakes = 8;
-  std::vector<double> rate[2];
+  std::vector<double> rate[2], cpuPerBrick;
   for (int round = 0; round < 3; ++round)
     for (int mode = 0; mode < 2; ++mode) {
       MasterRun m = masterRun(fakes, 1024, 64, leavesPerBrick, mode == 0 ? 1 : 0);
       rate[mode].push_back(double(m.bricks) / m.wall);
+      if (mode == 1) cpuPerBrick.push_back(m.processCpu / double(m.bricks));
       std::printf("  %d fake workers, %s: %llu bricks in %.2f s = %.0f bricks/s wall; master CPU %.0f us/brick, "
                   "loop %.0f us/brick; process peak RSS %.0f MiB\n",
                   fakes, mode == 0 ? "decoding on the loop " : "decoding on all cores", (unsigned long long)m.bricks,
@@ -294,6 +295,8 @@ int main(int argc, char** argv) {
   };
   std::printf("median: %.0f bricks/s decoding on the loop, %.0f on all cores: %.2fx\n", median(rate[0]),
               median(rate[1]), median(rate[1]) / median(rate[0]));
+  std::printf("master CPU per brick (median, all cores): %.0f us: %.0f bricks per second of master CPU\n",
+              1e6 * median(cpuPerBrick), 1 / median(cpuPerBrick));
   if (brickSeconds > 0)
     std::printf("  -> at %.4f s per brick one master keeps %.0f workers busy (goal >= 256)\n", brickSeconds,
                 median(rate[1]) * brickSeconds);

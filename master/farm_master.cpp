@@ -114,9 +114,9 @@ zmq::message_t messageOf(std::string&& bytes) {
                         held);
 }
 
-KeptBrick keepSample(const BrickOutput& decoded, zmq::message_t&& payload) {
+// What is kept of a decoded brick: its leaves' origins and its tiles (the caller adds the payload).
+KeptBrick keptOf(const BrickOutput& decoded) {
   KeptBrick k;
-  k.payload = std::move(payload);
   k.origins.reserve(decoded.leaves.size());
   for (const LeafBlock& l : decoded.leaves) k.origins.push_back(l.origin);
   k.tiles = decoded.tiles;
@@ -177,7 +177,11 @@ class Master {
         BrickOutput out;
         std::string err;
         if (!decodePayload(op_, payload.data(), payload.size(), out, &err) || !insideBrick(out, bricks_[id])) return;
-        KeptBrick kept = op_ == Operation::Sample ? keepSample(out, messageOf(std::string(payload))) : KeptBrick{};
+        KeptBrick kept;
+        if (op_ == Operation::Sample) {
+          kept = keptOf(out);
+          kept.payload = messageOf(std::string(payload));
+        }
         commit(id, std::move(out), "journal", false, std::move(kept));
         ++report_.bricksFromJournal;
       });
@@ -278,7 +282,11 @@ class Master {
       report_.perWorker["in-process"].computeSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
       std::string payload = journal_ || op_ == Operation::Sample ? encodePayload(op_, out) : std::string();
       if (journal_) journal_->append(b.id, payload);
-      KeptBrick kept = op_ == Operation::Sample ? keepSample(out, messageOf(std::move(payload))) : KeptBrick{};
+      KeptBrick kept;
+      if (op_ == Operation::Sample) {
+        kept = keptOf(out);
+        kept.payload = messageOf(std::move(payload));
+      }
       commit(b.id, std::move(out), "in-process", true, std::move(kept));
       progress_->update(done_, report_.pointEvals, 1);
     }
@@ -638,11 +646,7 @@ class Master {
         BrickOutput& out = op_ == Operation::Sample ? scratch_.local() : a.out;
         a.ok = crc32Of(data, a.payload.size()) == a.result.payload_crc32() &&
                decodePayload(op_, data, a.payload.size(), out, &a.error) && insideBrick(out, bricks_[a.brick]);
-        if (a.ok && op_ == Operation::Sample) {
-          a.kept.origins.reserve(out.leaves.size());
-          for (const LeafBlock& l : out.leaves) a.kept.origins.push_back(l.origin);
-          a.kept.tiles = out.tiles;
-        }
+        if (a.ok && op_ == Operation::Sample) a.kept = keptOf(out);
         // Journaled before it is merged (judge); a copy that turns out to be a duplicate is
         // harmless there (a resume merges the first record of a brick).
         if (a.ok && journal_) journal_->add(a.brick, data, a.payload.size(), a.result.payload_crc32());
