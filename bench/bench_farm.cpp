@@ -1,14 +1,13 @@
 // Farm figures, all measured in this run:
 //  1. speed-up of a compute-heavy job from 1 to 2 local workers (this machine has 2 cores);
 //  2. the master's own throughput against fake workers that replay pre-encoded results (bricks
-//     merged per second, the master's CPU per brick), and from it how many real workers one
-//     master keeps busy at the brick time measured in 1.
+//     merged per second, the master's CPU per brick), decoding on the scheduling loop alone
+//     against decoding on all cores, and from it how many real workers one master keeps busy at
+//     the brick time measured in 1.
 // `bench_farm --master-only` runs 2 alone.
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
-#include <cstring>
-#include <future>
 #include <cstdio>
 #include <thread>
 #include <vector>
@@ -231,15 +230,10 @@ MasterRun masterRun(int fakes, int res, int brickVoxels, int leaves, int decodeT
   return m;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  if (argc == 6 && std::string(argv[1]) == "--fake-workers")
-    return runFakeWorkers(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), std::atoi(argv[5]));
-  const bool masterOnly = argc == 2 && std::string(argv[1]) == "--master-only";
+// 1. Speed-up of a compute-heavy job, 1 -> 2 local workers; returns the mean compute time of
+// a 64^3 brick of it (the brick time the master must keep up with).
+double workerSpeedUp() {
   double brickSeconds = 0;
-  if (!masterOnly) {
-  // 1. Speed-up, 1 -> 2 local workers.
   JobSpec heavy = job(kHeavyModel, 192);
   double t[3] = {0, 0, 0};
   uint64_t bricks = 0;
@@ -266,7 +260,17 @@ int main(int argc, char** argv) {
     brickSeconds = out.report.perWorker.begin()->second.computeSeconds / double(out.report.bricks);
     std::printf("mean compute time of a 64^3 brick (heavy model, 256^3): %.4f s\n\n", brickSeconds);
   }
-  }
+  return brickSeconds;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc == 6 && std::string(argv[1]) == "--fake-workers")
+    return runFakeWorkers(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), std::atoi(argv[5]));
+  const bool masterOnly = argc == 2 && std::string(argv[1]) == "--master-only";
+  double brickSeconds = 0;
+  if (!masterOnly) brickSeconds = workerSpeedUp();
 
   // 2. The master's own ceiling: a 1024^3 grid in 64^3 bricks = 4096 bricks, each answered at
   //    once with 128 leaf blocks (a surface crossing a 64^3 brick, 150 kB), with a journal.
