@@ -827,11 +827,18 @@ class Master {
     }
   }
 
-  double medianBrickSeconds() const {
-    if (brickSeconds_.empty()) return 0;
-    std::vector<double> v = brickSeconds_;
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
+  // The median compute time of the merged bricks (lease and straggler timers). Every turn asks
+  // for it; it is recomputed only once the sample has grown by an eighth (or is small), so the
+  // whole job spends O(bricks) on it, not O(bricks) a turn.
+  double medianBrickSeconds() {
+    const size_t n = brickSeconds_.size();
+    if (n != medianOf_ && (n < 64 || n >= medianOf_ + medianOf_ / 8)) {
+      std::vector<double> v = brickSeconds_;
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      median_ = v[v.size() / 2];
+      medianOf_ = n;
+    }
+    return median_;
   }
 
   // Leases past their deadline are issued once more to someone else (the first holder keeps
@@ -1080,6 +1087,8 @@ class Master {
   tbb::task_arena decoders_;       // the decode threads (FarmOptions::decodeThreads)
   std::map<std::string, Peer> peers_;
   std::vector<double> brickSeconds_;
+  double median_ = 0;    // medianBrickSeconds() of the first medianOf_ entries
+  size_t medianOf_ = 0;
   std::set<uint64_t> leased_;  // bricks in phase Leased (timers scan only these)
   size_t payloadLimit_ = 0;
   size_t done_ = 0, poisoned_ = 0;
