@@ -1,15 +1,21 @@
 // Farm figures, all measured in this run:
 //  1. speed-up of a compute-heavy job from 1 to 2 local workers (this machine has 2 cores);
-//  2. the master's own throughput against instant fake workers (bricks and leaf blocks merged
-//     per second), and from it how many real workers one master keeps busy at the brick time
-//     measured in 1.
+//  2. the master's own throughput against fake workers that replay pre-encoded results (bricks
+//     merged per second, the master's CPU per brick), decoding on the scheduling loop alone
+//     against decoding on all cores, and from it how many real workers one master keeps busy at
+//     the brick time measured in 1.
+// `bench_farm --master-only` runs 2 alone.
+#include <algorithm>
 #include <chrono>
-#include <cstring>
-#include <future>
+#include <cstdlib>
 #include <cstdio>
 #include <thread>
 #include <vector>
 #include <zmq.hpp>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "brick.h"
 #include "farm_master.h"
@@ -51,18 +57,47 @@ double seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// A fake worker: answers every task at once with a canned payload of `leaves` leaf blocks.
-void fakeWorker(const std::string& ep, int leaves, std::atomic<bool>& stop) {
+// The payload a fake worker returns for the brick at `lo`: `leaves` leaf blocks inside it, each
+// a typical surface leaf (about half its voxels in the band, so the compact FRB2 form).
+std::string fakePayload(const std::array<int32_t, 3>& lo, int leaves) {
+  BrickOutput b;
+  for (int i = 0; i < leaves; ++i) {
+    LeafBlock l{};
+    l.origin = {lo[0] + 8 * (i % 8), lo[1] + 8 * ((i / 8) % 8), lo[2] + 8 * (i / 64)};
+    for (int v = 0; v < kLeafVoxels; ++v) {
+      bool active = (v / 8) % 2 == 0;
+      l.values[size_t(v)] = active ? 0.01f * float(v % 7) : (v < 256 ? 0.3f : -0.3f);
+      if (active) l.active[size_t(v >> 6)] |= uint64_t(1) << (v & 63);
+    }
+    b.leaves.push_back(l);
+  }
+  return encodeBrick(b);
+}
+
+// Fake workers replay results encoded before the job starts (payload and CRC per brick, sent
+// without a copy), so what is measured is the master, not the workers. They run in a child
+// process (this program with --fake-workers), so the master's CPU time is the parent's.
+struct Replay {
+  int brickVoxels, perAxis, leaves;
+  std::vector<std::string> payloads;  // by brick index (i * perAxis + j) * perAxis + k
+  std::vector<uint32_t> crcs;
+  const std::string& payload(const Task& t, uint32_t& crc) const {
+    size_t i = (size_t(t.lo(0) / brickVoxels) * size_t(perAxis) + size_t(t.lo(1) / brickVoxels)) * size_t(perAxis) +
+               size_t(t.lo(2) / brickVoxels);
+    crc = crcs.at(i);
+    return payloads.at(i);
+  }
+};
+
+void fakeWorker(const std::string& ep, const std::string& id, const Replay& replay) {
   zmq::context_t ctx(1);
   zmq::socket_t s(ctx, zmq::socket_type::dealer);
   s.set(zmq::sockopt::linger, 0);
   s.connect(ep);
   Envelope hello;
-  hello.mutable_hello()->set_worker_id("fake");
+  hello.mutable_hello()->set_worker_id(id);  // distinct ids: a shared id reads as one worker reconnecting
   send(s, "", hello);
-  std::string payloadCache;
-  std::vector<size_t> leafOffsets;
-  while (!stop) {
+  for (;;) {
     zmq::pollitem_t item{static_cast<void*>(s), 0, ZMQ_POLLIN, 0};
     zmq::poll(&item, 1, std::chrono::milliseconds(50));
     Incoming in;
@@ -70,53 +105,138 @@ void fakeWorker(const std::string& ep, int leaves, std::atomic<bool>& stop) {
       if (in.envelope.body_case() == Envelope::kBye) return;
       if (in.envelope.body_case() != Envelope::kTask) continue;
       const Task& t = in.envelope.task();
-      // The payload is encoded once; per task only the leaf origins are patched, so that the
-      // fake workers cost the shared cores as little as possible.
-      if (payloadCache.empty()) {
-        BrickOutput b;
-        for (int i = 0; i < leaves; ++i) {
-          LeafBlock l{};
-          l.origin = {8 * (i % 8), 8 * ((i / 8) % 8), 8 * (i / 64)};
-          // a typical surface leaf: about half its voxels in the band
-          for (int v = 0; v < kLeafVoxels; ++v) {
-            bool active = (v / 8) % 2 == 0;
-            l.values[size_t(v)] = active ? 0.01f * float(v % 7) : (v < 256 ? 0.3f : -0.3f);
-            if (active) l.active[size_t(v >> 6)] |= uint64_t(1) << (v & 63);
-          }
-          b.leaves.push_back(l);
-        }
-        payloadCache = encodeBrick(b);
-        leafOffsets.clear();
-        for (size_t pos = 12, i = 0; i < size_t(leaves); ++i) {
-          leafOffsets.push_back(pos);
-          pos += 12 + 4 + 64 + 64 + 4 + 4 * 256;
-        }
-      }
-      std::string payload = payloadCache;
-      for (int i = 0; i < leaves; ++i) {
-        int32_t origin[3] = {t.lo(0) + 8 * (i % 8), t.lo(1) + 8 * ((i / 8) % 8), t.lo(2) + 8 * (i / 64)};
-        std::memcpy(payload.data() + leafOffsets[size_t(i)], origin, sizeof origin);
-      }
+      uint32_t crc = 0;
+      const std::string& payload = replay.payload(t, crc);
       Envelope r;
       r.set_job_id(in.envelope.job_id());
+      r.set_proto_major(kProtoMajor);
+      r.set_proto_minor(kProtoMinor);
       Result* res = r.mutable_result();
       res->set_brick_id(t.brick_id());
       res->set_attempt(t.attempt());
-      res->set_leaves(uint32_t(leaves));
-      res->set_payload_crc32(crc32Of(payload.data(), payload.size()));
-      send(s, "", r, &payload);
+      res->set_leaves(uint32_t(replay.leaves));
+      res->set_payload_crc32(crc);
+      std::string head = r.SerializeAsString();
+      s.send(zmq::buffer(head), zmq::send_flags::sndmore);
+      s.send(zmq::message_t(const_cast<char*>(payload.data()), payload.size(), nullptr), zmq::send_flags::none);
     }
   }
 }
 
-}  // namespace
+// Child process: encodes every brick's result, says "ready", reads the master's endpoint from
+// stdin and serves it with `fakes` workers until each is told bye.
+int runFakeWorkers(int fakes, int res, int brickVoxels, int leaves) {
+  Replay replay{brickVoxels, (res + brickVoxels - 1) / brickVoxels, leaves, {}, {}};
+  for (int i = 0; i < replay.perAxis; ++i)
+    for (int j = 0; j < replay.perAxis; ++j)
+      for (int k = 0; k < replay.perAxis; ++k) {
+        replay.payloads.push_back(fakePayload({i * brickVoxels, j * brickVoxels, k * brickVoxels}, leaves));
+        replay.crcs.push_back(crc32Of(replay.payloads.back().data(), replay.payloads.back().size()));
+      }
+  std::printf("ready\n");
+  std::fflush(stdout);
+  char ep[256] = {};
+  if (!std::fgets(ep, sizeof ep, stdin)) return 1;
+  std::string endpoint(ep);
+  while (!endpoint.empty() && (endpoint.back() == '\n' || endpoint.back() == '\r')) endpoint.pop_back();
+  std::vector<std::thread> ws;
+  for (int i = 0; i < fakes; ++i) ws.emplace_back(fakeWorker, endpoint, "fake-" + std::to_string(i), std::cref(replay));
+  for (auto& w : ws) w.join();
+  return 0;
+}
 
-int main() {
-  // 1. Speed-up, 1 -> 2 local workers.
+// The fake workers' child process: its stdin takes the endpoint, its stdout says "ready".
+struct FakeFarm {
+  pid_t pid = -1;
+  FILE* toChild = nullptr;
+  FakeFarm(int fakes, int res, int brickVoxels, int leaves) {
+    int in[2], out[2];
+    if (pipe(in) != 0 || pipe(out) != 0) throw std::runtime_error("pipe");
+    pid = fork();
+    if (pid == 0) {
+      dup2(in[0], 0);
+      dup2(out[1], 1);
+      close(in[1]);
+      close(out[0]);
+      const std::string a[] = {std::to_string(fakes), std::to_string(res), std::to_string(brickVoxels),
+                               std::to_string(leaves)};
+      execl("/proc/self/exe", "bench_farm", "--fake-workers", a[0].c_str(), a[1].c_str(), a[2].c_str(), a[3].c_str(),
+            static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    close(in[0]);
+    close(out[1]);
+    toChild = fdopen(in[1], "w");
+    FILE* fromChild = fdopen(out[0], "r");
+    char line[64] = {};
+    if (!std::fgets(line, sizeof line, fromChild)) throw std::runtime_error("fake workers did not start");
+    std::fclose(fromChild);
+  }
+  void connect(const std::string& endpoint) {
+    std::fprintf(toChild, "%s\n", endpoint.c_str());
+    std::fflush(toChild);
+  }
+  ~FakeFarm() {
+    if (toChild) std::fclose(toChild);
+    int status = 0;
+    waitpid(pid, &status, 0);
+  }
+};
+
+double threadCpuSeconds() {
+  struct rusage ru {};
+  getrusage(RUSAGE_THREAD, &ru);
+  return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+double processCpuSeconds() {
+  struct rusage ru {};
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+struct MasterRun {
+  double wall = 0, loopCpu = 0, processCpu = 0, peakRssMb = 0;
+  uint64_t bricks = 0, leaves = 0;
+};
+
+// One job of the master against `fakes` replaying workers, with a journal as frep keeps one.
+MasterRun masterRun(int fakes, int res, int brickVoxels, int leaves, int decodeThreads) {
+  FakeFarm farm(fakes, res, brickVoxels, leaves);
+  JobSpec big = job("my_model(x[3], a[1]) { my_model = 1; }", res);
+  FarmOptions o;
+  o.listen = "tcp://127.0.0.1:*";
+  o.onListening = [&](const std::string& ep) { farm.connect(ep); };
+  o.brickVoxels = brickVoxels;
+  o.heartbeatMs = 500;
+  o.decodeThreads = decodeThreads;
+  char journal[] = "/tmp/bench_farm_XXXXXX";
+  int fd = mkstemp(journal);
+  if (fd >= 0) close(fd);
+  o.journalPath = journal;
+  MasterRun m;
+  std::thread master([&] {
+    const double cpu0 = processCpuSeconds(), loop0 = threadCpuSeconds();
+    FarmOutcome out = runJob(big, o);
+    m.loopCpu = threadCpuSeconds() - loop0;
+    m.processCpu = processCpuSeconds() - cpu0;
+    m.wall = out.report.wallSeconds;
+    m.bricks = out.report.bricks;
+    m.leaves = out.report.leaves;
+    m.peakRssMb = double(out.report.peakRssBytes) / (1 << 20);
+  });
+  master.join();
+  std::remove(journal);
+  return m;
+}
+
+// 1. Speed-up of a compute-heavy job, 1 -> 2 local workers; returns the mean compute time of
+// a 64^3 brick of it (the brick time the master must keep up with).
+double workerSpeedUp() {
+  double brickSeconds = 0;
   JobSpec heavy = job(kHeavyModel, 192);
   double t[3] = {0, 0, 0};
   uint64_t bricks = 0;
-  double brickSeconds = 0;
   for (int w : {1, 2}) {
     FarmOptions o;
     o.workers = w;
@@ -140,36 +260,49 @@ int main() {
     brickSeconds = out.report.perWorker.begin()->second.computeSeconds / double(out.report.bricks);
     std::printf("mean compute time of a 64^3 brick (heavy model, 256^3): %.4f s\n\n", brickSeconds);
   }
+  return brickSeconds;
+}
 
-  // 2. Master throughput with instant fake workers: a 1024^3 grid in 64^3 bricks = 4096
-  //    bricks, each answered with 128 leaf blocks (a surface crossing a 64^3 brick).
-  JobSpec big = job("my_model(x[3], a[1]) { my_model = 1; }", 1024);
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc == 6 && std::string(argv[1]) == "--fake-workers")
+    return runFakeWorkers(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), std::atoi(argv[5]));
+  const bool masterOnly = argc == 2 && std::string(argv[1]) == "--master-only";
+  double brickSeconds = 0;
+  if (!masterOnly) brickSeconds = workerSpeedUp();
+
+  // 2. The master's own ceiling: a 1024^3 grid in 64^3 bricks = 4096 bricks, each answered at
+  //    once with 128 leaf blocks (a surface crossing a 64^3 brick, 150 kB), with a journal.
   const int leavesPerBrick = 128;
-  for (int fakes : {2, 8}) {
-    FarmOptions o;
-    o.listen = "tcp://127.0.0.1:*";
-    std::promise<std::string> bound;
-    o.onListening = [&](const std::string& ep) { bound.set_value(ep); };
-    o.brickVoxels = 64;
-    o.heartbeatMs = 500;
-    std::atomic<bool> stop{false};
-    std::vector<std::thread> ws;
-    auto t0 = std::chrono::steady_clock::now();
-    std::thread master([&] {
-      FarmOutcome out = runJob(big, o);
-      double s = seconds(t0);
-      double rate = double(out.report.bricks) / s;
-      std::printf("master with %2d instant fake workers: %llu bricks, %llu leaves in %.2f s = %.0f bricks/s, %.0f leaves/s\n",
-                  fakes, (unsigned long long)out.report.bricks, (unsigned long long)out.report.leaves, s, rate,
-                  double(out.report.leaves) / s);
-      std::printf("  -> at %.4f s per brick one master keeps %.0f workers busy (goal >= 256)\n", brickSeconds,
-                  rate * brickSeconds);
-    });
-    const std::string endpoint = bound.get_future().get();
-    for (int i = 0; i < fakes; ++i) ws.emplace_back(fakeWorker, endpoint, leavesPerBrick, std::ref(stop));
-    master.join();
-    stop = true;
-    for (auto& w : ws) w.join();
-  }
+  std::printf("master against fake workers replaying pre-encoded results (their cost not measured; a child process),\n"
+              "1024^3 in 64^3 bricks, %d leaves (150 kB) a brick, journal on; master CPU = the master's process\n"
+              "(loop, decoders, ZeroMQ I/O thread), loop = its scheduling thread alone\n", leavesPerBrick);
+  // Decoding on the scheduling loop alone (decodeThreads 1) against the decode threads (0: all
+  // cores), alternated, 3 runs each; medians.
+  const int fakes = 8;
+  std::vector<double> rate[2], cpuPerBrick;
+  for (int round = 0; round < 3; ++round)
+    for (int mode = 0; mode < 2; ++mode) {
+      MasterRun m = masterRun(fakes, 1024, 64, leavesPerBrick, mode == 0 ? 1 : 0);
+      rate[mode].push_back(double(m.bricks) / m.wall);
+      if (mode == 1) cpuPerBrick.push_back(m.processCpu / double(m.bricks));
+      std::printf("  %d fake workers, %s: %llu bricks in %.2f s = %.0f bricks/s wall; master CPU %.0f us/brick, "
+                  "loop %.0f us/brick; process peak RSS %.0f MiB\n",
+                  fakes, mode == 0 ? "decoding on the loop " : "decoding on all cores", (unsigned long long)m.bricks,
+                  m.wall, rate[mode].back(), 1e6 * m.processCpu / double(m.bricks), 1e6 * m.loopCpu / double(m.bricks),
+                  m.peakRssMb);
+    }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  std::printf("median: %.0f bricks/s decoding on the loop, %.0f on all cores: %.2fx\n", median(rate[0]),
+              median(rate[1]), median(rate[1]) / median(rate[0]));
+  std::printf("master CPU per brick (median, all cores): %.0f us: %.0f bricks per second of master CPU\n",
+              1e6 * median(cpuPerBrick), 1 / median(cpuPerBrick));
+  if (brickSeconds > 0)
+    std::printf("  -> at %.4f s per brick one master keeps %.0f workers busy (goal >= 256)\n", brickSeconds,
+                median(rate[1]) * brickSeconds);
   return 0;
 }

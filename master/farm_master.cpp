@@ -16,6 +16,12 @@
 #include <thread>
 #include <zmq.hpp>
 
+#include <malloc.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#include <tbb/task_arena.h>
+
 #include "brick.h"
 #include "curve.h"
 #include "frep/meshing/mesh_merge.h"
@@ -62,6 +68,10 @@ constexpr size_t kMaxBanned = 1024;     // banned routing ids remembered (oldest
 constexpr size_t kMaxPeers = 4096;      // welcomed workers at once; a hello beyond is refused
 constexpr size_t kMaxAliases = 4096;    // routing ids of workers that reconnected
 constexpr int kRouterRcvHwm = 64;       // queued messages per connection (ZMQ_RCVHWM)
+// Results received in a row are verified and decoded together on the decode threads; a batch
+// ends at a message of another kind, at the end of a turn's drain, or at these bounds.
+constexpr size_t kMaxArrivals = 64;
+constexpr size_t kMaxArrivalBytes = 64 << 20;
 
 enum class Departure { Left, Dead, Dropped };
 
@@ -87,6 +97,45 @@ struct Brick {
   size_t maxLeaves = 0;  // upper bound on leaves in the region (payload sanity check)
 };
 
+// "sample": what the master keeps of a merged brick until the job's end: its verified FRB2
+// payload (compact leaves take about half the bytes of decoded ones), its leaves' origins (where
+// they go in the sorted output) and its tiles. finish() decodes each payload once more, straight
+// into the output (Master::mergeLeaves).
+struct KeptBrick {
+  zmq::message_t payload;
+  std::vector<std::array<int32_t, 3>> origins;  // of its leaves, in payload order
+  std::vector<Tile> tiles;
+};
+
+// A payload held in a message without a copy.
+zmq::message_t messageOf(std::string&& bytes) {
+  auto* held = new std::string(std::move(bytes));
+  return zmq::message_t(held->data(), held->size(), [](void*, void* hint) { delete static_cast<std::string*>(hint); },
+                        held);
+}
+
+// What is kept of a decoded brick: its leaves' origins and its tiles (the caller adds the payload).
+KeptBrick keptOf(const BrickOutput& decoded) {
+  KeptBrick k;
+  k.origins.reserve(decoded.leaves.size());
+  for (const LeafBlock& l : decoded.leaves) k.origins.push_back(l.origin);
+  k.tiles = decoded.tiles;
+  return k;
+}
+
+// A result from its brick's holder, waiting to be verified (CRC, codec, inside the brick) and
+// decoded off the scheduling loop (Master::verifyArrivals).
+struct Arrival {
+  uint64_t brick = 0;
+  std::string routingId, workerId;
+  Result result;
+  zmq::message_t payload;
+  BrickOutput out;  // "mesh", "render": the decoded result
+  KeptBrick kept;   // "sample": origins and tiles (the leaves are decoded into scratch, not kept)
+  std::string error;
+  bool ok = false;
+};
+
 struct Peer {
   std::string workerId;
   uint32_t threads = 1;
@@ -101,7 +150,12 @@ struct Peer {
 class Master {
  public:
   Master(const JobSpec& job, const FarmOptions& opt)
-      : job_(job), opt_(opt), jobId_(jobIdOf(job)), grid_(gridOf(job)), op_(operationOf(job)) {
+      : job_(job),
+        opt_(opt),
+        jobId_(jobIdOf(job)),
+        grid_(gridOf(job)),
+        op_(operationOf(job)),
+        decoders_(opt.decodeThreads > 0 ? opt.decodeThreads : tbb::task_arena::automatic) {
     if (opt.brickVoxels < 8 || opt.brickVoxels % 8 != 0)
       throw std::invalid_argument("--brick must be a positive multiple of 8 voxels");
     if (op_ == Operation::Render && opt.brickVoxels % kRenderTile != 0)  // castRegion's regions
@@ -123,7 +177,12 @@ class Master {
         BrickOutput out;
         std::string err;
         if (!decodePayload(op_, payload.data(), payload.size(), out, &err) || !insideBrick(out, bricks_[id])) return;
-        commit(id, std::move(out), "journal", false);
+        KeptBrick kept;
+        if (op_ == Operation::Sample) {
+          kept = keptOf(out);
+          kept.payload = messageOf(std::string(payload));
+        }
+        commit(id, std::move(out), "journal", false, std::move(kept));
         ++report_.bricksFromJournal;
       });
       if (report_.bricksFromJournal)
@@ -158,7 +217,8 @@ class Master {
           bricks_.push_back(br);
           pending_.push_back(br.id);
         }
-    outputs_.resize(bricks_.size());
+    if (op_ == Operation::Sample) kept_.resize(bricks_.size());
+    else outputs_.resize(bricks_.size());
     report_.bricks = bricks_.size();
     size_t leaves = 0;
     for (auto& br : bricks_) leaves = std::max(leaves, br.maxLeaves);
@@ -176,8 +236,8 @@ class Master {
     }
   }
 
-  // A brick's result is final: keep it, journal it, count it.
-  void commit(uint64_t id, BrickOutput&& out, const std::string& who, bool computed) {
+  // A brick's result is final: keep it (for "sample", `kept`; out's leaves are not kept), count it.
+  void commit(uint64_t id, BrickOutput&& out, const std::string& who, bool computed, KeptBrick&& kept = {}) {
     Brick& b = bricks_[id];
     b.phase = BrickPhase::Done;
     for (auto& [rid, t] : b.holders)  // cancelled copies no longer take a worker's credit
@@ -186,8 +246,9 @@ class Master {
     leased_.erase(id);
     ++done_;
     if (op_ == Operation::Sample) {
-      report_.leaves += out.leaves.size();
-      report_.tiles += out.tiles.size();
+      report_.leaves += kept.origins.size();
+      report_.tiles += kept.tiles.size();
+      kept_[id] = std::move(kept);
     }
     if (computed) {
       ++report_.bricksComputed;
@@ -203,7 +264,7 @@ class Master {
       ++share.bricks;
       share.pointEvals += out.stats.pointEvals;
     }
-    outputs_[id] = std::move(out);
+    if (op_ != Operation::Sample) outputs_[id] = std::move(out);
   }
 
   void runInProcess() {
@@ -219,8 +280,14 @@ class Master {
       auto t0 = Clock::now();
       BrickOutput out = computeBrick(tape, job_, b.lo, b.hi, opt_.threads);
       report_.perWorker["in-process"].computeSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
-      if (journal_) journal_->append(b.id, encodePayload(op_, out));
-      commit(b.id, std::move(out), "in-process", true);
+      std::string payload = journal_ || op_ == Operation::Sample ? encodePayload(op_, out) : std::string();
+      if (journal_) journal_->append(b.id, payload);
+      KeptBrick kept;
+      if (op_ == Operation::Sample) {
+        kept = keptOf(out);
+        kept.payload = messageOf(std::move(payload));
+      }
+      commit(b.id, std::move(out), "in-process", true, std::move(kept));
       progress_->update(done_, report_.pointEvals, 1);
     }
   }
@@ -300,8 +367,11 @@ class Master {
         Incoming in;
         std::string err;
         if (!receive(router, true, in, &err, frameLimit)) break;
+        // Only results in a row share a batch: anything else sees the state they leave.
+        if (!err.empty() || in.envelope.body_case() != Envelope::kResult) verifyArrivals(router);
         handle(router, in, err);
       }
+      verifyArrivals(router);
       auto now = Clock::now();
       // The master's own stall (SIGSTOP, swapping, a slow disk): a turn is at most a poll
       // (a quarter beat) and a bounded drain, so a gap longer than the liveness window means
@@ -550,22 +620,69 @@ class Master {
       ++report_.duplicates;
       return;
     }
-    const auto& payload = *in.payload;
-    BrickOutput out;
-    std::string err;
-    bool ok = crc32Of(payload.data(), payload.size()) == r.payload_crc32() &&
-              decodePayload(op_, payload.data(), payload.size(), out, &err) && insideBrick(out, b);
-    if (!ok) {
+    // Verified and decoded with the results that arrived with it (verifyArrivals).
+    Arrival a;
+    a.brick = id;
+    a.routingId = in.routingId;
+    a.workerId = p.workerId;
+    a.result = std::move(*in.envelope.mutable_result());
+    a.payload = std::move(*in.payload);
+    arrivalBytes_ += a.payload.size();
+    arrivals_.push_back(std::move(a));
+    if (arrivals_.size() >= kMaxArrivals || arrivalBytes_ >= kMaxArrivalBytes) verifyArrivals(router);
+  }
+
+  // The results received in a row: CRC, codec and bounds checked, decoded and journaled in
+  // parallel on the decode threads (pure functions of each payload and its brick), then judged
+  // one by one in the order they arrived, as if each had been decoded on arrival; the merged
+  // output does not depend on that order anyway (outputs_ by brick, sorted in finish).
+  void verifyArrivals(zmq::socket_t& router) {
+    if (arrivals_.empty()) return;
+    decoders_.execute([&] {
+      tbb::parallel_for(size_t(0), arrivals_.size(), [&](size_t i) {
+        Arrival& a = arrivals_[i];
+        const void* data = a.payload.data();
+        // "sample": decoded into this thread's scratch (warm memory), only origins and tiles kept.
+        BrickOutput& out = op_ == Operation::Sample ? scratch_.local() : a.out;
+        a.ok = crc32Of(data, a.payload.size()) == a.result.payload_crc32() &&
+               decodePayload(op_, data, a.payload.size(), out, &a.error) && insideBrick(out, bricks_[a.brick]);
+        if (a.ok && op_ == Operation::Sample) a.kept = keptOf(out);
+        // Journaled before it is merged (judge); a copy that turns out to be a duplicate is
+        // harmless there (a resume merges the first record of a brick).
+        if (a.ok && journal_) journal_->add(a.brick, data, a.payload.size(), a.result.payload_crc32());
+      });
+    });
+    for (Arrival& a : arrivals_) judge(router, a);
+    arrivals_.clear();
+    arrivalBytes_ = 0;
+  }
+
+  void judge(zmq::socket_t& router, Arrival& a) {
+    Brick& b = bricks_[a.brick];
+    const uint64_t id = a.brick;
+    if (banned_.count(a.routingId)) {
+      // Its sender was dropped for garbage after sending it (an earlier result of this batch):
+      // ignored, as a message received after the ban would have been; the brick goes back.
+      if (b.phase == BrickPhase::Leased && b.holders.empty()) requeue(b, "worker " + a.workerId + " dropped", false);
+      return;
+    }
+    if (b.phase == BrickPhase::Done || b.phase == BrickPhase::Poisoned) {
+      ++report_.duplicates;  // another copy of this batch was merged first
+      return;
+    }
+    if (!a.ok) {
       // The holder's own brick came back corrupt: it counts as a failure of the brick (a brick
       // that breaks every worker's encoder is poisoned like one that fails), and the peer,
       // which sent garbage, is dropped.
       ++report_.malformed;
-      std::string why = "corrupt result from " + p.workerId + ": " + (err.empty() ? "crc or bounds" : err);
+      std::string why = "corrupt result from " + a.workerId + ": " + (a.error.empty() ? "crc or bounds" : a.error);
       spdlog::warn("dropped a {}", why);
       if (b.holders.empty()) requeue(b, why, true);
-      ban(router, in.routingId, "corrupt result for brick " + std::to_string(id));
+      ban(router, a.routingId, "corrupt result for brick " + std::to_string(id));
       return;
     }
+    const Result& r = a.result;
+    BrickOutput& out = a.out;
     out.stats.pointEvals = r.point_evals();
     out.stats.intervalEvals = r.interval_evals();
     out.stats.nanValues = r.nan_values();
@@ -573,16 +690,16 @@ class Master {
     out.extremumUncertified = r.extremum_uncertified();
     for (int k = 0; k < r.domain_errors_size() && k < int(kDomainErrorKinds); ++k)
       out.stats.domainErrors.n[k] = r.domain_errors(k);
-    report_.perWorker[p.workerId].computeSeconds += r.compute_seconds();
+    report_.perWorker[a.workerId].computeSeconds += r.compute_seconds();
     brickSeconds_.push_back(r.compute_seconds());
-    if (journal_) journal_->append(id, std::string(static_cast<const char*>(payload.data()), payload.size()));
     // Other holders (straggler backups) may drop the brick.
     for (auto& [rid, t] : b.holders) {
       Envelope c;
       c.mutable_cancel()->set_brick_id(id);
       send(router, rid, c);
     }
-    commit(id, std::move(out), p.workerId, true);
+    a.kept.payload = std::move(a.payload);
+    commit(id, std::move(out), a.workerId, true, std::move(a.kept));
   }
 
   bool insideBrick(const BrickOutput& out, const Brick& b) const {
@@ -710,11 +827,18 @@ class Master {
     }
   }
 
-  double medianBrickSeconds() const {
-    if (brickSeconds_.empty()) return 0;
-    std::vector<double> v = brickSeconds_;
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
+  // The median compute time of the merged bricks (lease and straggler timers). Every turn asks
+  // for it; it is recomputed only once the sample has grown by an eighth (or is small), so the
+  // whole job spends O(bricks) on it, not O(bricks) a turn.
+  double medianBrickSeconds() {
+    const size_t n = brickSeconds_.size();
+    if (n != medianOf_ && (n < 64 || n >= medianOf_ + medianOf_ / 8)) {
+      std::vector<double> v = brickSeconds_;
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      median_ = v[v.size() / 2];
+      medianOf_ = n;
+    }
+    return median_;
   }
 
   // Leases past their deadline are issued once more to someone else (the first holder keeps
@@ -836,6 +960,67 @@ class Master {
     }
   }
 
+  // The bricks' leaves sorted by origin (as sample() sorts them) and their tiles, one slab of
+  // bricks at a time: the bricks are planned x-slab by x-slab and the sort is by x first, so a
+  // slab's leaves follow all the leaves of the slabs before it. Each brick's payload is decoded
+  // (on the decode threads, into warm scratch) and its leaves copied straight to their sorted
+  // places; the slab's payloads are then freed, so the master holds the payloads or the output,
+  // not both.
+  void mergeLeaves(SampleResult& result) {
+    size_t leaves = 0;
+    for (const KeptBrick& k : kept_) {
+      leaves += k.origins.size();
+      result.tiles.insert(result.tiles.end(), k.tiles.begin(), k.tiles.end());
+    }
+    std::vector<LeafBlock> noLeaves;
+    sortByOrigin(noLeaves, result.tiles);
+    result.leaves.reserve(leaves);  // filled slab by slab: pages are touched as payloads are freed
+    const size_t perSlab = size_t((grid_.dims[1] + opt_.brickVoxels - 1) / opt_.brickVoxels) *
+                           size_t((grid_.dims[2] + opt_.brickVoxels - 1) / opt_.brickVoxels);
+    struct Ref {
+      std::array<int32_t, 3> origin;
+      uint32_t brick, leaf;  // brick within the slab, leaf within the brick
+    };
+    std::vector<Ref> refs;
+    std::vector<size_t> start, where;  // where[start[brick] + leaf]: the leaf's index in the output
+    size_t at = 0, untrimmed = 0;
+    for (size_t first = 0; first < kept_.size(); first += perSlab) {
+      const size_t last = std::min(kept_.size(), first + perSlab);
+      refs.clear();
+      start.assign(1, 0);
+      for (size_t i = first; i < last; ++i) {
+        for (size_t l = 0; l < kept_[i].origins.size(); ++l)
+          refs.push_back(Ref{kept_[i].origins[l], uint32_t(i - first), uint32_t(l)});
+        start.push_back(refs.size());
+      }
+      where.resize(refs.size());
+      result.leaves.resize(at + refs.size());
+      decoders_.execute([&] {
+        tbb::parallel_sort(refs.begin(), refs.end(), [](const Ref& a, const Ref& b) { return a.origin < b.origin; });
+        for (size_t r = 0; r < refs.size(); ++r) where[start[refs[r].brick] + refs[r].leaf] = at + r;
+        tbb::parallel_for(first, last, [&](size_t i) {
+          const KeptBrick& k = kept_[i];
+          if (k.origins.empty()) return;
+          BrickOutput& out = scratch_.local();
+          std::string err;
+          if (!decodePayload(op_, k.payload.data(), k.payload.size(), out, &err) || out.leaves.size() != k.origins.size())
+            throw std::logic_error("brick " + std::to_string(i) + ": its verified payload no longer decodes: " + err);
+          for (size_t l = 0; l < out.leaves.size(); ++l) result.leaves[where[start[i - first] + l]] = out.leaves[l];
+        });
+      });
+      at += refs.size();
+      for (size_t i = first; i < last; ++i) {
+        untrimmed += kept_[i].payload.size();
+        kept_[i] = KeptBrick{};
+      }
+      if (untrimmed > (size_t(64) << 20)) {
+        malloc_trim(0);  // give the freed pages back now (glibc keeps freed heap pages otherwise)
+        untrimmed = 0;
+      }
+    }
+    kept_.clear();
+  }
+
   FarmOutcome finish() {
     FarmOutcome o;
     report_.operation = op_ == Operation::Mesh ? "mesh" : op_ == Operation::Render ? "render" : "sample";
@@ -870,18 +1055,7 @@ class Master {
     }
     o.result.grid = grid_;
     o.result.bandVoxels = job_.band();
-    // One pass: order pointers to the bricks' leaves, then copy each leaf once (they are 2 KiB).
-    std::vector<const LeafBlock*> order;
-    for (auto& out : outputs_) {
-      for (const LeafBlock& l : out.leaves) order.push_back(&l);
-      o.result.tiles.insert(o.result.tiles.end(), out.tiles.begin(), out.tiles.end());
-    }
-    std::sort(order.begin(), order.end(), [](const LeafBlock* a, const LeafBlock* b) { return a->origin < b->origin; });
-    o.result.leaves.reserve(order.size());
-    for (const LeafBlock* l : order) o.result.leaves.push_back(*l);
-    std::vector<LeafBlock> noLeaves;
-    sortByOrigin(noLeaves, o.result.tiles);
-    outputs_.clear();
+    mergeLeaves(o.result);
     o.result.stats.pointEvals = report_.pointEvals;
     o.result.stats.intervalEvals = report_.intervalEvals;
     o.result.stats.nanValues = report_.nanValues;
@@ -905,9 +1079,16 @@ class Master {
   std::set<std::string> banned_;   // routing ids that sent garbage
   std::deque<std::string> bannedOrder_;
   std::map<std::string, std::string> aliases_;  // old routing id -> new, of reconnected workers
-  std::vector<BrickOutput> outputs_;
+  std::vector<BrickOutput> outputs_;  // "mesh", "render": the merged bricks' results, by brick
+  std::vector<KeptBrick> kept_;       // "sample": the merged bricks' payloads, by brick
+  tbb::enumerable_thread_specific<BrickOutput> scratch_;  // "sample": decoding, per thread
+  std::vector<Arrival> arrivals_;  // results received, not yet verified (verifyArrivals)
+  size_t arrivalBytes_ = 0;
+  tbb::task_arena decoders_;       // the decode threads (FarmOptions::decodeThreads)
   std::map<std::string, Peer> peers_;
   std::vector<double> brickSeconds_;
+  double median_ = 0;    // medianBrickSeconds() of the first medianOf_ entries
+  size_t medianOf_ = 0;
   std::set<uint64_t> leased_;  // bricks in phase Leased (timers scan only these)
   size_t payloadLimit_ = 0;
   size_t done_ = 0, poisoned_ = 0;

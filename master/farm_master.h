@@ -37,6 +37,7 @@ struct FarmOptions {
   std::string workerExecutable;  // local mode: path of frep-worker ("" = next to this program)
   int workerThreads = 1;         // local mode: threads per worker
   int threads = 0;               // in-process mode: threads per brick (0: all cores)
+  int decodeThreads = 0;         // farm: threads verifying and decoding results (0: all cores, 1: the loop's own)
   std::string logLevel = "warn"; // local mode: workers' --log-level
   // Called once the master is bound, with the actual endpoint (tcp://127.0.0.1:* picks a free
   // port): tests and embedders start their workers from it.

@@ -92,7 +92,7 @@ Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
     }
   }
   if (goodEnd > 0) {
-    file_ = openJournal(path, O_WRONLY | O_APPEND, "ab");
+    file_ = openJournal(path, O_WRONLY, "wb");  // records go at end_ (pwrite), not O_APPEND
     if (!file_ || ::ftruncate(fileno(file_), goodEnd) != 0)
       throw JournalIoError("cannot truncate journal " + path + ": " + std::strerror(errno));
   } else {
@@ -102,6 +102,7 @@ Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
   }
   if (std::fflush(file_) != 0 || std::ferror(file_))
     throw JournalIoError("cannot write journal " + path + ": " + std::strerror(errno));
+  end_ = goodEnd > 0 ? uint64_t(goodEnd) : uint64_t(sizeof kMagic + sizeof jobId);
   flush();
 }
 
@@ -109,14 +110,28 @@ Journal::~Journal() {
   if (file_) std::fclose(file_);
 }
 
+void Journal::add(uint64_t brick, const void* payload, size_t size, uint32_t crc) {
+  char head[kRecordHeader];
+  const uint64_t size64 = size;
+  std::memcpy(head, &brick, 8);
+  std::memcpy(head + 8, &crc, 4);
+  std::memcpy(head + 12, &size64, 8);
+  // Each record gets its own stretch of the file, so threads write theirs at once.
+  const uint64_t at = end_.fetch_add(uint64_t(kRecordHeader) + size);
+  auto writeAt = [&](const char* p, size_t n, uint64_t off) {
+    while (n > 0) {
+      const ssize_t w = ::pwrite(fileno(file_), p, n, off_t(off));
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) throw JournalIoError("cannot write journal " + path_ + ": " + std::strerror(w < 0 ? errno : ENOSPC));
+      p += w, n -= size_t(w), off += uint64_t(w);
+    }
+  };
+  writeAt(head, sizeof head, at);
+  writeAt(static_cast<const char*>(payload), size, at + kRecordHeader);
+}
+
 void Journal::append(uint64_t brick, const std::string& payload) {
-  uint32_t crc = crc32Of(payload.data(), payload.size());
-  uint64_t size = payload.size();
-  bool ok = std::fwrite(&brick, sizeof brick, 1, file_) == 1 && std::fwrite(&crc, sizeof crc, 1, file_) == 1 &&
-            std::fwrite(&size, sizeof size, 1, file_) == 1 &&
-            std::fwrite(payload.data(), 1, payload.size(), file_) == payload.size();
-  // Hand the record to the kernel now: a killed master loses nothing that was merged.
-  if (!ok || std::fflush(file_) != 0) throw JournalIoError("cannot write journal " + path_ + ": " + std::strerror(errno));
+  add(brick, payload.data(), payload.size(), crc32Of(payload.data(), payload.size()));
 }
 
 void Journal::flush() {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <atomic>
 #include <cstdio>
 #include <functional>
 #include <stdexcept>
@@ -32,7 +33,11 @@ class Journal {
   Journal(const Journal&) = delete;
   Journal& operator=(const Journal&) = delete;
 
-  void append(uint64_t brick, const std::string& payload);
+  // Appends a record (its payload's CRC-32 already known) straight to the kernel (pwrite), so
+  // a killed master loses none of it. Safe to call from several threads at once: each record
+  // takes its own stretch of the file (their order in it does not matter).
+  void add(uint64_t brick, const void* payload, size_t size, uint32_t crc);
+  void append(uint64_t brick, const std::string& payload);  // add, computing the CRC
   void flush();  // to the disk (fdatasync)
   void remove(); // after the output was written: the journal is no longer needed
   const std::string& path() const { return path_; }
@@ -40,6 +45,7 @@ class Journal {
  private:
   std::string path_;
   FILE* file_ = nullptr;
+  std::atomic<uint64_t> end_{0};  // where the next record goes
 };
 
 }  // namespace frep::farm

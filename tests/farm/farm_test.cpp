@@ -48,9 +48,13 @@ TEST(Farm, InProcessEqualsDirectSampling) {
 TEST(Farm, OneTwoAndFourWorkersGiveTheInProcessResult) {
   JobSpec j = job(96);
   FarmOutcome ref = runJob(j, fast(0));
-  for (int w : {1, 2, 4}) {
-    FarmOutcome o = runJob(j, fast(w));
-    SCOPED_TRACE(w);
+  // With 4 workers also decoding on the scheduling loop alone (decodeThreads 1), as before the
+  // decode threads: the same bytes either way.
+  for (auto [w, decodeThreads] : {std::pair{1, 0}, {2, 0}, {4, 0}, {4, 1}}) {
+    FarmOptions opt = fast(w);
+    opt.decodeThreads = decodeThreads;
+    FarmOutcome o = runJob(j, opt);
+    SCOPED_TRACE(std::to_string(w) + " workers, decodeThreads " + std::to_string(decodeThreads));
     expectSame(ref.result, o.result);
     EXPECT_EQ(o.report.bricksComputed, ref.report.bricks);
     EXPECT_EQ(o.report.pointEvals, ref.report.pointEvals);

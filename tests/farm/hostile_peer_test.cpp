@@ -297,6 +297,34 @@ TEST(HostilePeer, GarbageFromAWelcomedPeerDropsThePeerNotItsBricks) {
   expectSameLeaves(ref, master.outcome.result);
 }
 
+// Results received in a row are decoded together and judged in arrival order: a peer that sends
+// a corrupt result (banned) and right behind it a well-formed forged one for its other brick
+// must not have the second merged, whether or not both landed in one batch. The forged brick
+// goes back to the queue uncharged; the corrupt one is charged once.
+TEST(HostilePeer, AResultBehindACorruptOneFromTheSamePeerIsNotMerged) {
+  JobSpec j = sphereJob();
+  SampleResult ref = reference(j);
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
+  zmq::context_t ctx(1);
+  ScriptedPeer a(ctx, ep, "a");
+  std::vector<Envelope> held = a.collect(Envelope::kTask, 2);
+  ASSERT_EQ(held.size(), 2u);
+  a.forgeResult(jobIdOf(j), held[0].task(), /*corruptCrc=*/true);
+  a.forgeResult(jobIdOf(j), held[1].task());
+  EXPECT_EQ(a.collect(Envelope::kBye, 1, 2000).size(), 1u) << "the peer was not dropped";
+  a.s.set(zmq::sockopt::linger, 0);
+  EXPECT_EQ(runRealWorker(ep), 0);
+  master.join();
+  ASSERT_EQ(master.error, "");
+  const FarmReport& r = master.outcome.report;
+  EXPECT_TRUE(r.poisoned.empty());
+  EXPECT_EQ(r.bannedPeers, 1u);
+  EXPECT_EQ(r.bricksComputed, 8u);
+  EXPECT_EQ(r.perWorker.count("a"), 0u);
+  expectSameLeaves(ref, master.outcome.result);
+}
+
 // A worker whose master went silent reconnects under a new routing id and lists the bricks it
 // still has (Hello.holding): the leases it no longer holds (their results went out on the
 // closed connection) go back to the queue and come to it again. Before, it kept them: with every

@@ -8,7 +8,10 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <thread>
+#include <vector>
 
 #include "journal.h"
 
@@ -102,4 +105,55 @@ TEST(Journal, NeverOpensThroughASymlinkOrASpecialFile) {
   EXPECT_NE(::lstat((dir + "made").c_str(), &st), 0);
   // A regular journal still works.
   EXPECT_EQ((writeJournal(dir + "ok.journal", 2), replayed(dir + "ok.journal")), 2);
+}
+
+// Records added from several threads at once (the master's decode threads) each take their own
+// stretch of the file: all replay, intact. A resumed journal with a torn last record writes its
+// new records right after the last good one.
+TEST(Journal, RecordsAddedConcurrentlyAndAfterAResumeAllReplay) {
+  const std::string path = "/tmp/frep_journal_concurrent_" + std::to_string(getpid()) + ".journal";
+  std::remove(path.c_str());
+  const int threads = 4, perThread = 50;
+  auto payloadOf = [](uint64_t brick) { return std::string(1000 + brick, char('a' + brick % 26)); };
+  {
+    Journal j(path, 42, false, nullptr);
+    std::vector<std::thread> ts;
+    for (int t = 0; t < threads; ++t)
+      ts.emplace_back([&, t] {
+        for (int r = 0; r < perThread; ++r) j.append(uint64_t(t * perThread + r), payloadOf(uint64_t(t * perThread + r)));
+      });
+    for (auto& t : ts) t.join();
+  }
+  const std::string whole = readAll(path);
+  ASSERT_EQ(whole.size(), size_t(12 + threads * perThread * 20) + [&] {
+    size_t n = 0;
+    for (uint64_t b = 0; b < uint64_t(threads * perThread); ++b) n += payloadOf(b).size();
+    return n;
+  }());
+  std::set<uint64_t> seen;
+  auto replay = [&] {
+    seen.clear();
+    Journal j(path, 42, true, [&](uint64_t brick, const std::string& payload) {
+      EXPECT_EQ(payload, payloadOf(brick));
+      EXPECT_TRUE(seen.insert(brick).second) << "brick " << brick << " replayed twice";
+    });
+  };
+  replay();
+  EXPECT_EQ(seen.size(), size_t(threads * perThread));
+  // Tear the last record, resume (it is dropped), add two records: they follow the good ones.
+  ASSERT_EQ(truncate(path.c_str(), off_t(whole.size() - 10)), 0);
+  uint64_t torn = 0;
+  {
+    std::set<uint64_t> before;
+    Journal j(path, 42, true, [&](uint64_t brick, const std::string&) { before.insert(brick); });
+    EXPECT_EQ(before.size(), size_t(threads * perThread - 1));
+    for (uint64_t b = 0; b < uint64_t(threads * perThread); ++b)
+      if (!before.count(b)) torn = b;
+    j.append(torn, payloadOf(torn));
+    j.append(1000, payloadOf(1000));
+  }
+  replay();
+  EXPECT_EQ(seen.size(), size_t(threads * perThread + 1));
+  EXPECT_TRUE(seen.count(torn) && seen.count(1000));
+  std::remove(path.c_str());
 }
