@@ -1,14 +1,14 @@
 // Batch evaluator: one pass over the tape per batch of points, each instruction a tight loop
 // over structure-of-arrays lanes that the compiler vectorises (arithmetic, min/max, sqrt,
-// comparisons, select); transcendentals call libm per lane. The kernel is compiled for several
-// ISA levels (target_clones) and picked at run time; -ffp-contract=off keeps every clone
+// comparisons, select, sin/cos of sin_cos.h); other transcendentals call libm per lane. The
+// kernel is compiled for several ISA levels (target_clones) and picked at run time; -ffp-contract=off keeps every clone
 // bit-identical to the others and to the point evaluator for + - * / sqrt.
 #include <algorithm>
 #include <cmath>
-#include <math.h>  // sincos, sincosf (GNU)
 
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/pow_int.h"
+#include "frep/expressions/sin_cos.h"
 #include "frep/expressions/field_function.h"
 #include "frep/extremum/extremum.h"
 
@@ -23,41 +23,53 @@ namespace {
 #define FREP_CLONES
 #endif
 
-// sin and cos in one call. glibc's sincos/sincosf share the code paths of sin/cos and
-// sinf/cosf, so the bits are the same (checked on doubles over the whole range and on every
-// float); elsewhere, two calls.
-inline void sinCos(double x, double& s, double& c) {
-#ifdef __GLIBC__
-  ::sincos(x, &s, &c);
-#else
-  s = std::sin(x), c = std::cos(x);
-#endif
-}
-inline void sinCos(float x, float& s, float& c) {
-#ifdef __GLIBC__
-  ::sincosf(x, &s, &c);
-#else
-  s = std::sin(x), c = std::cos(x);
-#endif
+// Lanes (< n) whose argument is outside the own sin/cos range (sin_cos.h), NaN included.
+template <typename T>
+size_t lanesOutOfTrigRange(const T* a, size_t n) {
+  size_t bad = 0;
+  for (size_t i = 0; i < n; ++i) bad += !(std::fabs(a[i]) <= T(kOwnTrigLimit));
+  return bad;
 }
 
-// A Sin or Cos the tape's sinCosPlan pairs: the first of the pair writes both outputs (the
-// partner's register is free until the partner, see planSinCos), the second has nothing left
-// to do.
+// Sin or Cos of every lane (cos: isCos), or both (sinOut and cosOut non-null) when the tape's
+// sinCosPlan pairs them. In double whatever T is (a float lane gets the double result rounded).
+// Chunks of 8 through a local buffer: an output may be the input register. A batch with a lane
+// out of range takes the scalar path of the same functions (same bits on the other lanes).
 template <typename T>
-void runSinCos(const Instr& ins, uint32_t partnerOut, T* regs, size_t n) {
-  if (partnerOut == Tape::kSinCosDone) return;
-  constexpr size_t B = BatchEvaluator<T>::kBatch;
-  const T* a = regs + size_t(ins.a) * B;
-  T* s = regs + size_t(ins.out) * B;
-  T* c = regs + size_t(partnerOut) * B;
-  if (ins.op == Op::Cos) std::swap(s, c);
-  for (size_t i = 0; i < n; ++i) {
-    T sv, cv;
-    sinCos(a[i], sv, cv);  // a may be the partner's output register: read before writing
-    s[i] = sv;
-    c[i] = cv;
+FREP_CLONES void runTrig(const T* a, T* sinOut, T* cosOut, size_t n) {
+  if (lanesOutOfTrigRange(a, n)) {
+    for (size_t i = 0; i < n; ++i) {
+      double sv, cv;
+      ownSinCos(double(a[i]), sv, cv);
+      if (sinOut) sinOut[i] = T(sv);
+      if (cosOut) cosOut[i] = T(cv);
+    }
+    return;
   }
+  constexpr size_t C = 8;  // n is a multiple of 8
+  for (size_t i0 = 0; i0 < n; i0 += C) {
+    double sv[C], cv[C];
+    for (size_t j = 0; j < C; ++j) ownSinCosInRange(double(a[i0 + j]), sv[j], cv[j]);
+    if (sinOut)
+      for (size_t j = 0; j < C; ++j) sinOut[i0 + j] = T(sv[j]);
+    if (cosOut)
+      for (size_t j = 0; j < C; ++j) cosOut[i0 + j] = T(cv[j]);
+  }
+}
+
+// A Sin or Cos: alone, or the first of a pair of the tape's sinCosPlan, which writes both
+// outputs (the partner's register is free until the partner, see planSinCos); the second of a
+// pair has nothing left to do.
+template <typename T>
+void runSinOrCos(const Instr& ins, const uint32_t* plan, T* regs, size_t n) {
+  constexpr size_t B = BatchEvaluator<T>::kBatch;
+  const uint32_t partner = plan ? *plan : Tape::kNoSinCos;
+  if (partner == Tape::kSinCosDone) return;
+  const T* a = regs + size_t(ins.a) * B;
+  T* own = regs + size_t(ins.out) * B;
+  T* other = partner == Tape::kNoSinCos ? nullptr : regs + size_t(partner) * B;
+  if (ins.op == Op::Sin) runTrig(a, own, other, n);
+  else runTrig(a, other, own, n);
 }
 
 // Counts the lanes (< count) where an instruction hits a domain error; runs before the
@@ -115,18 +127,7 @@ FREP_CLONES void runTape(const Instr* code, const uint32_t* sinCos, size_t ninst
       case Op::Exp: LOOP(std::exp(a[i]));
       case Op::Log: LOOP(T(std::log(double(a[i]) > kLogFloor ? double(a[i]) : kLogFloor)));
       case Op::Log10: LOOP(T(std::log10(double(a[i]) > kLogFloor ? double(a[i]) : kLogFloor)));
-      case Op::Sin:
-        if (sinCos && sinCos[k] != Tape::kNoSinCos) {
-          runSinCos(ins, sinCos[k], regs, n);
-          break;
-        }
-        LOOP(std::sin(a[i]));
-      case Op::Cos:
-        if (sinCos && sinCos[k] != Tape::kNoSinCos) {
-          runSinCos(ins, sinCos[k], regs, n);
-          break;
-        }
-        LOOP(std::cos(a[i]));
+      case Op::Sin: case Op::Cos: runSinOrCos(ins, sinCos ? sinCos + k : nullptr, regs, n); break;
       case Op::Tan: LOOP(std::tan(a[i]));
       case Op::Asin: LOOP(std::asin(a[i] < T(-1) ? T(-1) : (a[i] > T(1) ? T(1) : a[i])));
       case Op::Acos: LOOP(std::acos(a[i] < T(-1) ? T(-1) : (a[i] > T(1) ? T(1) : a[i])));

@@ -1,0 +1,121 @@
+// sin and cos as every evaluator computes them (point, batch, gradient; the interval evaluator
+// widens by the error bound below): the one definition, so that all give the same bits, and
+// written as straight-line arithmetic so that the batch evaluator's lane loops vectorise
+// (libm's sin/cos are calls per lane).
+//
+// Method: Cody-Waite reduction x = k pi/2 + r with pi/2 split into three 33-bit parts (k * part
+// is exact for |k| < 2^20; x - k*P1 is exact by Sterbenz's lemma; the rounding errors of the
+// other two subtractions are kept as a low part rlo), then Taylor polynomials in z = r^2 on
+// |r| <= pi/4 (+ rounding): sin to r^17, cos to r^18 (truncation < 1e-3 ulp), corrected to first
+// order in rlo, and the quadrant k mod 4 picks +-sin(r) or +-cos(r). Only + - * in IEEE double: with
+// -ffp-contract=off the bits are the same for every ISA clone and every machine.
+// |x| > kOwnTrigLimit, infinities and NaN go to libm (the batch evaluator takes a scalar path
+// for a batch holding such a lane).
+//
+// Error (tests/core/own_sin_cos_test.cpp measures it against long double): within
+// kOwnTrigUlps ulp of the true value (the last rounding, 0.5 ulp, plus < 0.3 ulp from the
+// polynomial and the first-order correction) plus an absolute kOwnTrigAbsErr, which covers the
+// reduction near zeros of sin/cos: pi/2 - (P1 + P2 + P3) ~ 8.5e-32 times |k| <= 2^19 is 4.5e-26.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+namespace frep {
+
+constexpr double kOwnTrigLimit = 0x1p19;   // |x| above this: libm
+constexpr int kOwnTrigUlps = 1;            // relative part of the error bound
+constexpr double kOwnTrigAbsErr = 0x1p-80; // absolute part (8.3e-25 > 4.5e-26 + 1e-31)
+
+namespace trig_detail {
+
+// pi/2 = P1 + P2 + P3 + O(8.5e-32): 33 significant bits each (the fdlibm split).
+constexpr double kP1 = 1.57079632673412561417e+00;
+constexpr double kP2 = 6.07710050630396597660e-11;
+constexpr double kP3 = 2.02226624871116645580e-21;
+constexpr double kTwoOverPi = 6.36619772367581382433e-01;
+constexpr double kRound = 0x1.8p52;  // (t + kRound) - kRound rounds t to an integer, |t| < 2^51
+
+constexpr double fact(int n) { return n <= 1 ? 1.0 : n * fact(n - 1); }  // exact up to 22!
+
+// a + b = s + e exactly (Knuth's TwoSum, any magnitudes).
+inline void twoSum(double a, double b, double& sum, double& err) {
+  sum = a + b;
+  const double bb = sum - a;
+  err = (a - (sum - bb)) + (b - bb);
+}
+
+// sin and cos of r + rlo for |r| <= pi/4 (a hair more after rounding of k), |rlo| <= ulp(r):
+// sin(r + rlo) ~ sin r + rlo (1 - r^2/2), cos(r + rlo) ~ cos r - rlo r.
+inline void kernel(double r, double rlo, double& s, double& c) {
+  const double z = r * r;
+  double ps = -1 / fact(17);
+  ps = ps * z + 1 / fact(15);
+  ps = ps * z - 1 / fact(13);
+  ps = ps * z + 1 / fact(11);
+  ps = ps * z - 1 / fact(9);
+  ps = ps * z + 1 / fact(7);
+  ps = ps * z - 1 / fact(5);
+  ps = ps * z + 1 / fact(3);
+  const double h = 0.5 * z;
+  // r - r^3/3! + ...; sin(r) has the sign of r (copysign: sin(-0) = -0, as libm's)
+  s = std::copysign(r + ((rlo - h * rlo) - r * z * ps), r);
+  double pc = 1 / fact(18);
+  pc = pc * z - 1 / fact(16);
+  pc = pc * z + 1 / fact(14);
+  pc = pc * z - 1 / fact(12);
+  pc = pc * z + 1 / fact(10);
+  pc = pc * z - 1 / fact(8);
+  pc = pc * z + 1 / fact(6);
+  pc = pc * z - 1 / fact(4);
+  // 1 - r^2/2 + r^4/4! - ...; (1 - w) - h is the exact rounding error of w = 1 - h
+  const double w = 1.0 - h;
+  c = w + (((1.0 - w) - h) - (z * z * pc + r * rlo));
+}
+
+}  // namespace trig_detail
+
+// Both for |x| <= kOwnTrigLimit (no check: the caller tests ownTrigInRange).
+inline void ownSinCosInRange(double x, double& sinX, double& cosX) {
+  using namespace trig_detail;
+  const double kb = x * kTwoOverPi + kRound;
+  const double k = kb - kRound;
+  uint64_t bits;
+  std::memcpy(&bits, &kb, sizeof bits);  // low mantissa bits of kb: k mod 4 (kRound = 3 * 2^51)
+  // x - k P1 is exact; the two other subtractions keep their rounding errors in rlo
+  double t2, e2, r, e3;
+  twoSum(x - k * kP1, -(k * kP2), t2, e2);
+  twoSum(t2, -(k * kP3), r, e3);
+  double s, c;
+  trig_detail::kernel(r, e2 + e3, s, c);
+  const bool swap = bits & 1, negSin = bits & 2, negCos = (bits + 1) & 2;
+  const double sv = swap ? c : s, cv = swap ? s : c;
+  sinX = negSin ? -sv : sv;
+  cosX = negCos ? -cv : cv;
+}
+
+inline bool ownTrigInRange(double x) { return std::fabs(x) <= kOwnTrigLimit; }  // false for NaN
+
+inline double ownSin(double x) {
+  if (!ownTrigInRange(x)) return std::sin(x);
+  double s, c;
+  ownSinCosInRange(x, s, c);
+  return s;
+}
+inline double ownCos(double x) {
+  if (!ownTrigInRange(x)) return std::cos(x);
+  double s, c;
+  ownSinCosInRange(x, s, c);
+  return c;
+}
+inline void ownSinCos(double x, double& s, double& c) {
+  if (ownTrigInRange(x)) {
+    ownSinCosInRange(x, s, c);
+  } else {
+    s = std::sin(x);
+    c = std::cos(x);
+  }
+}
+
+}  // namespace frep
