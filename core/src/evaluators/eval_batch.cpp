@@ -123,7 +123,8 @@ FREP_CLONES void runTape(const Instr* code, const uint32_t* sinCos, size_t ninst
     switch (ins.op) {
       case Op::Neg: LOOP(-a[i]);
       case Op::Abs: LOOP(std::fabs(a[i]));
-      case Op::Sqrt: LOOP(a[i] > T(0) ? std::sqrt(a[i]) : T(0));
+      // sqrt(max(a, 0)): the bits of "a > 0 ? sqrt(a) : 0" (NaN -> 0 too), without a branch
+      case Op::Sqrt: LOOP(std::sqrt(a[i] > T(0) ? a[i] : T(0)));
       case Op::Exp: LOOP(std::exp(a[i]));
       case Op::Log: LOOP(T(std::log(double(a[i]) > kLogFloor ? double(a[i]) : kLogFloor)));
       case Op::Log10: LOOP(T(std::log10(double(a[i]) > kLogFloor ? double(a[i]) : kLogFloor)));
@@ -178,13 +179,13 @@ FREP_CLONES void runTape(const Instr* code, const uint32_t* sinCos, size_t ninst
         if (ins.imm == 0.0) {
           for (size_t i = 0; i < n; ++i) {
             T s = a[i] * a[i] + b[i] * b[i];
-            T root = s > T(0) ? std::sqrt(s) : T(0);
+            T root = std::sqrt(s > T(0) ? s : T(0));
             o[i] = a[i] + b[i] + sg * root;
           }
         } else {
           for (size_t i = 0; i < n; ++i) {
             T s = a[i] * a[i] + b[i] * b[i] - T(2) * al * a[i] * b[i];
-            T root = s > T(0) ? std::sqrt(s) : T(0);
+            T root = std::sqrt(s > T(0) ? s : T(0));
             o[i] = (a[i] + b[i] + sg * root) / (T(1) + al);
           }
         }
