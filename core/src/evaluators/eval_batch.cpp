@@ -24,36 +24,45 @@ namespace {
 #endif
 
 // Lanes (< n) whose argument is outside the own sin/cos range (sin_cos.h), NaN included.
-template <typename T>
-size_t lanesOutOfTrigRange(const T* a, size_t n) {
+inline size_t lanesOutOfTrigRange(const double* a, size_t n) {
   size_t bad = 0;
-  for (size_t i = 0; i < n; ++i) bad += !(std::fabs(a[i]) <= T(kOwnTrigLimit));
+  for (size_t i = 0; i < n; ++i) bad += !(std::fabs(a[i]) <= kOwnTrigLimit);
+  return bad;
+}
+inline size_t lanesOutOfTrigRange(const float* a, size_t n) {
+  size_t bad = 0;
+  for (size_t i = 0; i < n; ++i) bad += !(std::fabs(a[i]) <= kOwnTrigLimitFloat);
   return bad;
 }
 
-// Sin or Cos of every lane (cos: isCos), or both (sinOut and cosOut non-null) when the tape's
-// sinCosPlan pairs them. In double whatever T is (a float lane gets the double result rounded).
-// Chunks of 8 through a local buffer: an output may be the input register. A batch with a lane
-// out of range takes the scalar path of the same functions (same bits on the other lanes).
+// Sin or Cos of every lane, or both (sinOut and cosOut non-null) when the tape's sinCosPlan
+// pairs them: ownSinCos in double, ownSinCosFloat in float (sin_cos.h). Chunks through a local
+// buffer: an output may be the input register. A batch with a lane out of range takes the scalar
+// path of the same functions (same bits on the other lanes).
+inline void trigLane(double x, double& s, double& c) { ownSinCosInRange(x, s, c); }
+inline void trigLane(float x, float& s, float& c) { ownSinCosInRangeFloat(x, s, c); }
+inline void trigLaneChecked(double x, double& s, double& c) { ownSinCos(x, s, c); }
+inline void trigLaneChecked(float x, float& s, float& c) { ownSinCosFloat(x, s, c); }
+
 template <typename T>
 FREP_CLONES void runTrig(const T* a, T* sinOut, T* cosOut, size_t n) {
   if (lanesOutOfTrigRange(a, n)) {
     for (size_t i = 0; i < n; ++i) {
-      double sv, cv;
-      ownSinCos(double(a[i]), sv, cv);
-      if (sinOut) sinOut[i] = T(sv);
-      if (cosOut) cosOut[i] = T(cv);
+      T sv, cv;
+      trigLaneChecked(a[i], sv, cv);
+      if (sinOut) sinOut[i] = sv;
+      if (cosOut) cosOut[i] = cv;
     }
     return;
   }
   constexpr size_t C = 8;  // n is a multiple of 8
   for (size_t i0 = 0; i0 < n; i0 += C) {
-    double sv[C], cv[C];
-    for (size_t j = 0; j < C; ++j) ownSinCosInRange(double(a[i0 + j]), sv[j], cv[j]);
+    T sv[C], cv[C];
+    for (size_t j = 0; j < C; ++j) trigLane(a[i0 + j], sv[j], cv[j]);
     if (sinOut)
-      for (size_t j = 0; j < C; ++j) sinOut[i0 + j] = T(sv[j]);
+      for (size_t j = 0; j < C; ++j) sinOut[i0 + j] = sv[j];
     if (cosOut)
-      for (size_t j = 0; j < C; ++j) cosOut[i0 + j] = T(cv[j]);
+      for (size_t j = 0; j < C; ++j) cosOut[i0 + j] = cv[j];
   }
 }
 

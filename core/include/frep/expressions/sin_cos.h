@@ -74,6 +74,28 @@ inline void kernel(double r, double rlo, double& s, double& c) {
   c = w + (((1.0 - w) - h) - (z * z * pc + r * rlo));
 }
 
+// Float lanes (the float batch path only), in float arithmetic so that a vector holds twice the
+// lanes: pi/2 = F1 + F2 + F3 with 11-bit F1, F2 (k * F exact for |k| < 2^13) and a 24-bit F3
+// (tail 1.7e-15); Taylor sin to r^9, cos to r^10 (truncation < 3e-9 relative).
+constexpr float kF1 = 0x1.92p+0f, kF2 = 0x1.fb4p-12f, kF3 = 0x1.4442d2p-24f;
+constexpr float kTwoOverPiF = 0x1.45f306p-1f;
+constexpr float kRoundF = 0x1.8p23f;  // (t + kRoundF) - kRoundF rounds t, |t| < 2^22
+
+inline void kernelFloat(float r, float& s, float& c) {
+  const float z = r * r;
+  float ps = float(1 / fact(9));
+  ps = ps * z - float(1 / fact(7));
+  ps = ps * z + float(1 / fact(5));
+  ps = ps * z - float(1 / fact(3));
+  s = std::copysign(r + r * z * ps, r);  // sin(-0) = -0
+  float pc = float(-1 / fact(10));
+  pc = pc * z + float(1 / fact(8));
+  pc = pc * z - float(1 / fact(6));
+  pc = pc * z + float(1 / fact(4));
+  const float h = 0.5f * z, w = 1.0f - h;
+  c = w + (((1.0f - w) - h) + z * z * pc);
+}
+
 }  // namespace trig_detail
 
 // Both for |x| <= kOwnTrigLimit (no check: the caller tests ownTrigInRange).
@@ -115,6 +137,37 @@ inline void ownSinCos(double x, double& s, double& c) {
   } else {
     s = std::sin(x);
     c = std::cos(x);
+  }
+}
+
+// Float lanes: within 2 float ulps of the true value plus 1e-9 absolute (the float reduction) for
+// |x| <= kOwnTrigLimitFloat; beyond, the double functions rounded to float. Only the float batch
+// path uses these (tests/core/own_sin_cos_test.cpp measures them).
+constexpr float kOwnTrigLimitFloat = 0x1p13f;
+inline bool ownTrigInRangeFloat(float x) { return std::fabs(x) <= kOwnTrigLimitFloat; }
+
+inline void ownSinCosInRangeFloat(float x, float& sinX, float& cosX) {
+  using namespace trig_detail;
+  const float kb = x * kTwoOverPiF + kRoundF;
+  const float k = kb - kRoundF;
+  uint32_t bits;
+  std::memcpy(&bits, &kb, sizeof bits);  // low mantissa bits of kb: k mod 4 (kRoundF = 3 * 2^22)
+  const float r = ((x - k * kF1) - k * kF2) - k * kF3;
+  float s, c;
+  kernelFloat(r, s, c);
+  const bool swap = bits & 1, negSin = bits & 2, negCos = (bits + 1) & 2;
+  const float sv = swap ? c : s, cv = swap ? s : c;
+  sinX = negSin ? -sv : sv;
+  cosX = negCos ? -cv : cv;
+}
+inline void ownSinCosFloat(float x, float& s, float& c) {
+  if (ownTrigInRangeFloat(x)) {
+    ownSinCosInRangeFloat(x, s, c);
+  } else {
+    double sd, cd;
+    ownSinCos(double(x), sd, cd);
+    s = float(sd);
+    c = float(cd);
   }
 }
 
