@@ -45,6 +45,19 @@ inline void trigLaneChecked(double x, double& s, double& c) { ownSinCos(x, s, c)
 inline void trigLaneChecked(float x, float& s, float& c) { ownSinCosFloat(x, s, c); }
 
 template <typename T>
+constexpr size_t kTrigChunk = sizeof(T) == 8 ? 32 : 64;
+
+template <typename T, size_t C>
+inline __attribute__((always_inline)) void trigChunk(const T* a, T* sinOut, T* cosOut, size_t i0) {
+  T sv[C], cv[C];
+  for (size_t j = 0; j < C; ++j) trigLane(a[j], sv[j], cv[j]);
+  if (sinOut)
+    for (size_t j = 0; j < C; ++j) sinOut[i0 + j] = sv[j];
+  if (cosOut)
+    for (size_t j = 0; j < C; ++j) cosOut[i0 + j] = cv[j];
+}
+
+template <typename T>
 FREP_CLONES void runTrig(const T* a, T* sinOut, T* cosOut, size_t n) {
   if (lanesOutOfTrigRange(a, n)) {
     for (size_t i = 0; i < n; ++i) {
@@ -55,15 +68,11 @@ FREP_CLONES void runTrig(const T* a, T* sinOut, T* cosOut, size_t n) {
     }
     return;
   }
-  constexpr size_t C = 8;  // n is a multiple of 8
-  for (size_t i0 = 0; i0 < n; i0 += C) {
-    T sv[C], cv[C];
-    for (size_t j = 0; j < C; ++j) trigLane(a[i0 + j], sv[j], cv[j]);
-    if (sinOut)
-      for (size_t j = 0; j < C; ++j) sinOut[i0 + j] = sv[j];
-    if (cosOut)
-      for (size_t j = 0; j < C; ++j) cosOut[i0 + j] = cv[j];
-  }
+  // Chunks of several vectors (C lanes), so that the polynomials' independent chains overlap;
+  // n is a multiple of 8, the rest goes by 8.
+  size_t i0 = 0;
+  for (; i0 + kTrigChunk<T> <= n; i0 += kTrigChunk<T>) trigChunk<T, kTrigChunk<T>>(a + i0, sinOut, cosOut, i0);
+  for (; i0 < n; i0 += 8) trigChunk<T, 8>(a + i0, sinOut, cosOut, i0);
 }
 
 // A Sin or Cos: alone, or the first of a pair of the tape's sinCosPlan, which writes both
@@ -115,12 +124,103 @@ void runField(const FieldFunction& fn, const Instr& ins, T* regs, size_t n) {
   for (size_t i = 0; i < n; ++i) o[i] = T(out[i]);
 }
 
+// A binary op over the lanes with a uniform operand (a constant: its register holds one value in
+// every lane), read once as a scalar: a load less per lane, and the constants' registers stay
+// out of the cache. Same operations on the same values: the same bits (a finite constant leaves
+// no choice of which NaN propagates). Returns false when neither operand is uniform.
+template <typename T, typename F>
+inline __attribute__((always_inline)) bool uniformLoop(const T* a, const T* b, T* __restrict o, size_t n,
+                                                       bool aUniform, bool bUniform, F f) {
+  if (bUniform) {
+    const T y = b[0];
+    for (size_t i = 0; i < n; ++i) o[i] = f(a[i], y);
+  } else if (aUniform) {
+    const T x = a[0];
+    for (size_t i = 0; i < n; ++i) o[i] = f(x, b[i]);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// Fused in-place chains (tape specialisation). The tape's register allocator writes
+// "t = x - c; t = t^2; t = d - t" into one register, so each intermediate value is overwritten by
+// the next instruction and read by nothing else: one loop computes the chain with the same
+// operations in the same order (same bits), without storing and reloading the intermediates.
+// Returns how many instructions it ran (0: no pattern here).
+inline bool isSquare(const Instr& i) { return i.op == Op::PowI && i.imm == 2.0; }
+inline bool squaresInPlace(const Instr& next, uint32_t r) { return isSquare(next) && next.a == r && next.out == r; }
+// next = u - r or next = r - u (in place on r, u another register)
+inline int subtractsInPlace(const Instr& next, uint32_t r) {
+  if (next.op != Op::Sub || next.out != r) return 0;
+  if (next.b == r && next.a != r) return 1;  // u - r
+  if (next.a == r && next.b != r) return 2;  // r - u
+  return 0;
+}
+
+template <typename T>
+inline __attribute__((always_inline)) size_t runFused(const Instr* code, size_t k, size_t ninstr, T* regs, size_t n,
+                                                      uint32_t numUniforms) {
+  constexpr size_t B = BatchEvaluator<T>::kBatch;
+  const Instr& i0 = code[k];
+  const uint32_t r = i0.out;
+  auto reg = [&](uint32_t q) { return regs + size_t(q) * B; };
+  T* __restrict o = reg(r);
+  if ((i0.op == Op::Add || i0.op == Op::Sub) && i0.b < numUniforms && i0.a != r && k + 1 < ninstr &&
+      squaresInPlace(code[k + 1], r)) {
+    // (x +- c)^2, then maybe d - that or that - d
+    const T* x = reg(i0.a);
+    const T c = reg(i0.b)[0];
+    const int sub = k + 2 < ninstr ? subtractsInPlace(code[k + 2], r) : 0;
+    const uint32_t dq = sub == 1 ? code[k + 2].a : code[k + 2].b;
+    const bool three = sub && dq < numUniforms;
+    const T d = three ? reg(dq)[0] : T(0);
+    auto chain = [&](auto first) {
+      if (three && sub == 1) {
+        for (size_t i = 0; i < n; ++i) { const T t = first(x[i], c); o[i] = d - t * t; }
+      } else if (three) {
+        for (size_t i = 0; i < n; ++i) { const T t = first(x[i], c); o[i] = t * t - d; }
+      } else {
+        for (size_t i = 0; i < n; ++i) { const T t = first(x[i], c); o[i] = t * t; }
+      }
+    };
+    if (i0.op == Op::Add) chain([](T p, T q) { return p + q; });
+    else chain([](T p, T q) { return p - q; });
+    return three ? 3 : 2;
+  }
+  if (isSquare(i0) && i0.a != r && k + 1 < ninstr) {
+    // x^2 then u - that or that - u (u a register or a constant)
+    const int sub = subtractsInPlace(code[k + 1], r);
+    if (!sub) return 0;
+    const T* x = reg(i0.a);
+    const uint32_t uq = sub == 1 ? code[k + 1].a : code[k + 1].b;
+    const T* u = reg(uq);
+    const bool uUniform = uq < numUniforms;
+    if (uUniform) {
+      const T uv = u[0];
+      if (sub == 1) for (size_t i = 0; i < n; ++i) o[i] = uv - x[i] * x[i];
+      else for (size_t i = 0; i < n; ++i) o[i] = x[i] * x[i] - uv;
+    } else {
+      if (sub == 1) for (size_t i = 0; i < n; ++i) o[i] = u[i] - x[i] * x[i];
+      else for (size_t i = 0; i < n; ++i) o[i] = x[i] * x[i] - u[i];
+    }
+    return 2;
+  }
+  return 0;
+}
+
 template <typename T>
 FREP_CLONES void runTape(const Instr* code, const uint32_t* sinCos, size_t ninstr, T* __restrict regs, size_t n,
-                         DomainCounts* dom, size_t count, const std::shared_ptr<const FieldFunction>* fields) {
+                         DomainCounts* dom, size_t count, const std::shared_ptr<const FieldFunction>* fields,
+                         uint32_t nu) {
   constexpr size_t B = BatchEvaluator<T>::kBatch;
   for (size_t k = 0; k < ninstr; ++k) {
     const Instr& ins = code[k];
+    // (no fused op can hit a domain error: + - * only)
+    if (const size_t fused = runFused(code, k, ninstr, regs, n, nu)) {
+      k += fused - 1;
+      continue;
+    }
     T* __restrict o = regs + size_t(ins.out) * B;
     const T* a = regs + size_t(ins.a) * B;
     const T* b = regs + size_t(ins.b) * B;
@@ -162,14 +262,18 @@ FREP_CLONES void runTape(const Instr* code, const uint32_t* sinCos, size_t ninst
       }
       case Op::Not: LOOP(a[i] == T(0) ? T(1) : T(0));
       case Op::Copy: LOOP(a[i]);
-      case Op::Add: LOOP(a[i] + b[i]);
-      case Op::Sub: LOOP(a[i] - b[i]);
-      case Op::Mul: LOOP(a[i] * b[i]);
-      case Op::Div: LOOP(a[i] / b[i]);
+#define BINARY(expr) \
+  if (!uniformLoop(a, b, o, n, ins.a < nu, ins.b < nu, [](T x, T y) { return (expr); })) \
+    for (size_t i = 0; i < n; ++i) { const T x = a[i], y = b[i]; o[i] = (expr); } \
+  break
+      case Op::Add: BINARY(x + y);
+      case Op::Sub: BINARY(x - y);
+      case Op::Mul: BINARY(x * y);
+      case Op::Div: BINARY(x / y);
       case Op::Pow: LOOP(std::pow(a[i], b[i]));
       case Op::Atan2: LOOP(std::atan2(a[i], b[i]));
-      case Op::Min: LOOP(b[i] < a[i] ? b[i] : a[i]);
-      case Op::Max: LOOP(b[i] > a[i] ? b[i] : a[i]);
+      case Op::Min: BINARY(y < x ? y : x);
+      case Op::Max: BINARY(y > x ? y : x);
       case Op::Fmod: LOOP(std::fmod(a[i], b[i]));
       case Op::Lt: LOOP(a[i] < b[i] ? T(1) : T(0));
       case Op::Le: LOOP(a[i] <= b[i] ? T(1) : T(0));
@@ -203,6 +307,7 @@ FREP_CLONES void runTape(const Instr* code, const uint32_t* sinCos, size_t ninst
       default: break;
     }
 #undef LOOP
+#undef BINARY
   }
 }
 
@@ -241,18 +346,19 @@ const T* BatchEvaluator<T>::eval(const Tape& tape, size_t count) {
   const uint32_t* sinCos = tape.sinCosPlan().empty() ? nullptr : tape.sinCosPlan().data();
   auto at = [&](size_t k) { return sinCos ? sinCos + k : nullptr; };
   const auto* fields = tape.fields().data();
+  const uint32_t nu = tape.numUniforms();
   if (!tape.hasExtrema()) {
-    runTape<T>(code.data(), sinCos, code.size(), regs_.data(), n, domain_, count, fields);
+    runTape<T>(code.data(), sinCos, code.size(), regs_.data(), n, domain_, count, fields, nu);
   } else {
     // Straight-line segments between extremum instructions run vectorised as usual.
     size_t start = 0;
     for (size_t k = 0; k < code.size(); ++k) {
       if (code[k].op != Op::Extremum) continue;
-      runTape<T>(code.data() + start, at(start), k - start, regs_.data(), n, domain_, count, fields);
+      runTape<T>(code.data() + start, at(start), k - start, regs_.data(), n, domain_, count, fields, nu);
       runExtremum(tape, code[k], count);
       start = k + 1;
     }
-    runTape<T>(code.data() + start, at(start), code.size() - start, regs_.data(), n, domain_, count, fields);
+    runTape<T>(code.data() + start, at(start), code.size() - start, regs_.data(), n, domain_, count, fields, nu);
   }
   return regs_.data() + size_t(tape.resultReg()) * kBatch;
 }

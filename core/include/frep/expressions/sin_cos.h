@@ -3,19 +3,18 @@
 // written as straight-line arithmetic so that the batch evaluator's lane loops vectorise
 // (libm's sin/cos are calls per lane).
 //
-// Method: Cody-Waite reduction x = k pi/2 + r with pi/2 split into three 33-bit parts (k * part
-// is exact for |k| < 2^20; x - k*P1 is exact by Sterbenz's lemma; the rounding errors of the
-// other two subtractions are kept as a low part rlo), then Taylor polynomials in z = r^2 on
-// |r| <= pi/4 (+ rounding): sin to r^17, cos to r^18 (truncation < 1e-3 ulp), corrected to first
-// order in rlo, and the quadrant k mod 4 picks +-sin(r) or +-cos(r). Only + - * in IEEE double: with
-// -ffp-contract=off the bits are the same for every ISA clone and every machine.
-// |x| > kOwnTrigLimit, infinities and NaN go to libm (the batch evaluator takes a scalar path
-// for a batch holding such a lane).
+// Method: Cody-Waite reduction x = k pi/2 + r with pi/2 = P1 + P2, P1 of 33 bits (k P1 exact for
+// |k| < 2^20, and x - k P1 exact by Sterbenz's lemma), then Taylor polynomials in z = r^2 on
+// |r| <= pi/4 (+ rounding): sin to r^17, cos to r^16 (truncation < 0.03 ulp), and the quadrant
+// k mod 4 picks +-sin(r) or +-cos(r). Only + - * in IEEE double: with -ffp-contract=off the
+// bits are the same for every ISA clone and every machine. |x| > kOwnTrigLimit, infinities and
+// NaN go to libm (the batch evaluator takes a scalar path for a batch holding such a lane).
 //
-// Error (tests/core/own_sin_cos_test.cpp measures it against long double): within
-// kOwnTrigUlps ulp of the true value (the last rounding, 0.5 ulp, plus < 0.3 ulp from the
-// polynomial and the first-order correction) plus an absolute kOwnTrigAbsErr, which covers the
-// reduction near zeros of sin/cos: pi/2 - (P1 + P2 + P3) ~ 8.5e-32 times |k| <= 2^19 is 4.5e-26.
+// Error (tests/core/own_sin_cos_test.cpp measures it against long double, max ~1.3 ulp): within
+// kOwnTrigUlps ulps of the true value (0.5 ulp of r from the rounded subtraction, 0.5 ulp final
+// rounding, < 0.3 ulp from the polynomial) plus an absolute kOwnTrigAbsErr, which covers the
+// reduction near zeros of sin/cos: the rounding of k P2 (<= 2^-54 * 2^19 * 6.1e-11 = 3.4e-21)
+// and the tail of pi/2 - (P1 + P2) (3.5e-27 times |k| <= 2^19).
 #pragma once
 
 #include <cmath>
@@ -25,30 +24,22 @@
 namespace frep {
 
 constexpr double kOwnTrigLimit = 0x1p19;   // |x| above this: libm
-constexpr int kOwnTrigUlps = 1;            // relative part of the error bound
-constexpr double kOwnTrigAbsErr = 0x1p-80; // absolute part (8.3e-25 > 4.5e-26 + 1e-31)
+constexpr int kOwnTrigUlps = 2;            // relative part of the error bound
+constexpr double kOwnTrigAbsErr = 0x1p-64; // absolute part (5.4e-20 > 2^19 * 3.5e-27 + 3.4e-21)
 
 namespace trig_detail {
 
-// pi/2 = P1 + P2 + P3 + O(8.5e-32): 33 significant bits each (the fdlibm split).
-constexpr double kP1 = 1.57079632673412561417e+00;
-constexpr double kP2 = 6.07710050630396597660e-11;
-constexpr double kP3 = 2.02226624871116645580e-21;
+// pi/2 = P1 + P2 + 3.5e-27: P1 with 33 significant bits (k P1 exact for |k| < 2^20), P2 the
+// rest rounded to double.
+constexpr double kP1 = 0x1.921fb544p+0;
+constexpr double kP2 = 0x1.0b4611a626331p-34;
 constexpr double kTwoOverPi = 6.36619772367581382433e-01;
 constexpr double kRound = 0x1.8p52;  // (t + kRound) - kRound rounds t to an integer, |t| < 2^51
 
 constexpr double fact(int n) { return n <= 1 ? 1.0 : n * fact(n - 1); }  // exact up to 22!
 
-// a + b = s + e exactly (Knuth's TwoSum, any magnitudes).
-inline void twoSum(double a, double b, double& sum, double& err) {
-  sum = a + b;
-  const double bb = sum - a;
-  err = (a - (sum - bb)) + (b - bb);
-}
-
-// sin and cos of r + rlo for |r| <= pi/4 (a hair more after rounding of k), |rlo| <= ulp(r):
-// sin(r + rlo) ~ sin r + rlo (1 - r^2/2), cos(r + rlo) ~ cos r - rlo r.
-inline void kernel(double r, double rlo, double& s, double& c) {
+// sin and cos of r for |r| <= pi/4 (a hair more after rounding of k).
+inline void kernel(double r, double& s, double& c) {
   const double z = r * r;
   double ps = -1 / fact(17);
   ps = ps * z + 1 / fact(15);
@@ -58,11 +49,9 @@ inline void kernel(double r, double rlo, double& s, double& c) {
   ps = ps * z + 1 / fact(7);
   ps = ps * z - 1 / fact(5);
   ps = ps * z + 1 / fact(3);
-  const double h = 0.5 * z;
   // r - r^3/3! + ...; sin(r) has the sign of r (copysign: sin(-0) = -0, as libm's)
-  s = std::copysign(r + ((rlo - h * rlo) - r * z * ps), r);
-  double pc = 1 / fact(18);
-  pc = pc * z - 1 / fact(16);
+  s = std::copysign(r - r * z * ps, r);
+  double pc = -1 / fact(16);
   pc = pc * z + 1 / fact(14);
   pc = pc * z - 1 / fact(12);
   pc = pc * z + 1 / fact(10);
@@ -70,8 +59,8 @@ inline void kernel(double r, double rlo, double& s, double& c) {
   pc = pc * z + 1 / fact(6);
   pc = pc * z - 1 / fact(4);
   // 1 - r^2/2 + r^4/4! - ...; (1 - w) - h is the exact rounding error of w = 1 - h
-  const double w = 1.0 - h;
-  c = w + (((1.0 - w) - h) - (z * z * pc + r * rlo));
+  const double h = 0.5 * z, w = 1.0 - h;
+  c = w + (((1.0 - w) - h) - z * z * pc);
 }
 
 // Float lanes (the float batch path only), in float arithmetic so that a vector holds twice the
@@ -105,12 +94,9 @@ inline void ownSinCosInRange(double x, double& sinX, double& cosX) {
   const double k = kb - kRound;
   uint64_t bits;
   std::memcpy(&bits, &kb, sizeof bits);  // low mantissa bits of kb: k mod 4 (kRound = 3 * 2^51)
-  // x - k P1 is exact; the two other subtractions keep their rounding errors in rlo
-  double t2, e2, r, e3;
-  twoSum(x - k * kP1, -(k * kP2), t2, e2);
-  twoSum(t2, -(k * kP3), r, e3);
+  const double r = (x - k * kP1) - k * kP2;  // x - k P1 exact; k P2 and the subtraction rounded
   double s, c;
-  trig_detail::kernel(r, e2 + e3, s, c);
+  trig_detail::kernel(r, s, c);
   const bool swap = bits & 1, negSin = bits & 2, negCos = (bits + 1) & 2;
   const double sv = swap ? c : s, cv = swap ? s : c;
   sinX = negSin ? -sv : sv;
