@@ -4,17 +4,17 @@
 // (libm's sin/cos are calls per lane).
 //
 // Method: Cody-Waite reduction x = k pi/2 + r with pi/2 = P1 + P2, P1 of 33 bits (k P1 exact for
-// |k| < 2^20, and x - k P1 exact by Sterbenz's lemma), then Taylor polynomials in z = r^2 on
-// |r| <= pi/4 (+ rounding): sin to r^17, cos to r^16 (truncation < 0.03 ulp), and the quadrant
-// k mod 4 picks +-sin(r) or +-cos(r). Only + - * in IEEE double: with -ffp-contract=off the
-// bits are the same for every ISA clone and every machine. |x| > kOwnTrigLimit, infinities and
-// NaN go to libm (the batch evaluator takes a scalar path for a batch holding such a lane).
+// |k| < 2^20, and x - k P1 exact by Sterbenz's lemma), then polynomials in z = r^2 on
+// |r| <= pi/4 (+ rounding) of degree 13 (sin) and 14 (cos) fitted below (< 0.1 ulp), and the
+// quadrant k mod 4 picks +-sin(r) or +-cos(r). Only + - * in IEEE double: with -ffp-contract=off
+// the bits are the same for every ISA clone and every machine. |x| > kOwnTrigLimit, infinities
+// and NaN go to libm (the batch evaluator takes a scalar path for a batch holding such a lane).
 //
-// Error (tests/core/own_sin_cos_test.cpp measures it against long double, max ~1.3 ulp): within
+// Error (tests/core/own_sin_cos_test.cpp measures it against long double, max ~1.5 ulp): within
 // kOwnTrigUlps ulps of the true value (0.5 ulp of r from the rounded subtraction, 0.5 ulp final
-// rounding, < 0.3 ulp from the polynomial) plus an absolute kOwnTrigAbsErr, which covers the
-// reduction near zeros of sin/cos: the rounding of k P2 (<= 2^-54 * 2^19 * 6.1e-11 = 3.4e-21)
-// and the tail of pi/2 - (P1 + P2) (3.5e-27 times |k| <= 2^19).
+// rounding, 0.5 ulp from 1 - z/2 in cos, < 0.1 ulp from the polynomials) plus an absolute
+// kOwnTrigAbsErr, which covers the reduction near zeros of sin/cos: the rounding of k P2
+// (<= 2^-54 * 2^19 * 6.1e-11 = 3.4e-21) and the tail of pi/2 - (P1 + P2) (3.5e-27 * |k| <= 2^19).
 #pragma once
 
 #include <cmath>
@@ -38,29 +38,26 @@ constexpr double kRound = 0x1.8p52;  // (t + kRound) - kRound rounds t to an int
 
 constexpr double fact(int n) { return n <= 1 ? 1.0 : n * fact(n - 1); }  // exact up to 22!
 
-// sin and cos of r for |r| <= pi/4 (a hair more after rounding of k).
+// sin and cos of r for |r| <= pi/4 (a hair more after rounding of k): sin r = r + r^3 S(z),
+// cos r = 1 - z/2 + z^2 C(z), z = r^2, with S and C of degree 5: Chebyshev fits (mpmath chebyfit,
+// 50 digits) of (sin r - r) / r^3 and (cos r - 1 + z/2) / z^2 over z in [0, 1.0001 (pi/4)^2];
+// with the coefficients rounded to double, relative error 2.0e-17 (sin) and 1.3e-18 (cos).
 inline void kernel(double r, double& s, double& c) {
   const double z = r * r;
-  double ps = -1 / fact(17);
-  ps = ps * z + 1 / fact(15);
-  ps = ps * z - 1 / fact(13);
-  ps = ps * z + 1 / fact(11);
-  ps = ps * z - 1 / fact(9);
-  ps = ps * z + 1 / fact(7);
-  ps = ps * z - 1 / fact(5);
-  ps = ps * z + 1 / fact(3);
-  // r - r^3/3! + ...; sin(r) has the sign of r (copysign: sin(-0) = -0, as libm's)
-  s = std::copysign(r - r * z * ps, r);
-  double pc = -1 / fact(16);
-  pc = pc * z + 1 / fact(14);
-  pc = pc * z - 1 / fact(12);
-  pc = pc * z + 1 / fact(10);
-  pc = pc * z - 1 / fact(8);
-  pc = pc * z + 1 / fact(6);
-  pc = pc * z - 1 / fact(4);
-  // 1 - r^2/2 + r^4/4! - ...; (1 - w) - h is the exact rounding error of w = 1 - h
-  const double h = 0.5 * z, w = 1.0 - h;
-  c = w + (((1.0 - w) - h) - z * z * pc);
+  double ps = 0x1.5e0b05bff20f2p-33;
+  ps = ps * z - 0x1.ae600aca92c64p-26;
+  ps = ps * z + 0x1.71de379654304p-19;
+  ps = ps * z - 0x1.a01a019e83816p-13;
+  ps = ps * z + 0x1.1111111110bb2p-7;
+  ps = ps * z - 0x1.5555555555555p-3;
+  s = std::copysign(r + r * z * ps, r);  // sin(r) has the sign of r: sin(-0) = -0, as libm's
+  double pc = -0x1.907d8f29fe831p-37;
+  pc = pc * z + 0x1.1eeb68cd22f56p-29;
+  pc = pc * z - 0x1.27e4fa17bf139p-22;
+  pc = pc * z + 0x1.a01a019f4e9b4p-16;
+  pc = pc * z - 0x1.6c16c16c16967p-10;
+  pc = pc * z + 0x1.5555555555555p-5;
+  c = (1.0 - 0.5 * z) + z * z * pc;
 }
 
 // Float lanes (the float batch path only), in float arithmetic so that a vector holds twice the
@@ -97,10 +94,15 @@ inline void ownSinCosInRange(double x, double& sinX, double& cosX) {
   const double r = (x - k * kP1) - k * kP2;  // x - k P1 exact; k P2 and the subtraction rounded
   double s, c;
   trig_detail::kernel(r, s, c);
-  const bool swap = bits & 1, negSin = bits & 2, negCos = (bits + 1) & 2;
+  const bool swap = bits & 1;
   const double sv = swap ? c : s, cv = swap ? s : c;
-  sinX = negSin ? -sv : sv;
-  cosX = negCos ? -cv : cv;
+  uint64_t sb, cb;  // signs: sin negative for k mod 4 in {2, 3}, cos for {1, 2}
+  std::memcpy(&sb, &sv, sizeof sb);
+  std::memcpy(&cb, &cv, sizeof cb);
+  sb ^= (bits & 2) << 62;
+  cb ^= ((bits + 1) & 2) << 62;
+  std::memcpy(&sinX, &sb, sizeof sb);
+  std::memcpy(&cosX, &cb, sizeof cb);
 }
 
 inline bool ownTrigInRange(double x) { return std::fabs(x) <= kOwnTrigLimit; }  // false for NaN
