@@ -166,26 +166,30 @@ inline __attribute__((always_inline)) size_t runFused(const Instr* code, size_t 
   const uint32_t r = i0.out;
   auto reg = [&](uint32_t q) { return regs + size_t(q) * B; };
   T* __restrict o = reg(r);
-  if ((i0.op == Op::Add || i0.op == Op::Sub) && i0.b < numUniforms && i0.a != r && k + 1 < ninstr &&
-      squaresInPlace(code[k + 1], r)) {
-    // (x +- c)^2, then maybe d - that or that - d
-    const T* x = reg(i0.a);
-    const T c = reg(i0.b)[0];
+  const bool aUniform = i0.a < numUniforms, bUniform = i0.b < numUniforms;
+  if ((i0.op == Op::Add || i0.op == Op::Sub) && aUniform != bUniform && (aUniform ? i0.b : i0.a) != r &&
+      k + 1 < ninstr && squaresInPlace(code[k + 1], r)) {
+    // (x +- c)^2 or (c +- x)^2, then maybe d - that or that - d
+    const T* x = reg(aUniform ? i0.b : i0.a);
+    const T c = reg(aUniform ? i0.a : i0.b)[0];
     const int sub = k + 2 < ninstr ? subtractsInPlace(code[k + 2], r) : 0;
     const uint32_t dq = sub == 1 ? code[k + 2].a : code[k + 2].b;
     const bool three = sub && dq < numUniforms;
     const T d = three ? reg(dq)[0] : T(0);
     auto chain = [&](auto first) {
       if (three && sub == 1) {
-        for (size_t i = 0; i < n; ++i) { const T t = first(x[i], c); o[i] = d - t * t; }
+        for (size_t i = 0; i < n; ++i) { const T t = first(x[i]); o[i] = d - t * t; }
       } else if (three) {
-        for (size_t i = 0; i < n; ++i) { const T t = first(x[i], c); o[i] = t * t - d; }
+        for (size_t i = 0; i < n; ++i) { const T t = first(x[i]); o[i] = t * t - d; }
       } else {
-        for (size_t i = 0; i < n; ++i) { const T t = first(x[i], c); o[i] = t * t; }
+        for (size_t i = 0; i < n; ++i) { const T t = first(x[i]); o[i] = t * t; }
       }
     };
-    if (i0.op == Op::Add) chain([](T p, T q) { return p + q; });
-    else chain([](T p, T q) { return p - q; });
+    // the operands in the tape's order
+    if (i0.op == Op::Add && aUniform) chain([c](T v) { return c + v; });
+    else if (i0.op == Op::Add) chain([c](T v) { return v + c; });
+    else if (aUniform) chain([c](T v) { return c - v; });
+    else chain([c](T v) { return v - c; });
     return three ? 3 : 2;
   }
   if (isSquare(i0) && i0.a != r && k + 1 < ninstr) {

@@ -1,0 +1,117 @@
+// The batch evaluator's tape specialisation (eval_batch.cpp): constant operands read as scalars
+// and fused in-place chains ((x +- c)^2, d - (x +- c)^2, (x +- c)^2 - d, u - x^2, x^2 - u) must
+// give the point evaluator's bits on every lane, finite or not; the float path stays close.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/expr.h"
+
+using namespace frep;
+
+namespace {
+
+const Expr X = Expr::x(0), Y = Expr::x(1), Z = Expr::x(2);
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+bool isSquare(const Instr& i) { return i.op == Op::PowI && i.imm == 2.0; }
+
+// The chain shapes the evaluator fuses, counted on the tape (so the test knows it covers them).
+struct Shapes {
+  int shiftSquare = 0, shiftSquareThenSub = 0, squareThenSub = 0;
+};
+Shapes shapesOf(const Tape& t) {
+  Shapes s;  // (x +- c)^2 with c on either side; then d - . or . - d; x^2 then u - . or . - u
+  const auto& c = t.code();
+  const uint32_t nu = t.numUniforms();
+  auto subInPlace = [](const Instr& n, uint32_t r) {
+    return n.op == Op::Sub && n.out == r && ((n.b == r) != (n.a == r));
+  };
+  for (size_t k = 0; k + 1 < c.size(); ++k) {
+    const uint32_t r = c[k].out;
+    const bool sq = isSquare(c[k + 1]) && c[k + 1].a == r && c[k + 1].out == r;
+    const bool ua = c[k].a < nu, ub = c[k].b < nu;
+    if ((c[k].op == Op::Add || c[k].op == Op::Sub) && ua != ub && (ua ? c[k].b : c[k].a) != r && sq) {
+      const bool third = k + 2 < c.size() && subInPlace(c[k + 2], r) &&
+                         (c[k + 2].b == r ? c[k + 2].a : c[k + 2].b) < nu;
+      ++(third ? s.shiftSquareThenSub : s.shiftSquare);
+    }
+    if (isSquare(c[k]) && c[k].a != r && subInPlace(c[k + 1], r)) ++s.squareThenSub;
+  }
+  return s;
+}
+
+Expr model() {
+  // cylinders and spheres as CSG writes them, constants on both sides of every binary op
+  Expr cyl = 0.04 - square(X - 0.3) - square(Y + 0.2);
+  Expr bowl = square(Z) - 0.5 + square(X - 1.0) * 0.25;
+  Expr cap = 1.0 - square(Y);
+  Expr shifted = square(Z + 0.7) - 2.0 + square(1.5 - X);
+  Expr mix = min(X, 0.5) + max(0.25, Y) * (2.0 / (X + 3.0)) - Z / 3.0 + (3.0 - Y) * X;
+  return max(min(cyl, bowl), cap) + shifted * mix - min(0.5, Z) + max(Y * Z, 0.1);
+}
+
+double coord(std::mt19937_64& rng) {
+  static const double special[] = {0.0, -0.0, 0.3, -0.2, 1e-310, 1e200, -1e300,
+                                   std::numeric_limits<double>::infinity(),
+                                   -std::numeric_limits<double>::infinity(),
+                                   std::numeric_limits<double>::quiet_NaN()};
+  if (rng() % 12 == 0) return special[rng() % (sizeof special / sizeof special[0])];
+  return std::uniform_real_distribution<double>(-3.0, 3.0)(rng);
+}
+
+TEST(BatchFusion, TapeHasEveryFusedShape) {
+  const Shapes s = shapesOf(*Tape::compile(model(), 3));
+  EXPECT_GE(s.shiftSquare, 1);
+  EXPECT_GE(s.shiftSquareThenSub, 1);
+  EXPECT_GE(s.squareThenSub, 1);
+}
+
+TEST(BatchFusion, SameBitsAsPointEvaluator) {
+  TapePtr t = Tape::compile(model(), 3);
+  constexpr size_t B = BatchEvaluator<double>::kBatch;
+  PointEvaluator pe;
+  BatchEvaluator<double> be;
+  be.reserve(*t);
+  std::mt19937_64 rng(31);
+  std::vector<double> p(B * 3);
+  for (int rep = 0; rep < 40; ++rep) {
+    const size_t n = rep % 5 == 4 ? 1 + rng() % B : B;  // short batches too
+    for (size_t k = 0; k < n; ++k)
+      for (uint32_t i = 0; i < 3; ++i) be.in(i)[k] = p[k * 3 + i] = coord(rng);
+    const double* out = be.eval(*t, n);
+    for (size_t k = 0; k < n; ++k) {
+      const double ref = pe.eval(*t, &p[k * 3]);
+      ASSERT_TRUE(sameBits(out[k], ref)) << "lane " << k << " at (" << p[k * 3] << ", " << p[k * 3 + 1] << ", "
+                                         << p[k * 3 + 2] << "): batch " << out[k] << " point " << ref;
+    }
+  }
+}
+
+TEST(BatchFusion, FloatPathClose) {
+  TapePtr t = Tape::compile(model(), 3);
+  constexpr size_t B = BatchEvaluator<float>::kBatch;
+  PointEvaluator pe;
+  BatchEvaluator<float> bf;
+  bf.reserve(*t);
+  std::mt19937_64 rng(32);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  double p[3];
+  std::vector<double> pts(B * 3);
+  for (size_t k = 0; k < B; ++k)
+    for (uint32_t i = 0; i < 3; ++i) bf.in(i)[k] = float(pts[k * 3 + i] = double(float(u(rng))));
+  const float* out = bf.eval(*t, B);
+  for (size_t k = 0; k < B; ++k) {
+    for (int i = 0; i < 3; ++i) p[i] = pts[k * 3 + i];
+    const double ref = pe.eval(*t, p);
+    EXPECT_NEAR(double(out[k]), ref, 1e-5 * (1 + std::fabs(ref))) << "lane " << k;
+  }
+}
+
+}  // namespace
