@@ -1,5 +1,6 @@
 // The batch evaluator's tape specialisation (eval_batch.cpp): constant operands read as scalars
-// and fused in-place chains ((x +- c)^2, d - (x +- c)^2, (x +- c)^2 - d, u - x^2, x^2 - u) must
+// and fused chains ((x +- c)^2, d - (x +- c)^2, (x +- c)^2 - d, u - x^2, x^2 - u, min/max of a
+// sum, difference or product read by nothing else) must
 // give the point evaluator's bits on every lane, finite or not; the float path stays close.
 #include <gtest/gtest.h>
 
@@ -24,7 +25,7 @@ bool isSquare(const Instr& i) { return i.op == Op::PowI && i.imm == 2.0; }
 
 // The chain shapes the evaluator fuses, counted on the tape (so the test knows it covers them).
 struct Shapes {
-  int shiftSquare = 0, shiftSquareThenSub = 0, squareThenSub = 0;
+  int shiftSquare = 0, shiftSquareThenSub = 0, squareThenSub = 0, intoMinMax = 0;
 };
 Shapes shapesOf(const Tape& t) {
   Shapes s;  // (x +- c)^2 with c on either side; then d - . or . - d; x^2 then u - . or . - u
@@ -43,6 +44,12 @@ Shapes shapesOf(const Tape& t) {
       ++(third ? s.shiftSquareThenSub : s.shiftSquare);
     }
     if (isSquare(c[k]) && c[k].a != r && subInPlace(c[k + 1], r)) ++s.squareThenSub;
+    // t = a +-* b read only by a min/max next (which overwrites t, or k + 2 overwrites it unread)
+    const Instr& n = c[k + 1];
+    const bool mm = (n.op == Op::Min || n.op == Op::Max) && ((n.a == r) != (n.b == r));
+    const bool dead = n.out == r || (k + 2 < c.size() && c[k + 2].out == r && opArity(c[k + 2].op) == 2 &&
+                                     c[k + 2].a != r && c[k + 2].b != r);
+    if ((c[k].op == Op::Add || c[k].op == Op::Sub || c[k].op == Op::Mul) && mm && dead) ++s.intoMinMax;
   }
   return s;
 }
@@ -54,7 +61,13 @@ Expr model() {
   Expr cap = 1.0 - square(Y);
   Expr shifted = square(Z + 0.7) - 2.0 + square(1.5 - X);
   Expr mix = min(X, 0.5) + max(0.25, Y) * (2.0 / (X + 3.0)) - Z / 3.0 + (3.0 - Y) * X;
-  return max(min(cyl, bowl), cap) + shifted * mix - min(0.5, Z) + max(Y * Z, 0.1);
+  // a grid of holes as the CSG bench model writes it: max chains of differences
+  Expr holes;
+  for (int i = 0; i < 6; ++i) {
+    Expr h = 0.04 - square(X - 0.4 * (i % 3)) - square(Y - 0.5 * (i / 3));
+    holes = i ? max(holes, h) : h;
+  }
+  return max(min(cyl, bowl), cap) + shifted * mix - min(0.5, Z) + max(Y * Z, 0.1) + min(holes * X, Z - holes);
 }
 
 double coord(std::mt19937_64& rng) {
@@ -71,6 +84,7 @@ TEST(BatchFusion, TapeHasEveryFusedShape) {
   EXPECT_GE(s.shiftSquare, 1);
   EXPECT_GE(s.shiftSquareThenSub, 1);
   EXPECT_GE(s.squareThenSub, 1);
+  EXPECT_GE(s.intoMinMax, 2);
 }
 
 TEST(BatchFusion, SameBitsAsPointEvaluator) {

@@ -158,6 +158,50 @@ inline int subtractsInPlace(const Instr& next, uint32_t r) {
   return 0;
 }
 
+// Whether instruction k + 1 is the last reader of register q written at k: it overwrites q
+// itself, or k + 2 overwrites q without reading it.
+inline bool lastReaderIsNext(const Instr* code, size_t k, size_t ninstr, uint32_t q) {
+  const Instr& next = code[k + 1];
+  if (next.out == q) return true;
+  if (k + 2 >= ninstr) return false;
+  const Instr& after = code[k + 2];
+  const int ar = opArity(after.op);
+  return after.out == q && after.op != Op::Extremum && after.op != Op::Field && !(ar > 0 && after.a == q) &&
+         !(ar > 1 && after.b == q) && !(ar > 2 && after.c == q);
+}
+
+// t = a op b (+ - *, registers) then min or max of t with another register, t read by nothing
+// else (CSG's "max(holes, c - ...)" chains): one loop, the operands in the tape's order.
+template <typename T>
+inline __attribute__((always_inline)) size_t runIntoMinMax(const Instr* code, size_t k, size_t ninstr, T* regs,
+                                                           size_t n) {
+  constexpr size_t B = BatchEvaluator<T>::kBatch;
+  const Instr &i0 = code[k], &i1 = code[k + 1];
+  const uint32_t q = i0.out;
+  if ((i1.op != Op::Min && i1.op != Op::Max) || (i1.a == q) == (i1.b == q) || !lastReaderIsNext(code, k, ninstr, q))
+    return 0;
+  auto reg = [&](uint32_t r) { return regs + size_t(r) * B; };
+  const T *a = reg(i0.a), *b = reg(i0.b), *p = reg(i1.a == q ? i1.b : i1.a);
+  T* __restrict o = reg(i1.out);
+  const bool tFirst = i1.a == q;
+  auto run = [&](auto f) {
+    // min: y < x ? y : x, max: y > x ? y : x, with (x, y) = (i1.a, i1.b)
+    if (i1.op == Op::Min && tFirst) {
+      for (size_t i = 0; i < n; ++i) { const T x = f(a[i], b[i]), y = p[i]; o[i] = y < x ? y : x; }
+    } else if (i1.op == Op::Min) {
+      for (size_t i = 0; i < n; ++i) { const T x = p[i], y = f(a[i], b[i]); o[i] = y < x ? y : x; }
+    } else if (tFirst) {
+      for (size_t i = 0; i < n; ++i) { const T x = f(a[i], b[i]), y = p[i]; o[i] = y > x ? y : x; }
+    } else {
+      for (size_t i = 0; i < n; ++i) { const T x = p[i], y = f(a[i], b[i]); o[i] = y > x ? y : x; }
+    }
+  };
+  if (i0.op == Op::Add) run([](T u, T v) { return u + v; });
+  else if (i0.op == Op::Sub) run([](T u, T v) { return u - v; });
+  else run([](T u, T v) { return u * v; });
+  return 2;
+}
+
 template <typename T>
 inline __attribute__((always_inline)) size_t runFused(const Instr* code, size_t k, size_t ninstr, T* regs, size_t n,
                                                       uint32_t numUniforms) {
@@ -210,6 +254,8 @@ inline __attribute__((always_inline)) size_t runFused(const Instr* code, size_t 
     }
     return 2;
   }
+  if ((i0.op == Op::Add || i0.op == Op::Sub || i0.op == Op::Mul) && k + 1 < ninstr)
+    return runIntoMinMax(code, k, ninstr, regs, n);
   return 0;
 }
 
