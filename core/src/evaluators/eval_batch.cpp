@@ -237,20 +237,22 @@ inline __attribute__((always_inline)) size_t runFused(const Instr* code, size_t 
     return three ? 3 : 2;
   }
   if (isSquare(i0) && i0.a != r && k + 1 < ninstr) {
-    // x^2 then u - that or that - u (u a register or a constant)
-    const int sub = subtractsInPlace(code[k + 1], r);
-    if (!sub) return 0;
+    // x^2 then u - that or that - u (u a register or a constant), the square read by nothing
+    // else: in place, or into another register when the square's dies there
+    const Instr& next = code[k + 1];
+    if (next.op != Op::Sub || (next.a == r) == (next.b == r) || !lastReaderIsNext(code, k, ninstr, r)) return 0;
+    const bool uFirst = next.b == r;  // u - x^2
     const T* x = reg(i0.a);
-    const uint32_t uq = sub == 1 ? code[k + 1].a : code[k + 1].b;
+    const uint32_t uq = uFirst ? next.a : next.b;
     const T* u = reg(uq);
-    const bool uUniform = uq < numUniforms;
-    if (uUniform) {
+    T* __restrict out = reg(next.out);
+    if (uq < numUniforms) {
       const T uv = u[0];
-      if (sub == 1) for (size_t i = 0; i < n; ++i) o[i] = uv - x[i] * x[i];
-      else for (size_t i = 0; i < n; ++i) o[i] = x[i] * x[i] - uv;
+      if (uFirst) for (size_t i = 0; i < n; ++i) out[i] = uv - x[i] * x[i];
+      else for (size_t i = 0; i < n; ++i) out[i] = x[i] * x[i] - uv;
     } else {
-      if (sub == 1) for (size_t i = 0; i < n; ++i) o[i] = u[i] - x[i] * x[i];
-      else for (size_t i = 0; i < n; ++i) o[i] = x[i] * x[i] - u[i];
+      if (uFirst) for (size_t i = 0; i < n; ++i) out[i] = u[i] - x[i] * x[i];
+      else for (size_t i = 0; i < n; ++i) out[i] = x[i] * x[i] - u[i];
     }
     return 2;
   }
