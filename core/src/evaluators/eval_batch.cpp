@@ -1,8 +1,9 @@
-// Batch evaluator: one pass over the tape per batch of points, each instruction a tight loop
-// over structure-of-arrays lanes that the compiler vectorises (arithmetic, min/max, sqrt,
-// comparisons, select, sin/cos of sin_cos.h); other transcendentals call libm per lane. The
-// kernel is compiled for several ISA levels (target_clones) and picked at run time; -ffp-contract=off keeps every clone
-// bit-identical to the others and to the point evaluator for + - * / sqrt.
+// Batch evaluator: one pass over the tape per batch of points, each instruction (or fused short
+// chain, see runFused) a tight loop over structure-of-arrays lanes that the compiler vectorises
+// (arithmetic, min/max, sqrt, comparisons, select, sin/cos of sin_cos.h); other transcendentals
+// call libm per lane. The kernel is compiled for several ISA levels (target_clones) and picked at
+// run time; -ffp-contract=off keeps every clone bit-identical to the others and to the point
+// evaluator.
 #include <algorithm>
 #include <cmath>
 
@@ -15,7 +16,6 @@
 namespace frep {
 
 namespace {
-
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define FREP_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))

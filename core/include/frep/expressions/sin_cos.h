@@ -3,8 +3,8 @@
 // written as straight-line arithmetic so that the batch evaluator's lane loops vectorise
 // (libm's sin/cos are calls per lane).
 //
-// Method: Cody-Waite reduction x = k pi/2 + r with pi/2 = P1 + P2, P1 of 33 bits (k P1 exact for
-// |k| < 2^20, and x - k P1 exact by Sterbenz's lemma), then polynomials in z = r^2 on
+// Method: Cody-Waite reduction x = k pi/2 + r with pi/2 = P1 + P2, P1 of 31 bits (k P1 exact for
+// |k| < 2^22, and x - k P1 exact by Sterbenz's lemma), then polynomials in z = r^2 on
 // |r| <= pi/4 (+ rounding) of degree 13 (sin) and 14 (cos) fitted below (< 0.1 ulp), and the
 // quadrant k mod 4 picks +-sin(r) or +-cos(r). Only + - * in IEEE double: with -ffp-contract=off
 // the bits are the same for every ISA clone and every machine. |x| > kOwnTrigLimit, infinities
@@ -29,7 +29,7 @@ constexpr double kOwnTrigAbsErr = 0x1p-64; // absolute part (5.4e-20 > 2^19 * 3.
 
 namespace trig_detail {
 
-// pi/2 = P1 + P2 + 3.5e-27: P1 with 33 significant bits (k P1 exact for |k| < 2^20), P2 the
+// pi/2 = P1 + P2 + 3.5e-27: P1 with 31 significant bits (k P1 exact for |k| < 2^22), P2 the
 // rest rounded to double.
 constexpr double kP1 = 0x1.921fb544p+0;
 constexpr double kP2 = 0x1.0b4611a626331p-34;
