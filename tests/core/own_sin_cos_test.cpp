@@ -183,7 +183,9 @@ TEST(OwnSinCos, PointBatchGradientSameBits) {
       const double dx = 8 * ownCos(8 * x[0]) * ownCos(8 * x[1]) - 8 * ownSin(8 * x[2]) * ownSin(8 * x[0]) -
                         x[1] * ownSin(x[0] * x[1]);
       EXPECT_NEAR(g[0], dx, 1e-12 * (1 + std::fabs(dx)));
-      if (!(rep == 19 && k == 5)) EXPECT_NEAR(double(outF[k]), ref, 3e-5);  // float: x*y rounds
+      if (!(rep == 19 && k == 5)) {  // (float: x*y of the 1e7 lane rounds)
+        EXPECT_NEAR(double(outF[k]), ref, 3e-5);
+      }
     }
   }
 }
