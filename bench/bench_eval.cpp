@@ -1,4 +1,4 @@
-// Evaluator throughput (points/second) on a sphere and a ~100-node CSG model: the naive tree
+// Evaluator throughput (points/second) on a sphere, a ~100-node CSG model and the gyroid ball: the naive tree
 // walker (baseline, tree_walker.h) and its memoised variant, PointEvaluator, BatchEvaluator<double> and <float>.
 // Prints, from the same run, the ratios against the tree walker and the float-vs-double error.
 #include <benchmark/benchmark.h>
@@ -36,10 +36,9 @@ struct Model {
   std::vector<double> pts;  // kPoints x 3, point-major
 };
 
-std::vector<double> samplePoints() {
+std::vector<double> samplePoints(const double half[3]) {
   std::mt19937_64 rng(42);
   std::vector<double> p(kPoints * 3);
-  const double half[3] = {2.2, 1.4, 1.0};
   for (size_t i = 0; i < p.size(); ++i)
     p[i] = half[i % 3] * (2.0 * double(rng() % 1000001) / 1000000.0 - 1.0);
   return p;
@@ -130,14 +129,17 @@ void reportFloatError(const Model& m) {
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  std::vector<Model> models(2);
+  std::vector<Model> models(3);
   models[0].name = "sphere";
   models[0].expr = sphereModel();
   models[1].name = "csg";
   models[1].expr = csgModel();
+  models[2].name = "gyroid";
+  models[2].expr = bench::gyroidModel();
+  const double csgHalf[3] = {2.2, 1.4, 1.0}, gyroidHalf[3] = {1.1, 1.1, 1.1};
   for (auto& m : models) {
     m.tape = Tape::compile(m.expr, 3);
-    m.pts = samplePoints();
+    m.pts = samplePoints(m.name == "gyroid" ? gyroidHalf : csgHalf);
     std::printf("%-8s %zu DAG nodes, %zu tree nodes (visits per point of the tree walker), "
                 "%zu tape instructions, %u registers\n",
                 m.name.c_str(), nodeCount(m.expr), bench::treeSize(m.expr.node()), m.tape->size(),

@@ -48,6 +48,7 @@
 #include "frep/sampling/sample.h"
 #include "frep/expressions/tape.h"
 #include "frep/io/vdb_grid.h"
+#include "bench_models.h"
 
 using namespace frep;
 
@@ -66,12 +67,7 @@ double cpuSeconds() {
   return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
 }
 
-Expr gyroidModel() {
-  Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
-  Expr X = 8.0 * x, Y = 8.0 * y, Z = 8.0 * z;
-  Expr g = sin(X) * cos(Y) + sin(Y) * cos(Z) + sin(Z) * cos(X);
-  return min(1.0 - square(x) - square(y) - square(z), 0.3 - abs(g));
-}
+using bench::gyroidModel;
 const char* kGyroidHf =
     "-- bench_mesh: the unit ball intersected with a gyroid sheet (period 2 pi / 8)\n"
     "my_model(x[3], a[1])\n"

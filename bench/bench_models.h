@@ -36,4 +36,14 @@ inline Expr csgModel() {
 }
 inline const std::array<double, 3> kCsgLo{-2.2, -2.2, -2.2}, kCsgHi{2.2, 2.2, 2.2};
 
+// The unit ball intersected with a gyroid sheet (|g| < 0.3, period 2 pi / 8): libfive's
+// showcase model, 3 sin/cos pairs per point.
+inline Expr gyroidModel() {
+  Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  Expr X = 8.0 * x, Y = 8.0 * y, Z = 8.0 * z;
+  Expr g = sin(X) * cos(Y) + sin(Y) * cos(Z) + sin(Z) * cos(X);
+  return min(1.0 - square(x) - square(y) - square(z), 0.3 - abs(g));
+}
+inline const std::array<double, 3> kGyroidLo{-1.1, -1.1, -1.1}, kGyroidHi{1.1, 1.1, 1.1};
+
 }  // namespace frep::bench

@@ -1,6 +1,6 @@
-// The batch evaluator computes sin and cos of the same input with one sincos() call where the
-// tape's sinCosPlan pairs them. The results must keep the bits of the point evaluator (std::sin,
-// std::cos) on every lane: pairs adjacent and far apart, registers reused in between, pruned
+// The batch evaluator computes sin and cos of the same input with one ownSinCos (sin_cos.h) where
+// the tape's sinCosPlan pairs them. The results must keep the bits of the point evaluator (ownSin,
+// ownCos) on every lane: pairs adjacent and far apart, registers reused in between, pruned
 // tapes, an extremum in between.
 #include <gtest/gtest.h>
 
@@ -14,6 +14,7 @@
 
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/expr.h"
+#include "frep/expressions/sin_cos.h"
 #include "frep/extremum/extremum.h"
 
 using namespace frep;
@@ -285,9 +286,10 @@ TEST(SinCos, NoPairAcrossAnExtremum) {
   expectSameAsPoint(*t, rng, 3.0, 512);
 }
 
-TEST(SinCos, FloatMatchesSinfCosf) {
-  // No float reference evaluator: compare with the same formula evaluated in float by hand
-  // (NaNs only as NaNs: which operand's NaN propagates depends on the order of operands).
+TEST(SinCos, FloatMatchesOwnSinCosFloat) {
+  // No float reference evaluator: compare with the same formula evaluated in float by hand, sin
+  // and cos being ownSinCosFloat (NaNs only as NaNs: which operand's NaN
+  // propagates depends on the order of operands).
   TapePtr t = Tape::compile(sin(X) * cos(X) - cos(Y) + sin(Y) * Z, 3);
   EXPECT_EQ(numFused(*t), 1u);  // sin(y), cos(y): cos(y)'s register is used between them
   BatchEvaluator<float> be;
@@ -301,7 +303,9 @@ TEST(SinCos, FloatMatchesSinfCosf) {
     const float* out = be.eval(*t, B);
     for (size_t k = 0; k < B; ++k) {
       const float x = p[k][0], y = p[k][1], z = p[k][2];
-      const float ref = std::sin(x) * std::cos(x) - std::cos(y) + std::sin(y) * z;
+      auto fsin = [](float v) { float s, c; ownSinCosFloat(v, s, c); return s; };
+      auto fcos = [](float v) { float s, c; ownSinCosFloat(v, s, c); return c; };
+      const float ref = fsin(x) * fcos(x) - fcos(y) + fsin(y) * z;
       ASSERT_TRUE(std::memcmp(&out[k], &ref, sizeof ref) == 0 || (std::isnan(out[k]) && std::isnan(ref)))
           << x << " " << y << " " << z << ": " << out[k] << " vs " << ref;
     }

@@ -7,6 +7,7 @@
 
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/field_function.h"
+#include "frep/expressions/sin_cos.h"
 #include "frep/extremum/extremum.h"
 
 namespace frep {
@@ -26,8 +27,8 @@ Partials partials(Op op, double a, double b, double value, double imm) {
     case Op::Exp: return {value};
     case Op::Log: return {a > kLogFloor ? 1.0 / a : 0.0};
     case Op::Log10: return {a > kLogFloor ? 1.0 / (a * std::log(10.0)) : 0.0};
-    case Op::Sin: return {std::cos(a)};
-    case Op::Cos: return {-std::sin(a)};
+    case Op::Sin: return {ownCos(a)};
+    case Op::Cos: return {-ownSin(a)};
     case Op::Tan: return {1.0 + value * value};
     case Op::Asin: return {std::fabs(a) < 1.0 ? 1.0 / std::sqrt(1.0 - a * a) : 0.0};
     case Op::Acos: return {std::fabs(a) < 1.0 ? -1.0 / std::sqrt(1.0 - a * a) : 0.0};

@@ -8,6 +8,7 @@
 //    pushed outward: 1 ulp for correctly rounded ops, kTransUlps for libm transcendentals.
 #include "frep/evaluators/interval.h"
 #include "frep/expressions/pow_int.h"
+#include "frep/expressions/sin_cos.h"
 #include "evaluators/interval_fast.h"
 
 #include <algorithm>
@@ -59,8 +60,13 @@ constexpr double kMaxPeriodicArg = 1e6;  // beyond this, sin/cos give [-1, 1], t
 Interval sinLike(const Interval& a, double maxOffset, double minOffset, double (*f)(double)) {
   if (!finite(a)) return Interval::everything();  // sin(inf) is NaN
   if (a.width() >= 2 * kPi || std::max(-a.lo, a.hi) > kMaxPeriodicArg) return {-1.0, 1.0};
-  double flo = f(a.lo), fhi = f(a.hi);
-  Interval r{down(std::min(flo, fhi), kTransUlps), up(std::max(flo, fhi), kTransUlps)};
+  // f is the evaluators' own sin/cos (sin_cos.h): within kOwnTrigUlps ulps (<= 2^-52 |v| each)
+  // plus kOwnTrigAbsErr of the true value, at the endpoints as at every point between, so a
+  // monotone piece's values lie within twice that of [f(lo), f(hi)] (absolute: near zeros too).
+  const double flo = f(a.lo), fhi = f(a.hi);
+  const double m = std::max(std::fabs(flo), std::fabs(fhi));
+  const double w = 2 * (kOwnTrigUlps * 0x1p-52 * m + kOwnTrigAbsErr);
+  Interval r{down(std::min(flo, fhi) - w, kTransUlps), up(std::max(flo, fhi) + w, kTransUlps)};
   if (mayHitGrid(a.lo, a.hi, maxOffset, 2 * kPi)) r.hi = 1.0;
   if (mayHitGrid(a.lo, a.hi, minOffset, 2 * kPi)) r.lo = -1.0;
   return {std::max(r.lo, -1.0), std::min(r.hi, 1.0)};
@@ -249,8 +255,8 @@ Interval dispatch(Op op, const Interval& a, const Interval& b, const Interval& c
     }
     case Op::Log: return increasing(static_cast<Fn>(std::log), floorLog(a.lo), floorLog(a.hi));
     case Op::Log10: return increasing(static_cast<Fn>(std::log10), floorLog(a.lo), floorLog(a.hi));
-    case Op::Sin: return sinLike(a, kPi / 2, -kPi / 2, static_cast<Fn>(std::sin));
-    case Op::Cos: return sinLike(a, 0.0, kPi, static_cast<Fn>(std::cos));
+    case Op::Sin: return sinLike(a, kPi / 2, -kPi / 2, ownSin);
+    case Op::Cos: return sinLike(a, 0.0, kPi, ownCos);
     case Op::Tan: return tanInterval(a);
     case Op::Asin: return increasing(static_cast<Fn>(std::asin), clamp1(a.lo), clamp1(a.hi));
     case Op::Acos: {

@@ -1,6 +1,7 @@
 // Hash-consed expression DAG: intern table, constant folding, structural rewrites.
 #include "frep/expressions/expr.h"
 #include "frep/expressions/pow_int.h"
+#include "frep/expressions/sin_cos.h"
 
 #include "frep/extremum/extremum.h"
 #include "frep/expressions/field_function.h"
@@ -268,8 +269,8 @@ double applyOp(Op op, double a, double b, double c, double imm) {
     case Op::Exp: return std::exp(a);
     case Op::Log: return std::log(a > kLogFloor ? a : kLogFloor);
     case Op::Log10: return std::log10(a > kLogFloor ? a : kLogFloor);
-    case Op::Sin: return std::sin(a);
-    case Op::Cos: return std::cos(a);
+    case Op::Sin: return ownSin(a);  // sin_cos.h: the bits every evaluator gives
+    case Op::Cos: return ownCos(a);
     case Op::Tan: return std::tan(a);
     case Op::Asin: return std::asin(a < -1.0 ? -1.0 : (a > 1.0 ? 1.0 : a));
     case Op::Acos: return std::acos(a < -1.0 ? -1.0 : (a > 1.0 ? 1.0 : a));

@@ -2,6 +2,7 @@
 // cut, centred (mean-value) upper bounds and local ascent (see extremum_terms.h).
 #include "extremum/extremum_terms.h"
 #include "evaluators/interval_fast.h"
+#include "frep/expressions/sin_cos.h"
 
 #include <algorithm>
 #include <cmath>
@@ -608,8 +609,8 @@ double TermForm::pointGrad(const double* t) {
       case Op::Abs: pa = a > 0.0 ? 1.0 : a < 0.0 ? -1.0 : 0.0; break;
       case Op::Exp: pa = v; break;
       case Op::Log: pa = a > kLogFloor ? 1.0 / a : 0.0; break;
-      case Op::Sin: pa = std::cos(a); break;
-      case Op::Cos: pa = -std::sin(a); break;
+      case Op::Sin: pa = ownCos(a); break;
+      case Op::Cos: pa = -ownSin(a); break;
       case Op::Atan: pa = 1.0 / (1.0 + a * a); break;
       case Op::Tanh: pa = 1.0 - v * v; break;
       case Op::Min: pass = b < a ? db : da; if (!(b < a ? depB : depA)) pass = nullptr; break;

@@ -60,9 +60,9 @@ class Tape {
   const std::vector<std::shared_ptr<const FieldFunction>>& fields() const { return *fields_; }
   const FieldFunction& field(const Instr& ins) const { return *(*fields_)[size_t(ins.imm)]; }
 
-  // Sin/Cos pairs of the same input value that the batch evaluator computes with one sincos()
-  // call at the first of the two: rotations and gyroids take both of one angle, and glibc's
-  // sincos costs less than sin + cos for the same bits. Per instruction: for the first of a
+  // Sin/Cos pairs of the same input value that the batch evaluator computes in one pass at the
+  // first of the two (ownSinCos, sin_cos.h, gives both from one reduction): rotations and
+  // gyroids take both of one angle. Per instruction: for the first of a
   // pair, the output register of the second (written at once); kSinCosDone for the second;
   // kNoSinCos for the rest. Empty when the tape has no pair. Built by compile and prune.
   static constexpr uint32_t kNoSinCos = UINT32_MAX, kSinCosDone = UINT32_MAX - 1;
