@@ -130,6 +130,10 @@ struct MeshOptions {
   // branch-and-bound tolerance among the model's extremum nodes (0 for models without them):
   // their searches' values are certified only that far, and each step costs a search.
   double rootStopValue = -1.0;
+  // Models with extremum nodes: vertices from shared grid-point values and warm-started searches
+  // along the edge, normals from those values (mesh_extremum_roots.cpp, docs/mesh.md); false: the
+  // generic root finder and gradient above (about 5x the searches; kept for comparison).
+  bool extremumVertices = true;
   // Roots are kept at least this fraction of the edge away from its ends, so no two vertices
   // coincide and no triangle is degenerate (the surface moves by at most this much).
   double endGuard = 1e-3;
