@@ -195,6 +195,7 @@ class RegionMesher {
     // take a band of 0 (half the evaluated points; the vertices get their own values).
     const bool extremumPath = tape_->hasExtrema() && opt_.extremumVertices;
     so.bandVoxels = extremumPath ? 0 : 1;
+    so.pointwiseSearches = extremumPath;  // signs that do not depend on the region
     so.fixedCoords = opt_.fixedCoords;
     so.threads = opt_.threads;
     for (int a = 0; a < 3; ++a) {

@@ -30,8 +30,8 @@ namespace frep {
 
 namespace {
 
-constexpr int kExtremumRootEvals = 4;    // searches per edge after its end values
-constexpr double kStopFraction = 1.0 / 256;
+constexpr int kExtremumRootEvals = 8;    // searches per edge after its end values
+constexpr double kStopFraction = 1.0 / 1024;
 
 using Params = std::vector<std::vector<double>>;  // arg-extremum per extremum entry of the tape
 

@@ -248,6 +248,7 @@ class Sampler {
     constexpr size_t B = BatchEvaluator<double>::kBatch;
     w.batch.reserve(tape);
     w.batch.countDomainErrors(&w.stats.domainErrors);
+    w.batch.setExtremumWarmStarts(!opt_.pointwiseSearches);
     for (size_t start = 0; start < n; start += B) {
       size_t count = std::min(B, n - start);
       for (size_t k = 0; k < count; ++k) {

@@ -67,9 +67,13 @@ class BatchEvaluator {
   const T* eval(const Tape& tape, size_t count);
   // Adds the domain errors of later evals (lanes < count) to *counts (nullptr: stop).
   void countDomainErrors(DomainCounts* counts) { domain_ = counts; }
+  // false: every lane's search starts cold, so each value is a function of its point alone
+  // (the PointEvaluator's value), at about twice the cost of warm-started lanes.
+  void setExtremumWarmStarts(bool on) { warmStarts_ = on; }
 
  private:
   DomainCounts* domain_ = nullptr;
+  bool warmStarts_ = true;
   void bind(const Tape& tape);
   void runExtremum(const Tape& tape, const Instr& ins, size_t count);
   std::vector<T> regs_;  // numRegs * kBatch, register-major
