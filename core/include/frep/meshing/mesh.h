@@ -9,7 +9,9 @@
 // 1 voxel). Every vertex lies on a sign-changing grid edge (axis edge, face diagonal or body
 // diagonal) and is keyed by that GLOBAL edge; its position comes from root finding on the model
 // along the edge (Illinois, with bisection as the fallback), its normal from the gradient
-// evaluator (outward = -grad f, inside is f >= 0).
+// evaluator (outward = -grad f, inside is f >= 0). Models with extremum nodes, where every
+// evaluation is a search, share grid-point values between edges instead (MeshOptions::
+// extremumVertices, mesh_extremum_roots.cpp).
 //
 // Sign rule: a grid point is inside when its value's sign bit is clear (+0 is inside, -0, NaN
 // and negative values are outside), so every edge has a strict sign change or none.
