@@ -2,8 +2,9 @@
 //
 // Every evaluation of such a model runs a branch-and-bound search (about 5 us cold, 2 us when
 // warm-started from a nearby arg-extremum), so the generic root finder's 7 evaluations per edge
-// plus a Danskin gradient (another 5 searches' worth, and wrong at the kinks where Minkowski
-// bodies reach their maximum) dominated meshing. Here:
+// plus a Danskin gradient (a search and ~300 body evaluations of polishing, and wrong at the
+// kinks where Minkowski bodies reach their maximum) dominated meshing. Here (every sign of the
+// cells comes from a cold search or an interval widened by the tolerance, see mesh.cpp):
 //   1. values at grid points: every end point of a sign-changing edge and every corner of the
 //      Kuhn tetrahedra around one, each a cold search (a function of the point), done once per
 //      point and shared by the edges (about half a search per edge);
@@ -11,8 +12,8 @@
 //      through the two latest points on one side of the root (exact where f is linear on that
 //      side: Minkowski fields are often kinked at the surface itself, where the search box
 //      clamps the arg-extremum), each search warm-started from the arg-extremum of the nearer
-//      bracket end; it stops once |f| <= max(rootStopValue, (f(in) - f(out)) / 256), i.e.
-//      within ~1/256 of the edge where f is linear along it, or after kExtremumRootEvals;
+//      bracket end; it stops once |f| <= max(rootStopValue, (f(in) - f(out)) / 1024), i.e.
+//      within ~1/1024 of the edge where f is linear along it, or after kExtremumRootEvals;
 //   3. normal: -(sum of the gradients of the linear interpolants on the tetrahedra around the
 //      edge), from the values of step 1: no further search.
 #include "meshing/mesh_extremum_roots.h"
