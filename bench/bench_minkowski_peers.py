@@ -135,7 +135,7 @@ def slab_exact_volume(r=0.3):
 
 def slab_section(args, frep, have_scad, work):
     exact = slab_exact_volume()
-    print("non-convex slab (+) ball r 0.3 (issue 17): frep mesh of the model vs OpenSCAD minkowki(), equal volume accuracy")
+    print("non-convex slab (+) ball r 0.3 (issue 17): frep mesh of the model vs OpenSCAD minkowski(), equal volume accuracy")
     print("exact volume %.6f (prism formula, see the header); load average %.2f" % (exact, os.getloadavg()[0]))
     hf = os.path.join(work, "slab.hf")
     with open(hf, "w") as f:
@@ -283,7 +283,7 @@ def main():
                     help="also time `frep mesh model.hf` (vertices by root finding on the model: slow with extremum nodes)")
     ap.add_argument("--only-slab", action="store_true", help="part 1 only (issue 17's comparison)")
     ap.add_argument("--no-slab", action="store_true", help="skip part 1")
-    ap.add_argument("--slab-res", default="40,44,48,52,56,60,64,72,80")
+    ap.add_argument("--slab-res", default="40,44,48,52,56,60,64,66,68,72,80")
     ap.add_argument("--slab-fn", default="64,96", help="OpenSCAD sphere $fn of part 1")
     ap.add_argument("--slab-workers", default="0", help="frep mesh --workers for part 1 (0: in-process, all cores)")
     ap.add_argument("--repeat", type=int, default=3, help="part 1: frep runs per resolution (median)")
