@@ -164,7 +164,7 @@ TEST(Sample, RejectsBadInput) {
   auto tape = Tape::compile(sphere(0, 0, 0, 1), 3);
   GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 16);
   SampleOptions o;
-  o.bandVoxels = 0;
+  o.bandVoxels = -1;
   EXPECT_THROW(sample(tape, g, o), std::invalid_argument);
   SampleOptions unaligned;
   unaligned.regionLo = {3, 0, 0};
@@ -172,6 +172,31 @@ TEST(Sample, RejectsBadInput) {
   auto tape4 = Tape::compile(sphere(0, 0, 0, 1) - square(Expr::x(3)), 4);
   EXPECT_THROW(sample(tape4, g), std::invalid_argument);
   EXPECT_THROW(GridSpec::fromBounds({1, 0, 0}, {0, 1, 1}, 16), std::invalid_argument);
+}
+
+TEST(Sample, BandZeroKeepsEverySignWithFewerEvaluations) {
+  // Band 0 (the mesher of extremum models): only points of 2^3 blocks whose own box may hold a
+  // zero are evaluated; every other point of a leaf keeps its certified sign as +-0.
+  const double r = 0.77;
+  auto tape = Tape::compile(sphere(0.01, 0.02, 0.03, r), 3);
+  GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 48);
+  SampleOptions zero, one;
+  zero.bandVoxels = 0;
+  one.bandVoxels = 1;
+  SampleResult a = sample(tape, g, zero), b = sample(tape, g, one);
+  EXPECT_LT(double(a.stats.pointEvals), 0.8 * double(b.stats.pointEvals));
+  size_t checked = 0;
+  for (const LeafBlock& leaf : a.leaves)
+    for (int i = 0; i < kLeafVoxels; ++i) {
+      const int64_t x = leaf.origin[0] + (i >> 6), y = leaf.origin[1] + ((i >> 3) & 7), z = leaf.origin[2] + (i & 7);
+      if (x >= g.dims[0] || y >= g.dims[1] || z >= g.dims[2]) continue;
+      auto p = g.world(x, y, z);
+      const double dx = p[0] - 0.01, dy = p[1] - 0.02, dz = p[2] - 0.03;
+      const double f = r * r - dx * dx - dy * dy - dz * dz;
+      EXPECT_EQ(!std::signbit(leaf.values[i]), f >= 0) << x << " " << y << " " << z;
+      ++checked;
+    }
+  EXPECT_GT(checked, 10000u);
 }
 
 TEST(Sample, FourDimensionalModelWithFixedCoordinate) {

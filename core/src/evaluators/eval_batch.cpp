@@ -428,7 +428,7 @@ void BatchEvaluator<T>::runExtremum(const Tape& tape, const Instr& ins, size_t c
     for (size_t k = 0; k < nin; ++k) xbuf_[k] = double(regs_[size_t(e.inputRegs[k]) * kBatch + i]);
     ExtremumResult r = solver.solve(xbuf_.data(), haveWarm ? warm_.data() : nullptr);
     res_[i] = r.value;
-    if (!r.t.empty()) {
+    if (warmStarts_ && !r.t.empty()) {
       warm_ = r.t;
       haveWarm = true;
     }

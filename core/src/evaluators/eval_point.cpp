@@ -20,12 +20,20 @@ double PointEvaluator::eval(const Tape& tape, const double* x) {
     return r[tape.resultReg()];
   }
   DomainError kind;
+  params_.resize(tape.extrema().size());
+  for (auto& p : params_) p.clear();
   for (const Instr& ins : tape.code()) {
     if (ins.op == Op::Extremum) {
       const ExtremumEntry& e = tape.extrema()[ins.a];
       xbuf_.resize(e.inputRegs.size());
       for (size_t k = 0; k < e.inputRegs.size(); ++k) xbuf_[k] = r[e.inputRegs[k]];
-      r[ins.out] = extrema_.get(tape, ins.a).solve(xbuf_.data()).value;
+      ExtremumSolver& solver = extrema_.get(tape, ins.a);
+      const double* warm = nullptr;
+      if (warm_ && ins.a < warm_->size() && (*warm_)[ins.a].size() == solver.spec().numParams())
+        warm = (*warm_)[ins.a].data();
+      ExtremumResult res = solver.solve(xbuf_.data(), warm);
+      r[ins.out] = res.value;
+      params_[ins.a] = std::move(res.t);
       continue;
     }
     if (ins.op == Op::Field) {

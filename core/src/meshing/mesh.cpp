@@ -21,6 +21,7 @@
 
 #include "frep/evaluators/eval.h"
 #include "meshing/kuhn_tables.h"
+#include "meshing/mesh_extremum_roots.h"
 #include "sampling/parallel_chunks.h"
 
 namespace frep {
@@ -190,7 +191,11 @@ class RegionMesher {
     if (lo_[0] >= cellHi_[0] || lo_[1] >= cellHi_[1] || lo_[2] >= cellHi_[2]) return piece;
 
     SampleOptions so;
-    so.bandVoxels = 1;
+    // Only signs are read from the sample; extremum models, whose point values are searches,
+    // take a band of 0 (half the evaluated points; the vertices get their own values).
+    const bool extremumPath = tape_->hasExtrema() && opt_.extremumVertices;
+    so.bandVoxels = extremumPath ? 0 : 1;
+    so.pointwiseSearches = extremumPath;  // signs that do not depend on the region
     so.fixedCoords = opt_.fixedCoords;
     so.threads = opt_.threads;
     for (int a = 0; a < 3; ++a) {
@@ -237,6 +242,13 @@ class RegionMesher {
                             [](const CrossEdge& a, const CrossEdge& b) { return a.key == b.key; }),
                 edges.end());
 
+    if (extremumPath) {
+      std::vector<ExtremumEdge> xedges(edges.size());
+      for (size_t i = 0; i < edges.size(); ++i) xedges[i] = {edges[i].key, edges[i].inAtBase};
+      extremumEdgeVertices(tape_, grid_, opt_, xedges, piece.vertices, piece.stats);
+      return finish(piece, keyTris, quads);
+    }
+
     // Vertices: roots along the edges, normals from the gradient. Each edge is solved with the
     // tape pruned over the 8^3 block of its base point (a box that depends on the edge only,
     // never on the region), in groups of edges sharing that block.
@@ -274,7 +286,13 @@ class RegionMesher {
       piece.stats.gradientEvals += w.gradientEvals;
       piece.stats.fallbackEdges += w.fallbacks;
     }
+    return finish(piece, keyTris, quads);
+  }
 
+ private:
+  // Triangles as local indices of the piece's vertices.
+  MeshPiece finish(MeshPiece& piece, const std::vector<std::array<EdgeKey, 3>>& keyTris,
+                   const std::vector<std::array<EdgeKey, 4>>& quads) {
     // Triangles as local indices (vertices are sorted by key, so index order is key order).
     // Quads: split along the shorter diagonal (ties: 0-2), a choice made from the quad alone.
     KeyIndex index(piece.vertices);
@@ -290,10 +308,9 @@ class RegionMesher {
     for (auto& t : tris) canonicalRotate(t);
     std::sort(tris.begin(), tris.end());
     piece.triangles = std::move(tris);
-    return piece;
+    return std::move(piece);
   }
 
- private:
   static uint64_t blockKey(const std::array<int32_t, 3>& o) { return edgeKey(o[0], o[1], o[2], 0); }
   static uint64_t tileKey(const std::array<int32_t, 3>& o, int32_t size) {
     int lg = 0;

@@ -58,7 +58,7 @@ class Sampler {
     if (grid.dims[0] <= 0 || grid.dims[1] <= 0 || grid.dims[2] <= 0)
       throw std::invalid_argument("sample: grid dimensions must be positive");
     if (!(grid.voxel > 0)) throw std::invalid_argument("sample: voxel size must be positive");
-    if (opt.bandVoxels < 1) throw std::invalid_argument("sample: band must be >= 1 voxel");
+    if (opt.bandVoxels < 0) throw std::invalid_argument("sample: band must be >= 0 voxels");
     if (nvars_ > 3 && opt.fixedCoords.size() < nvars_ - 3)
       throw std::invalid_argument("sample: model has " + std::to_string(nvars_) +
                                   " coordinates; give values for x[4..] (fixedCoords)");
@@ -248,6 +248,7 @@ class Sampler {
     constexpr size_t B = BatchEvaluator<double>::kBatch;
     w.batch.reserve(tape);
     w.batch.countDomainErrors(&w.stats.domainErrors);
+    w.batch.setExtremumWarmStarts(!opt_.pointwiseSearches);
     for (size_t start = 0; start < n; start += B) {
       size_t count = std::min(B, n - start);
       for (size_t k = 0; k < count; ++k) {

@@ -35,6 +35,13 @@ class PointEvaluator {
   double eval(const Tape& tape, const double* x);
   // Adds every domain error of later evals to *counts (nullptr: stop counting).
   void countDomainErrors(DomainCounts* counts) { domain_ = counts; }
+  // Extremum searches. After an eval, searchParams()[e] holds the arg-extremum (search
+  // parameters) found for the tape's extremum entry e, empty when that entry was not reached.
+  // setWarmStarts(w): later evals also start entry e's search from (*w)[e] when it has the
+  // search's size, so their values depend on w; nullptr (the default): every value is a
+  // function of its point alone.
+  const std::vector<std::vector<double>>& searchParams() const { return params_; }
+  void setWarmStarts(const std::vector<std::vector<double>>* warm) { warm_ = warm; }
 
  private:
   DomainCounts* domain_ = nullptr;
@@ -42,6 +49,8 @@ class PointEvaluator {
   uint64_t boundId_ = 0;
   ExtremumSlots extrema_;
   std::vector<double> xbuf_;
+  std::vector<std::vector<double>> params_;
+  const std::vector<std::vector<double>>* warm_ = nullptr;
 };
 
 // 2. Batch evaluation over up to kBatch points in structure-of-arrays form.
@@ -58,9 +67,13 @@ class BatchEvaluator {
   const T* eval(const Tape& tape, size_t count);
   // Adds the domain errors of later evals (lanes < count) to *counts (nullptr: stop).
   void countDomainErrors(DomainCounts* counts) { domain_ = counts; }
+  // false: every lane's search starts cold, so each value is a function of its point alone
+  // (the PointEvaluator's value), at about twice the cost of warm-started lanes.
+  void setExtremumWarmStarts(bool on) { warmStarts_ = on; }
 
  private:
   DomainCounts* domain_ = nullptr;
+  bool warmStarts_ = true;
   void bind(const Tape& tape);
   void runExtremum(const Tape& tape, const Instr& ins, size_t count);
   std::vector<T> regs_;  // numRegs * kBatch, register-major

@@ -9,7 +9,9 @@
 // 1 voxel). Every vertex lies on a sign-changing grid edge (axis edge, face diagonal or body
 // diagonal) and is keyed by that GLOBAL edge; its position comes from root finding on the model
 // along the edge (Illinois, with bisection as the fallback), its normal from the gradient
-// evaluator (outward = -grad f, inside is f >= 0).
+// evaluator (outward = -grad f, inside is f >= 0). Models with extremum nodes, where every
+// evaluation is a search, share grid-point values between edges instead (MeshOptions::
+// extremumVertices, mesh_extremum_roots.cpp).
 //
 // Sign rule: a grid point is inside when its value's sign bit is clear (+0 is inside, -0, NaN
 // and negative values are outside), so every edge has a strict sign change or none.
@@ -130,6 +132,10 @@ struct MeshOptions {
   // branch-and-bound tolerance among the model's extremum nodes (0 for models without them):
   // their searches' values are certified only that far, and each step costs a search.
   double rootStopValue = -1.0;
+  // Models with extremum nodes: vertices from shared grid-point values and warm-started searches
+  // along the edge, normals from those values (mesh_extremum_roots.cpp, docs/mesh.md); false: the
+  // generic root finder and gradient above (about 5x the searches; kept for comparison).
+  bool extremumVertices = true;
   // Roots are kept at least this fraction of the edge away from its ends, so no two vertices
   // coincide and no triangle is degenerate (the surface moves by at most this much).
   double endGuard = 1e-3;

@@ -47,7 +47,13 @@ struct Tile {
 };
 
 struct SampleOptions {
-  int bandVoxels = 3;  // voxels within this many voxels (Chebyshev) of a possible zero are sampled
+  // Voxels within this many voxels (Chebyshev) of a possible zero are sampled. 0: only the
+  // points of 2^3 blocks whose own box may hold a zero (every other point keeps a certified sign
+  // as +-0: what the mesher of extremum models reads).
+  int bandVoxels = 3;
+  // Extremum searches start cold in every lane, so every value is a function of its point (as
+  // PointEvaluator's) whatever the region: the mesher's signs. Default: warm-started lanes.
+  bool pointwiseSearches = false;
   // Index-space region to sample, [lo, hi) per axis; lo must be a multiple of 8. Default: all.
   std::array<int32_t, 3> regionLo{0, 0, 0};
   std::array<int32_t, 3> regionHi{-1, -1, -1};
