@@ -59,6 +59,10 @@ class PolygonField : public DistanceField {
   uint64_t contentHash() const override { return hash_; }
   std::string describe() const override { return name_; }
   int dims() const override { return 2; }
+  // One closed loop: its edges are the boundary of the solid (for a simple polygon; the sign
+  // assumes that too).
+  bool exactOutside() const override { return true; }
+  bool exactInside() const override { return true; }
   size_t size() const { return xy_.size() / 2; }
   double area() const { return area_; }
   const std::vector<double>& vertices() const { return xy_; }
@@ -96,6 +100,10 @@ class MeshField : public DistanceField {
   uint64_t contentHash() const override { return hash_; }
   std::string describe() const override { return name_; }
   const MeshCheck& check() const { return check_; }
+  // A closed (watertight, 2-manifold) mesh is the boundary of its solid, so sign * dist is its
+  // signed distance; with open edges the winding-number solid's boundary is not the triangles.
+  bool exactOutside() const override { return check_.closed(); }
+  bool exactInside() const override { return check_.closed(); }
   size_t numTriangles() const { return tris_.size() / 3; }
   size_t numVertices() const { return xyz_.size() / 3; }
   const std::vector<double>& vertices() const { return xyz_; }
