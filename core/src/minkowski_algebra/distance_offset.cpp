@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "frep/extremum/extremum.h"
 #include "frep/geometry/field.h"
 #include "frep/minkowski_algebra/registry.h"
 
@@ -59,11 +60,21 @@ std::string ballText(const Ball& b) {
   return buf;
 }
 
-// f(x + sign * c) + shift, registered as a BallOffset term.
-Expr offsetField(const Expr& f, const Ball& b, double sign, double shift, ExactTerm t) {
-  std::vector<Expr> xs;
-  for (uint32_t i = 0; i < 3; ++i) xs.push_back(Expr::x(i) + Expr(sign * b.centre[i]));
-  Expr r = remap(f, xs) + Expr(shift);
+// The sum by minkowskiSum's analytic shortcut (f(x - c) + r), the difference as f(x + c) - r;
+// registered as a BallOffset term.
+Expr offsetField(const Expr& f, const Ball& b, bool erosion, ExactTerm t) {
+  Expr r;
+  if (!erosion) {
+    MinkowskiOptions o;
+    o.aIsDistance = o.bIsBall = true;
+    o.ballCenter.assign(b.centre.begin(), b.centre.end());
+    o.ballRadius = b.radius;
+    r = minkowskiSum(f, Expr(0.0), 3, Bounds{}, o);
+  } else {
+    std::vector<Expr> xs;
+    for (uint32_t i = 0; i < 3; ++i) xs.push_back(Expr::x(i) + Expr(b.centre[i]));
+    r = remap(f, xs) - Expr(b.radius);
+  }
   t.kind = ExactTerm::Kind::BallOffset;
   t.sum = b.sum;
   registerExact(r, t);
@@ -83,7 +94,7 @@ bool distanceBallSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
     ExactTerm t;
     t.operand = x.what + " + " + ballText(*ball);
     t.exactOutside = true;  // dist(x, A ⊕ ball) = dist(x - c, A) - r outside
-    *out = offsetField(field, *ball, -1.0, ball->radius, t);
+    *out = offsetField(field, *ball, false, t);
     return true;
   }
   return false;
@@ -98,7 +109,7 @@ bool distanceBallDifference(const Expr& a, const Expr& b, uint32_t dims, Expr* o
   t.operand = x.what + " - " + ballText(*ball);
   t.erosion = true;
   t.exactInside = true;  // dist(x, complement of A ⊖ ball) = dist(x + c, complement of A) - r inside
-  *out = offsetField(a, *ball, 1.0, -ball->radius, t);
+  *out = offsetField(a, *ball, true, t);
   return true;
 }
 

@@ -35,6 +35,9 @@ class Bvh {
   template <typename F>
   int64_t nearest(const double* p, F&& dist2, double& best2) const;
   size_t numNodes() const { return nodes_.size(); }
+  // A lower bound of the distance between box q and every primitive: the least distance from q
+  // to a leaf's box (0 when q touches one).
+  double boxGap(const Box& q) const;
 
  private:
   struct NodeB {
@@ -109,6 +112,10 @@ class MeshField : public DistanceField {
   const std::vector<double>& vertices() const { return xyz_; }
   const std::vector<uint32_t>& triangles() const { return tris_; }
   double distance(const double* p, double* q = nullptr) const;  // unsigned, closest point
+  // The Lipschitz bound, and on a closed mesh a box that touches no leaf box of the hierarchy
+  // has one sign and |f| >= its gap to them: the bound of a box near, not on, the surface
+  // then excludes 0 (the sampler keeps fewer voxels).
+  Interval bound(const Interval box[3]) const override;
   double windingNumber(const double* p) const;                   // exact sum, O(n)
   double volume() const;                                          // divergence theorem
 
