@@ -186,9 +186,9 @@ TEST_F(HybridSweptCut, ASweptMeshToolCutFromAScannedBlockIsTheSameThroughTheFarm
 
 // Known bug, not yet found: sampled by `frep sample` (0 or 2 workers alike), 8 lattice points
 // near the sweep's ends at z = 0.4, e.g. (0.1, 0, 0.4), get f = -0.022 where `frep eval` gives
-// +0.029 (stock 0.05 inside, sweep -0.05 outside). The core sampler alone gets the sweep right
-// there (-0.05, also with the tool as a formula), so the difference lies in the composition with
-// frVolume or in the CLI's sampling path. Enable when fixed.
+// +0.029 (stock 0.05 inside, sweep -0.05 outside). frep::sample() of the same compiled model on
+// the same world lattice gives +0.029 there, so the difference lies in the CLI/worker's brick
+// path (regions, job compilation), not in the fields or the search. Enable when fixed.
 TEST_F(HybridSweptCut, DISABLED_ASweptMeshToolCutFromAScannedBlockIsTheExactSolid) {
   sampleBoth();
   // The inside lattice points are those of the exact solid (no point is within half a voxel
