@@ -21,6 +21,7 @@
 #include "frep/extremum/extremum.h"
 #include "frep/evaluators/interval.h"
 #include "frep/expressions/tape.h"
+#include "frep/minkowski_algebra/distance_offset.h"
 #include "frep/relations/relations.h"
 #include "lib_fr_minkowski.h"
 #include "lib_hf_util.h"
@@ -233,11 +234,22 @@ Expr objectPair(const char* fn, std::vector<Arg>& a, Build build) {
 }
 
 // Basic-set operands (Roerdink-Minkowski, lib_fr_minkowski.h) take the exact algebra instead of
-// the search; the options then do not apply (there is nothing to search).
+// the search, and so does an exact signed distance (a closed mesh, a polygon, Bezier geometry)
+// with a ball (minkowski_algebra/distance_offset.h); the options then do not apply (there is
+// nothing to search).
 bool exactPair(std::vector<Arg>& a, bool diff, Expr* out) {
   if (a.size() < 3 || !a[1].isObject || !a[2].isObject || !a[0].isArray || !a[0].array) return false;
-  return diff ? exactMinkowskiDiff(a[1], a[2], *a[0].array, out)
-              : exactMinkowskiSum({&a[1], &a[2]}, *a[0].array, out);
+  if (diff ? exactMinkowskiDiff(a[1], a[2], *a[0].array, out) : exactMinkowskiSum({&a[1], &a[2]}, *a[0].array, out))
+    return true;
+  if (a[1].objectDims != 3 || a[2].objectDims != 3 || numParams(a[1].value) > 0 || numParams(a[2].value) > 0 ||
+      a[0].array->size() < 3)
+    return false;
+  Expr r;
+  if (!(diff ? minkowski::distanceBallDifference(a[1].value, a[2].value, 3, &r)
+             : minkowski::distanceBallSum(a[1].value, a[2].value, 3, &r)))
+    return false;
+  *out = through(r, *a[0].array, 3);
+  return true;
 }
 
 Expr frMinkowski(std::vector<Arg>& a) {
@@ -267,6 +279,11 @@ Expr frMinkowskiSum(std::vector<Arg>& a) {
                                    static_cast<int>(end));
   Expr r = ops[0]->value;
   for (size_t i = 1; i < ops.size(); ++i) {
+    Expr offset;
+    if (n == 3 && minkowski::distanceBallSum(r, ops[i]->value, 3, &offset)) {
+      r = offset;
+      continue;
+    }
     Bounds bb = autoBox(fn, *ops[i], static_cast<int>(i + 1));
     r = guarded(fn, -1, [&] { return minkowskiSum(r, ops[i]->value, static_cast<uint32_t>(n), bb, minkowskiOptions(o)); });
   }

@@ -157,7 +157,7 @@ bool exactMinkowskiSum(const std::vector<const Arg*>& operands, const std::vecto
 bool exactMinkowskiDiff(const Arg& A, const Arg& B, const std::vector<Expr>& xs, Expr* out) {
   if (xs.size() < 3 || A.objectDims != 3 || B.objectDims != 3) return false;
   std::optional<ExactTerm> ta = minkowski::lookupExact(A.value), tb = minkowski::lookupExact(B.value);
-  if (!ta || !tb || tb->kind != ExactTerm::Kind::Sum) return false;
+  if (!ta || !tb || tb->kind != ExactTerm::Kind::Sum || ta->kind == ExactTerm::Kind::BallOffset) return false;
   ExactTerm t;
   t.kind = ExactTerm::Kind::Erosion;
   if (ta->kind == ExactTerm::Kind::Sum) {

@@ -379,6 +379,32 @@ TEST(MeshField, IntervalBoundsAreSoundAndTight) {
   }
 }
 
+TEST(MeshField, BoxesThatMissTheTrianglesKeepOneSign) {
+  // Boxes near the surface of a closed torus: where a box touches no leaf box of the hierarchy
+  // the bound excludes 0 even when the Lipschitz bound f(c) +- half-diagonal does not; sound at
+  // every sampled point either way.
+  Soup s = torus(0.8, 0.3, 48, 24);
+  auto field = std::make_shared<MeshField>(s.xyz, s.tris, "torus");
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> ang(0, 2 * M_PI), off(-0.2, 0.2), w(0.01, 0.12);
+  int tighter = 0;
+  for (int b = 0; b < 400; ++b) {
+    const double a = ang(rng), v = ang(rng), d = 0.3 + off(rng), h = w(rng);
+    const double c[3] = {(0.8 + d * std::cos(v)) * std::cos(a), (0.8 + d * std::cos(v)) * std::sin(a), d * std::sin(v)};
+    const Interval box[3] = {{c[0] - h, c[0] + h}, {c[1] - h, c[1] + h}, {c[2] - h, c[2] + h}};
+    const Interval r = field->bound(box), lip = field->DistanceField::bound(box);
+    EXPECT_TRUE(r.lo >= lip.lo && r.hi <= lip.hi);
+    if ((r.lo > 0 || r.hi < 0) && !(lip.lo > 0 || lip.hi < 0)) ++tighter;
+    for (int k = 0; k < 125; ++k) {
+      const double p[3] = {box[0].lo + 2 * h * (k % 5) / 4.0, box[1].lo + 2 * h * ((k / 5) % 5) / 4.0,
+                           box[2].lo + 2 * h * (k / 25) / 4.0};
+      const double fv = field->value(p);
+      EXPECT_TRUE(fv >= r.lo && fv <= r.hi) << fv << " not in [" << r.lo << ", " << r.hi << "]";
+    }
+  }
+  EXPECT_GT(tighter, 5);  // 13 of 400 with this seed
+}
+
 TEST(MeshField, OpenMeshReportsEdgesAndSignsByWindingNumber) {
   Soup s = cube(0.5);
   s.tris.resize(s.tris.size() - 3);  // drop one triangle: 3 open edges

@@ -61,4 +61,33 @@ uint32_t Bvh::buildRange(const std::vector<Box>& boxes, std::vector<double>& cen
   return id;
 }
 
+double Bvh::boxGap(const Box& q) const {
+  double best2 = INFINITY;
+  if (nodes_.empty()) return best2;
+  auto gap2 = [&](const Box& b) {
+    double s = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = std::max({0.0, b.lo[k] - q.hi[k], q.lo[k] - b.hi[k]});
+      s += d * d;
+    }
+    return s;
+  };
+  uint32_t stack[128];
+  int sp = 0;
+  stack[sp++] = 0;
+  while (sp > 0 && best2 > 0.0) {
+    const NodeB& n = nodes_[stack[--sp]];
+    const double g = gap2(n.box);
+    if (g >= best2) continue;
+    if (n.count > 0) {
+      best2 = g;
+      continue;
+    }
+    stack[sp++] = n.left;
+    stack[sp++] = n.right;
+  }
+  // Rounded down: the square root and the squares may round either way.
+  return std::sqrt(best2) * (1.0 - 1e-12);
+}
+
 }  // namespace frep

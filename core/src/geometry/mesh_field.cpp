@@ -223,6 +223,21 @@ double MeshField::signedDistance(const double* p, double* q) const {
 
 double MeshField::value(const double* p) const { return signedDistance(p, nullptr); }
 
+Interval MeshField::bound(const Interval box[3]) const {
+  const Interval lip = DistanceField::bound(box);
+  if (!check_.closed() || lip.lo > 0.0 || lip.hi < 0.0 || !std::isfinite(lip.lo) || !std::isfinite(lip.hi)) return lip;
+  Bvh::Box q;
+  for (int k = 0; k < 3; ++k) q.lo[k] = box[k].lo, q.hi[k] = box[k].hi;
+  const double gap = bvh_.boxGap(q);
+  if (!(gap > 0.0)) return lip;
+  // The box meets no triangle: f keeps the sign of its value at the centre (the midpoint of
+  // lip) and |f| >= gap throughout.
+  const double mid = 0.5 * (lip.lo + lip.hi);
+  if (mid > 0.0) return {std::max(lip.lo, gap), lip.hi};
+  if (mid < 0.0) return {lip.lo, std::min(lip.hi, -gap)};
+  return lip;
+}
+
 double MeshField::distance(const double* p, double* q) const {
   double qq[3];
   return std::fabs(signedDistance(p, q ? q : qq));

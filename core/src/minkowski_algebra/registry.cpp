@@ -38,7 +38,11 @@ std::vector<std::string> describeExact(const Expr& f) {
     if (it == table().end()) return;
     const ExactTerm& t = it->second.term;
     if (t.kind == ExactTerm::Kind::Sum && t.sum.terms < 2) return;  // a member alone: no operation
-    if (t.kind == ExactTerm::Kind::Sum)
+    if (t.kind == ExactTerm::Kind::BallOffset)
+      lines.push_back(std::string("exact Minkowski ") + (t.erosion ? "difference " : "sum ") + t.operand +
+                      " as the offset f " + (t.erosion ? "- " : "+ ") +
+                      "r of an exact signed distance, error bound 0 (no search)");
+    else if (t.kind == ExactTerm::Kind::Sum)
       lines.push_back("exact Minkowski algebra (Roerdink): " + t.sum.describe() + " as a union of " +
                       std::to_string(t.pieces) + " primitives, error bound 0 (no search)");
     else

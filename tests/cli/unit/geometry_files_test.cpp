@@ -176,6 +176,44 @@ TEST(GeometryFiles, MeshOffsetByABallHasSteinersVolume) {
   EXPECT_NEAR(sampledVolume(r.model.field, -0.4, 1.4, 160) / steiner, 1.0, 0.01);
 }
 
+// frMinkowski of a file operand and frBall: a closed mesh is an exact signed distance, so the
+// sum is its offset (no extremum node, Steiner's volume); an open mesh (winding-number solid)
+// and a trilinear .vdb volume are not exact distances and keep the certified search.
+TEST(GeometryFiles, MinkowskiSumWithABallIsAnOffsetOnlyForExactDistances) {
+  TempDir d;
+  d.file("cube.stl", binaryStl());
+  d.file("open.stl", asciiStl(1));
+  io::installGeometryLoader();
+  auto compileSum = [&](const std::string& part) {
+    const std::string path = d.file("sum.hf", "p(x[3], a[1]) { p = " + part + "; }\n"
+                                              "b(x[3], a[1]) { b = frBall(x, 0.25); }\n"
+                                              "my_model(x[3], a[1]) { my_model = frMinkowski(x, p, b); }\n");
+    return lang::compileFile(path);
+  };
+  auto hasExtremum = [](const Expr& f) {
+    bool found = false;
+    forEachNode(f, [&](const Node& n) { found = found || n.op == Op::Extremum; });
+    return found;
+  };
+  lang::CompileResult closed = compileSum("frMesh(x, \"cube.stl\")");
+  ASSERT_TRUE(closed.ok) << (closed.diagnostics.empty() ? "" : closed.diagnostics[0].format());
+  EXPECT_FALSE(hasExtremum(closed.model.field));
+  const double rr = 0.25, steiner = 1 + 6 * rr + 3 * M_PI * rr * rr + 4.0 / 3.0 * M_PI * rr * rr * rr;
+  EXPECT_NEAR(sampledVolume(closed.model.field, -0.4, 1.4, 160) / steiner, 1.0, 0.01);
+
+  lang::CompileResult open = compileSum("frMesh(x, \"open.stl\")");
+  ASSERT_TRUE(open.ok);
+  EXPECT_TRUE(hasExtremum(open.model.field));
+
+  openvdb::initialize();
+  auto grid = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(0.5f, openvdb::Vec3f(0, 0, 0), 0.05f);
+  grid->setName("sphere");
+  openvdb::io::File(d.path + "/s.vdb").write({grid});
+  lang::CompileResult vol = compileSum("frVolume(x, \"s.vdb\")");
+  ASSERT_TRUE(vol.ok) << (vol.diagnostics.empty() ? "" : vol.diagnostics[0].format());
+  EXPECT_TRUE(hasExtremum(vol.model.field));
+}
+
 TEST(GeometryFiles, OpenMeshWarnsAndMissingFileIsAnErrorAtTheCall) {
   TempDir d;
   d.file("open.stl", asciiStl(1));

@@ -35,6 +35,9 @@ class Bvh {
   template <typename F>
   int64_t nearest(const double* p, F&& dist2, double& best2) const;
   size_t numNodes() const { return nodes_.size(); }
+  // A lower bound of the distance between box q and every primitive: the least distance from q
+  // to a leaf's box (0 when q touches one).
+  double boxGap(const Box& q) const;
 
  private:
   struct NodeB {
@@ -59,6 +62,10 @@ class PolygonField : public DistanceField {
   uint64_t contentHash() const override { return hash_; }
   std::string describe() const override { return name_; }
   int dims() const override { return 2; }
+  // One closed loop: its edges are the boundary of the solid (for a simple polygon; the sign
+  // assumes that too).
+  bool exactOutside() const override { return true; }
+  bool exactInside() const override { return true; }
   size_t size() const { return xy_.size() / 2; }
   double area() const { return area_; }
   const std::vector<double>& vertices() const { return xy_; }
@@ -96,11 +103,19 @@ class MeshField : public DistanceField {
   uint64_t contentHash() const override { return hash_; }
   std::string describe() const override { return name_; }
   const MeshCheck& check() const { return check_; }
+  // A closed (watertight, 2-manifold) mesh is the boundary of its solid, so sign * dist is its
+  // signed distance; with open edges the winding-number solid's boundary is not the triangles.
+  bool exactOutside() const override { return check_.closed(); }
+  bool exactInside() const override { return check_.closed(); }
   size_t numTriangles() const { return tris_.size() / 3; }
   size_t numVertices() const { return xyz_.size() / 3; }
   const std::vector<double>& vertices() const { return xyz_; }
   const std::vector<uint32_t>& triangles() const { return tris_; }
   double distance(const double* p, double* q = nullptr) const;  // unsigned, closest point
+  // The Lipschitz bound, and on a closed mesh a box that touches no leaf box of the hierarchy
+  // has one sign and |f| >= its gap to them: the bound of a box near, not on, the surface
+  // then excludes 0 (the sampler keeps fewer voxels).
+  Interval bound(const Interval box[3]) const override;
   double windingNumber(const double* p) const;                   // exact sum, O(n)
   double volume() const;                                          // divergence theorem
 

@@ -31,6 +31,12 @@ class DistanceField : public FieldFunction {
   virtual double lipschitz() const { return 1.0; }
   // Coordinates the field reads (2: a planar field ignores p[2], so its bound ignores box[2]).
   virtual int dims() const { return 3; }
+  // Where value() is the exact Euclidean signed distance to its solid S = {f >= 0}: outside
+  // (f(p) = -dist(p, S)) and inside (f(p) = dist(p, complement of S)). Minkowski sums and
+  // differences with a ball then reduce to offsets (minkowski_algebra/distance_offset.h).
+  // Default: neither (a sampled or approximate field).
+  virtual bool exactOutside() const { return false; }
+  virtual bool exactInside() const { return false; }
 
  protected:
   // Called only for another object of the same dynamic type and content hash.

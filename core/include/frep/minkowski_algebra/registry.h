@@ -15,10 +15,15 @@
 namespace frep::minkowski {
 
 struct ExactTerm {
-  enum class Kind { Sum, Erosion } kind = Kind::Sum;
-  Sum sum;         // Sum: the secondary object; Erosion: the subtracted sum C1 ⊕ … ⊕ CN
+  // BallOffset: a distance-field operand plus or minus a ball (distance_offset.h).
+  enum class Kind { Sum, Erosion, BallOffset } kind = Kind::Sum;
+  Sum sum;         // Sum: the secondary object; Erosion: the subtracted sum C1 ⊕ … ⊕ CN; BallOffset: the ball
   Sum c0;          // Erosion: the solid eroded (a block or a sphere)
   int pieces = 0;  // primitives of the union (Sum) or intersection (Erosion)
+  // BallOffset: "A ⊕ ball(...)" for reports, A ⊖ ball (else A ⊕ ball), and where the result
+  // is itself an exact signed distance (so a further ball can take the same path).
+  std::string operand;
+  bool erosion = false, exactOutside = false, exactInside = false;
 };
 
 void registerExact(const Expr& e, const ExactTerm& t);

@@ -1,0 +1,116 @@
+// Minkowski sum / difference of an exact signed distance and a ball as an offset
+// (distance_offset.h).
+#include "frep/minkowski_algebra/distance_offset.h"
+
+#include <cstdio>
+#include <optional>
+#include <string>
+
+#include "frep/extremum/extremum.h"
+#include "frep/geometry/field.h"
+#include "frep/minkowski_algebra/registry.h"
+
+namespace frep::minkowski {
+namespace {
+
+struct Ball {
+  Vec3 centre{0, 0, 0};
+  double radius = 0;
+  Sum sum;
+};
+
+// A registered basic-set sum with no block edges and no discs: a ball (radius 0: a point).
+std::optional<Ball> ballOf(const Expr& e) {
+  std::optional<ExactTerm> t = lookupExact(e);
+  if (!t || t->kind != ExactTerm::Kind::Sum) return std::nullopt;
+  const Sum& s = t->sum;
+  for (int i = 0; i < 3; ++i)
+    if (s.lengths[i] != 0 || s.disc[i] != 0) return std::nullopt;
+  return Ball{s.offset, s.ball, s};
+}
+
+// x_i, x_i + k or x_i - k (k constant): a translation keeps a distance exact.
+bool translatedCoordinate(const Expr& e, uint32_t i) {
+  auto isXi = [i](const Expr& v) { return v.op() == Op::Var && v.node().index == i; };
+  if (isXi(e)) return true;
+  if (e.op() == Op::Add) return (isXi(e.arg(0)) && e.arg(1).isConst()) || (e.arg(0).isConst() && isXi(e.arg(1)));
+  if (e.op() == Op::Sub) return isXi(e.arg(0)) && e.arg(1).isConst();
+  return false;
+}
+
+struct Exactness {
+  bool outside = false, inside = false;
+  std::string what;
+};
+
+Exactness exactnessOf(const Expr& e) {
+  if (std::optional<ExactTerm> t = lookupExact(e); t && t->kind == ExactTerm::Kind::BallOffset)
+    return {t->exactOutside, t->exactInside, "(" + t->operand + ")"};
+  if (e.op() != Op::Field) return {};
+  const auto* d = dynamic_cast<const DistanceField*>(e.node().fn.get());
+  if (!d) return {};
+  for (int i = 0; i < d->dims(); ++i)
+    if (!translatedCoordinate(e.arg(i), static_cast<uint32_t>(i))) return {};
+  return {d->exactOutside(), d->exactInside(), d->describe()};
+}
+
+std::string ballText(const Ball& b) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "ball(r %g at (%g, %g, %g))", b.radius, b.centre[0], b.centre[1], b.centre[2]);
+  return buf;
+}
+
+// The sum by minkowskiSum's analytic shortcut (f(x - c) + r), the difference as f(x + c) - r;
+// registered as a BallOffset term.
+Expr offsetField(const Expr& f, const Ball& b, bool erosion, ExactTerm t) {
+  Expr r;
+  if (!erosion) {
+    MinkowskiOptions o;
+    o.aIsDistance = o.bIsBall = true;
+    o.ballCenter.assign(b.centre.begin(), b.centre.end());
+    o.ballRadius = b.radius;
+    r = minkowskiSum(f, Expr(0.0), 3, Bounds{}, o);
+  } else {
+    std::vector<Expr> xs;
+    for (uint32_t i = 0; i < 3; ++i) xs.push_back(Expr::x(i) + Expr(b.centre[i]));
+    r = remap(f, xs) - Expr(b.radius);
+  }
+  t.kind = ExactTerm::Kind::BallOffset;
+  t.sum = b.sum;
+  registerExact(r, t);
+  return r;
+}
+
+}  // namespace
+
+bool distanceBallSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
+  if (dims != 3) return false;
+  for (int k = 0; k < 2; ++k) {
+    const Expr& field = k == 0 ? a : b;
+    std::optional<Ball> ball = ballOf(k == 0 ? b : a);
+    if (!ball) continue;
+    Exactness x = exactnessOf(field);
+    if (!x.outside) continue;
+    ExactTerm t;
+    t.operand = x.what + " + " + ballText(*ball);
+    t.exactOutside = true;  // dist(x, A ⊕ ball) = dist(x - c, A) - r outside
+    *out = offsetField(field, *ball, false, t);
+    return true;
+  }
+  return false;
+}
+
+bool distanceBallDifference(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
+  if (dims != 3) return false;
+  std::optional<Ball> ball = ballOf(b);
+  Exactness x = exactnessOf(a);
+  if (!ball || !x.inside) return false;
+  ExactTerm t;
+  t.operand = x.what + " - " + ballText(*ball);
+  t.erosion = true;
+  t.exactInside = true;  // dist(x, complement of A ⊖ ball) = dist(x + c, complement of A) - r inside
+  *out = offsetField(a, *ball, true, t);
+  return true;
+}
+
+}  // namespace frep::minkowski
