@@ -184,12 +184,9 @@ TEST_F(HybridSweptCut, ASweptMeshToolCutFromAScannedBlockIsTheSameThroughTheFarm
   EXPECT_LT(frep::insideVolume(s), 3.9 * 1.9 * 0.9 - 0.5);
 }
 
-// Known bug, not yet found: sampled by `frep sample` (0 or 2 workers alike), 8 lattice points
-// near the sweep's ends at z = 0.4, e.g. (0.1, 0, 0.4), get f = -0.022 where `frep eval` gives
-// +0.029 (stock 0.05 inside, sweep -0.05 outside). frep::sample() of the same compiled model on
-// the same world lattice gives +0.029 there, so the difference lies in the CLI/worker's brick
-// path (regions, job compilation), not in the fields or the search. Enable when fixed.
-TEST_F(HybridSweptCut, DISABLED_ASweptMeshToolCutFromAScannedBlockIsTheExactSolid) {
+// The signed-distance store keeps every sampled sign: OpenVDB's rebuild alone flipped 8 voxels
+// next to the slot's ends at z = 0.4 (e.g. (0.1, 0, 0.4): -0.022 where f = +0.029).
+TEST_F(HybridSweptCut, ASweptMeshToolCutFromAScannedBlockIsTheExactSolid) {
   sampleBoth();
   // The inside lattice points are those of the exact solid (no point is within half a voxel
   // of its boundary): volume 3.9 * 1.9 * 0.9 - 3 * 1 * 0.4 on the lattice.
