@@ -392,9 +392,13 @@ class Simplifier {
     double longest = std::max({norm(sub(b, a)), norm(sub(c, b)), norm(sub(a, c))});
     int m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
     const V3 u = scale(sub(b, a), 1.0 / m), v = scale(sub(c, a), 1.0 / m);
-    // The centroids of the m^2 sub-triangles (not the corners or edges: on a crease of the
-    // model the sign test along the normal is ill-posed): sub-triangle (i, j, up) has its
-    // centroid at a + (i + 1/3) u + (j + 1/3) v, or (i + 2/3, j + 2/3) when upside down.
+    // The centroids of the m(m+1)/2 upright sub-triangles of the m x m subdivision (not the
+    // corners or edges: on a crease of the model the sign test along the normal is ill-posed):
+    // sub-triangle (i, j, up) has its centroid at a + (i + 1/3) u + (j + 1/3) v, a lattice of
+    // spacing longest/m <= half a voxel. The upside-down ones' centroids (i + 2/3, j + 2/3) are
+    // left out: every point of the triangle is exactly as near to the nearest sample without
+    // them (the farthest points are at the corners and edges, covered by upright ones; brute
+    // force over random triangles, docs/mesh.md), at half the evaluations.
     // Probes first: the sub-triangles holding the centroid and the midpoints between it and
     // the corners.
     std::array<int, 3> probes[kProbes];
@@ -406,6 +410,12 @@ class Simplifier {
       std::array<int, 3> id{i, j, up};
       if (std::find(probes, probes + nProbes, id) == probes + nProbes) probes[nProbes++] = id;
     }
+    // Plain comparisons (std::array's == is a memcmp call, once per point and probe).
+    auto isProbe = [&](int i, int j, int up) {
+      for (size_t k = 0; k < nProbes; ++k)
+        if (probes[k][0] == i && probes[k][1] == j && probes[k][2] == up) return true;
+      return false;
+    };
     std::vector<V3>& pts = samplePoints_;
     pts.clear();
     size_t index = 0;
@@ -418,11 +428,8 @@ class Simplifier {
     };
     for (size_t k = 0; k < nProbes; ++k) emit(probes[k][0], probes[k][1], probes[k][2]);
     for (int i = 0; i < m && index < to; ++i)
-      for (int j = 0; i + j < m; ++j)
-        for (int up = 1; up >= 0; --up) {
-          if (!up && i + j > m - 2) continue;
-          if (std::find(probes, probes + nProbes, std::array<int, 3>{i, j, up}) == probes + nProbes) emit(i, j, up);
-        }
+      for (int j = 0; i + j < m && index < to; ++j)
+        if (!isProbe(i, j, 1)) emit(i, j, 1);
     return crossedAlong(pts, scale(d, e));
   }
 
@@ -431,13 +438,15 @@ class Simplifier {
     const uint32_t nvars = tape_->numVars();
     batch_.reserve(*tape_);
     const size_t perCall = BatchEvaluator<double>::kBatch / 2;
+    inputs_.resize(nvars);
+    for (uint32_t k = 0; k < nvars; ++k) inputs_[k] = batch_.in(k);
     for (size_t s = 0; s < pts.size(); s += perCall) {
       size_t n = std::min(perCall, pts.size() - s);
-      for (size_t i = 0; i < n; ++i)
-        for (int side = 0; side < 2; ++side) {
-          V3 q = side == 0 ? sub(pts[s + i], d) : add(pts[s + i], d);
-          for (uint32_t k = 0; k < nvars; ++k) batch_.in(k)[2 * i + side] = k < 3 ? q[k] : opt_.fixedCoords[k - 3];
-        }
+      for (size_t i = 0; i < n; ++i) {
+        const V3 lo = sub(pts[s + i], d), hi = add(pts[s + i], d);
+        for (int k = 0; k < 3; ++k) inputs_[k][2 * i] = lo[k], inputs_[k][2 * i + 1] = hi[k];
+      }
+      for (uint32_t k = 3; k < nvars; ++k) std::fill_n(inputs_[k], 2 * n, opt_.fixedCoords[k - 3]);
       const double* f = batch_.eval(*tape_, 2 * n);
       stats_.modelEvals += 2 * n;
       for (size_t i = 0; i < n; ++i)
@@ -631,11 +640,13 @@ class Simplifier {
             if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
             pr.seen = probeNow_;
             const Tri& tu = w_.tris[e.tri];
-            const std::array<exact::P, 3> qu{qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]};
+            std::array<exact::P, 3> qu;
+            bool loaded = false;  // the corners only for a triangle whose box meets a new one's
             for (const NewTri& n : fresh) {
               if (e.hi[0] < n.lo[0] || e.lo[0] > n.hi[0] || e.hi[1] < n.lo[1] || e.lo[1] > n.hi[1] || e.hi[2] < n.lo[2] ||
                   e.lo[2] > n.hi[2])
                 continue;
+              if (!loaded) qu = {qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]}, loaded = true;
               if (improperPair(n.t, n.q, tu, qu)) {
                 bad = true;
                 break;
@@ -750,6 +761,7 @@ class Simplifier {
   double tol_;
   SimplifyStats stats_;
   std::vector<V3> samplePoints_;
+  std::vector<double*> inputs_;  // the batch evaluator's input lanes, one array per coordinate
   struct Scratch {
     std::vector<uint32_t> na, nb, opposite, common, changed, removed, ring;
     std::vector<int8_t> newLevel;
