@@ -394,42 +394,38 @@ class Simplifier {
     const V3 u = scale(sub(b, a), 1.0 / m), v = scale(sub(c, a), 1.0 / m);
     // The centroids of the m(m+1)/2 upright sub-triangles of the m x m subdivision (not the
     // corners or edges: on a crease of the model the sign test along the normal is ill-posed):
-    // sub-triangle (i, j, up) has its centroid at a + (i + 1/3) u + (j + 1/3) v, a lattice of
+    // upright sub-triangle (i, j) has its centroid at a + (i + 1/3) u + (j + 1/3) v, a lattice of
     // spacing longest/m <= half a voxel. The upside-down ones' centroids (i + 2/3, j + 2/3) are
     // left out: every point of the triangle is exactly as near to the nearest sample without
     // them (the farthest points are at the corners and edges, covered by upright ones; brute
     // force over random triangles, docs/mesh.md), at half the evaluations.
-    // Probes first: the sub-triangles holding the centroid and the midpoints between it and
-    // the corners.
-    std::array<int, 3> probes[kProbes];
+    // Probes first: the upright sub-triangles at (or next to, from an upside-down one) the
+    // centroid and the midpoints between it and the corners; they belong to the full set.
+    std::array<int, 2> probes[kProbes];
     size_t nProbes = 0;
     const double targets[kProbes][2] = {{m / 3.0, m / 3.0}, {m / 6.0, m / 6.0}, {2 * m / 3.0, m / 6.0}, {m / 6.0, 2 * m / 3.0}};
     for (const auto& tg : targets) {
       int i = std::min(int(tg[0]), m - 1), j = std::min(int(tg[1]), m - 1 - i);
-      int up = tg[0] - i + tg[1] - j < 1 || i + j > m - 2 ? 1 : 0;
-      std::array<int, 3> id{i, j, up};
-      if (std::find(probes, probes + nProbes, id) == probes + nProbes) probes[nProbes++] = id;
+      bool known = false;
+      for (size_t k = 0; k < nProbes; ++k) known = known || (probes[k][0] == i && probes[k][1] == j);
+      if (!known) probes[nProbes++] = {i, j};
     }
-    // Plain comparisons (std::array's == is a memcmp call, once per point and probe).
-    auto isProbe = [&](int i, int j, int up) {
+    auto isProbe = [&](int i, int j) {  // plain comparisons: std::array's == is a memcmp call
       for (size_t k = 0; k < nProbes; ++k)
-        if (probes[k][0] == i && probes[k][1] == j && probes[k][2] == up) return true;
+        if (probes[k][0] == i && probes[k][1] == j) return true;
       return false;
     };
     std::vector<V3>& pts = samplePoints_;
     pts.clear();
     size_t index = 0;
-    auto emit = [&](int i, int j, int up) {
-      if (index >= from && index < to) {
-        double o = up ? 1.0 / 3 : 2.0 / 3;
-        pts.push_back(add(a, add(scale(u, i + o), scale(v, j + o))));
-      }
+    auto emit = [&](int i, int j) {
+      if (index >= from && index < to) pts.push_back(add(a, add(scale(u, i + 1.0 / 3), scale(v, j + 1.0 / 3))));
       ++index;
     };
-    for (size_t k = 0; k < nProbes; ++k) emit(probes[k][0], probes[k][1], probes[k][2]);
+    for (size_t k = 0; k < nProbes; ++k) emit(probes[k][0], probes[k][1]);
     for (int i = 0; i < m && index < to; ++i)
       for (int j = 0; i + j < m && index < to; ++j)
-        if (!isProbe(i, j, 1)) emit(i, j, 1);
+        if (!isProbe(i, j)) emit(i, j);
     return crossedAlong(pts, scale(d, e));
   }
 
@@ -615,6 +611,7 @@ class Simplifier {
       for (int c = 1; c < 3; ++c)
         for (int k = 0; k < 3; ++k) n.lo[k] = std::min(n.lo[k], corner(tr[c])[k]), n.hi[k] = std::max(n.hi[k], corner(tr[c])[k]);
       for (int k = 0; k < 3; ++k) ringLo[k] = std::min(ringLo[k], n.lo[k]), ringHi[k] = std::max(ringHi[k], n.hi[k]);
+      roundOut(n.lo, n.hi, n.flo, n.fhi);
       fresh.push_back(n);
     }
     for (size_t i = 0; i < fresh.size(); ++i)
@@ -626,6 +623,10 @@ class Simplifier {
     bool bad = false;
     ++probeNow_;
     const std::array<int32_t, 6> range = cellRange(ringLo, ringHi, ringHi);
+    // Float comparisons against boxes rounded outwards: a superset of the pairs whose boxes
+    // meet; the extra ones are apart by about the entries' margin, so the outcome is the same.
+    float rlo[3], rhi[3];
+    roundOut(ringLo, ringHi, rlo, rhi);
     for (int32_t x = range[0]; x <= range[3] && !bad; ++x)
       for (int32_t y = range[1]; y <= range[4] && !bad; ++y)
         for (int32_t z = range[2]; z <= range[5] && !bad; ++z) {
@@ -633,8 +634,8 @@ class Simplifier {
           if (it == buckets_.end()) continue;
           for (const Entry& e : it->second) {
             // Disjoint boxes: no contact, not even a shared vertex.
-            if (e.hi[0] < ringLo[0] || e.lo[0] > ringHi[0] || e.hi[1] < ringLo[1] || e.lo[1] > ringHi[1] ||
-                e.hi[2] < ringLo[2] || e.lo[2] > ringHi[2])
+            if (e.hi[0] < rlo[0] || e.lo[0] > rhi[0] || e.hi[1] < rlo[1] || e.lo[1] > rhi[1] || e.hi[2] < rlo[2] ||
+                e.lo[2] > rhi[2])
               continue;
             Probe& pr = probe_[e.tri];
             if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
@@ -643,8 +644,8 @@ class Simplifier {
             std::array<exact::P, 3> qu;
             bool loaded = false;  // the corners only for a triangle whose box meets a new one's
             for (const NewTri& n : fresh) {
-              if (e.hi[0] < n.lo[0] || e.lo[0] > n.hi[0] || e.hi[1] < n.lo[1] || e.lo[1] > n.hi[1] || e.hi[2] < n.lo[2] ||
-                  e.lo[2] > n.hi[2])
+              if (e.hi[0] < n.flo[0] || e.lo[0] > n.fhi[0] || e.hi[1] < n.flo[1] || e.lo[1] > n.fhi[1] ||
+                  e.hi[2] < n.flo[2] || e.lo[2] > n.fhi[2])
                 continue;
               if (!loaded) qu = {qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]}, loaded = true;
               if (improperPair(n.t, n.q, tu, qu)) {
@@ -770,7 +771,12 @@ class Simplifier {
     Tri t;
     std::array<exact::P, 3> q;  // quantised corners
     V3 lo, hi;                  // box
+    float flo[3], fhi[3];       // the box rounded outwards to floats, like the entries' boxes
   };
+  static void roundOut(const V3& lo, const V3& hi, float* flo, float* fhi) {
+    for (int k = 0; k < 3; ++k)
+      flo[k] = std::nextafter(float(lo[k]), -INFINITY), fhi[k] = std::nextafter(float(hi[k]), INFINITY);
+  }
   std::vector<NewTri> freshTris_;
   std::vector<exact::P> qpos_;
   std::vector<char> alive_;
