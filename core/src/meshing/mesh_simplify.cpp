@@ -112,10 +112,45 @@ double quality(const V3& a, const V3& b, const V3& c) {
   return s > 0 ? 2 * std::sqrt(3.0) * norm(cross(sub(b, a), sub(c, a))) / s : 0;
 }
 
-constexpr int kMaxSamplesPerSide = 64;  // error samples per triangle <= 64^2
+constexpr int kMaxSamplesPerSide = 64;  // the error check's subdivision: m <= 64
+constexpr size_t kProbes = 4;           // error samples tried first on every new triangle
+
+}  // namespace
+
+// The error check's samples of a triangle split m x m (withinLevel): the upright sub-triangles
+// (i, j), i + j < m, each standing for its centroid a + (i + 1/3) u + (j + 1/3) v (u, v: the
+// edges from a over m), probes first. Not the corners or edges: on a crease of the model the
+// sign test along the normal is ill-posed. The centroids form a lattice of spacing longest/m
+// (<= half a voxel); the upside-down sub-triangles' centroids would bring no point of the
+// triangle nearer to a sample (its farthest points are at the corners and edges, next to
+// upright ones; tested: ErrorSamplesCoverTheTriangleAsTheFullSubdivisionDoes) and are left out.
+// Probes: the upright sub-triangles at (or, from an upside-down one, next to) the centroid and
+// the midpoints between it and the corners, where a chord is deepest.
+const std::vector<std::array<int32_t, 2>>& errorSampleCells(int m) {
+  static const std::vector<std::vector<std::array<int32_t, 2>>> table = [] {
+    std::vector<std::vector<std::array<int32_t, 2>>> t(kMaxSamplesPerSide + 1);
+    for (int m = 1; m <= kMaxSamplesPerSide; ++m) {
+      std::vector<std::array<int32_t, 2>>& cells = t[m];
+      const double targets[kProbes][2] = {{m / 3.0, m / 3.0}, {m / 6.0, m / 6.0}, {2 * m / 3.0, m / 6.0}, {m / 6.0, 2 * m / 3.0}};
+      for (const auto& tg : targets) {
+        const int i = std::min(int(tg[0]), m - 1), j = std::min(int(tg[1]), m - 1 - i);
+        if (std::find(cells.begin(), cells.end(), std::array<int32_t, 2>{i, j}) == cells.end()) cells.push_back({i, j});
+      }
+      const auto probes = std::ptrdiff_t(cells.size());
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; i + j < m; ++j)
+          if (std::find(cells.begin(), cells.begin() + probes, std::array<int32_t, 2>{i, j}) == cells.begin() + probes)
+            cells.push_back({i, j});
+    }
+    return t;
+  }();
+  return table.at(size_t(m));
+}
+
+namespace {
+
 constexpr double kQuantum = 65536;      // exact predicates: 2^16 steps per voxel
 constexpr double kBucketVoxels = 2;     // spatial hash cell
-constexpr size_t kProbes = 4;           // error samples tried first on every new triangle
 
 // The state a simplification works on: the whole mesh, or one block of it (locked vertices and
 // the triangles around the block held fixed, placements confined to the block).
@@ -392,40 +427,11 @@ class Simplifier {
     double longest = std::max({norm(sub(b, a)), norm(sub(c, b)), norm(sub(a, c))});
     int m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
     const V3 u = scale(sub(b, a), 1.0 / m), v = scale(sub(c, a), 1.0 / m);
-    // The centroids of the m(m+1)/2 upright sub-triangles of the m x m subdivision (not the
-    // corners or edges: on a crease of the model the sign test along the normal is ill-posed):
-    // upright sub-triangle (i, j) has its centroid at a + (i + 1/3) u + (j + 1/3) v, a lattice of
-    // spacing longest/m <= half a voxel. The upside-down ones' centroids (i + 2/3, j + 2/3) are
-    // left out: every point of the triangle is exactly as near to the nearest sample without
-    // them (the farthest points are at the corners and edges, covered by upright ones; brute
-    // force over random triangles, docs/mesh.md), at half the evaluations.
-    // Probes first: the upright sub-triangles at (or next to, from an upside-down one) the
-    // centroid and the midpoints between it and the corners; they belong to the full set.
-    std::array<int, 2> probes[kProbes];
-    size_t nProbes = 0;
-    const double targets[kProbes][2] = {{m / 3.0, m / 3.0}, {m / 6.0, m / 6.0}, {2 * m / 3.0, m / 6.0}, {m / 6.0, 2 * m / 3.0}};
-    for (const auto& tg : targets) {
-      int i = std::min(int(tg[0]), m - 1), j = std::min(int(tg[1]), m - 1 - i);
-      bool known = false;
-      for (size_t k = 0; k < nProbes; ++k) known = known || (probes[k][0] == i && probes[k][1] == j);
-      if (!known) probes[nProbes++] = {i, j};
-    }
-    auto isProbe = [&](int i, int j) {  // plain comparisons: std::array's == is a memcmp call
-      for (size_t k = 0; k < nProbes; ++k)
-        if (probes[k][0] == i && probes[k][1] == j) return true;
-      return false;
-    };
+    const std::vector<std::array<int32_t, 2>>& cells = errorSampleCells(m);
     std::vector<V3>& pts = samplePoints_;
     pts.clear();
-    size_t index = 0;
-    auto emit = [&](int i, int j) {
-      if (index >= from && index < to) pts.push_back(add(a, add(scale(u, i + 1.0 / 3), scale(v, j + 1.0 / 3))));
-      ++index;
-    };
-    for (size_t k = 0; k < nProbes; ++k) emit(probes[k][0], probes[k][1]);
-    for (int i = 0; i < m && index < to; ++i)
-      for (int j = 0; i + j < m && index < to; ++j)
-        if (!isProbe(i, j)) emit(i, j);
+    for (size_t k = from; k < std::min(to, cells.size()); ++k)
+      pts.push_back(add(a, add(scale(u, cells[k][0] + 1.0 / 3), scale(v, cells[k][1] + 1.0 / 3))));
     return crossedAlong(pts, scale(d, e));
   }
 
