@@ -446,7 +446,7 @@ class Simplifier {
       size_t n = std::min(perCall, pts.size() - s);
       for (size_t i = 0; i < n; ++i) {
         const V3 lo = sub(pts[s + i], d), hi = add(pts[s + i], d);
-        for (int k = 0; k < 3; ++k) inputs_[k][2 * i] = lo[k], inputs_[k][2 * i + 1] = hi[k];
+        for (uint32_t k = 0; k < std::min(nvars, 3u); ++k) inputs_[k][2 * i] = lo[k], inputs_[k][2 * i + 1] = hi[k];
       }
       for (uint32_t k = 3; k < nvars; ++k) std::fill_n(inputs_[k], 2 * n, opt_.fixedCoords[k - 3]);
       const double* f = batch_.eval(*tape_, 2 * n);
@@ -602,7 +602,7 @@ class Simplifier {
     }
 
     // Self-intersection: the new triangles against each other, then against every other
-    // triangle whose box meets theirs (one pass over the cells of the ring's box).
+    // triangle near them whose box meets theirs.
     const exact::P qp = quantise(p);
     auto qcorner = [&](uint32_t v) { return v == a || v == b ? qp : qpos_[v]; };
     ++stampNow_;
@@ -628,40 +628,48 @@ class Simplifier {
         }
     bool bad = false;
     ++probeNow_;
-    const std::array<int32_t, 6> range = cellRange(ringLo, ringHi, ringHi);
+    // The cells the new triangles themselves may touch (as they would be filed): a triangle
+    // meeting one of them improperly shares a point with it, so both are filed under that point's
+    // cell. Fewer cells than the ring's box holds, when the ring is tilted or large.
+    std::vector<uint64_t>& cellKeys = scratch_.cells;
+    cellKeys.clear();
+    for (uint32_t t : changed) {
+      const Tri& tr = w_.tris[t];
+      forTriangleCells(corner(tr[0]), corner(tr[1]), corner(tr[2]), [&](uint64_t k) { cellKeys.push_back(k); });
+    }
+    std::sort(cellKeys.begin(), cellKeys.end());
+    cellKeys.erase(std::unique(cellKeys.begin(), cellKeys.end()), cellKeys.end());
     // Float comparisons against boxes rounded outwards: a superset of the pairs whose boxes
     // meet; the extra ones are apart by about the entries' margin, so the outcome is the same.
     float rlo[3], rhi[3];
     roundOut(ringLo, ringHi, rlo, rhi);
-    for (int32_t x = range[0]; x <= range[3] && !bad; ++x)
-      for (int32_t y = range[1]; y <= range[4] && !bad; ++y)
-        for (int32_t z = range[2]; z <= range[5] && !bad; ++z) {
-          auto it = buckets_.find(cellKey(x, y, z));
-          if (it == buckets_.end()) continue;
-          for (const Entry& e : it->second) {
-            // Disjoint boxes: no contact, not even a shared vertex.
-            if (e.hi[0] < rlo[0] || e.lo[0] > rhi[0] || e.hi[1] < rlo[1] || e.lo[1] > rhi[1] || e.hi[2] < rlo[2] ||
-                e.lo[2] > rhi[2])
-              continue;
-            Probe& pr = probe_[e.tri];
-            if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
-            pr.seen = probeNow_;
-            const Tri& tu = w_.tris[e.tri];
-            std::array<exact::P, 3> qu;
-            bool loaded = false;  // the corners only for a triangle whose box meets a new one's
-            for (const NewTri& n : fresh) {
-              if (e.hi[0] < n.flo[0] || e.lo[0] > n.fhi[0] || e.hi[1] < n.flo[1] || e.lo[1] > n.fhi[1] ||
-                  e.hi[2] < n.flo[2] || e.lo[2] > n.fhi[2])
-                continue;
-              if (!loaded) qu = {qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]}, loaded = true;
-              if (improperPair(n.t, n.q, tu, qu)) {
-                bad = true;
-                break;
-              }
-            }
-            if (bad) break;
+    for (size_t ci = 0; ci < cellKeys.size() && !bad; ++ci) {
+      auto it = buckets_.find(cellKeys[ci]);
+      if (it == buckets_.end()) continue;
+      for (const Entry& e : it->second) {
+        // Disjoint boxes: no contact, not even a shared vertex.
+        if (e.hi[0] < rlo[0] || e.lo[0] > rhi[0] || e.hi[1] < rlo[1] || e.lo[1] > rhi[1] || e.hi[2] < rlo[2] ||
+            e.lo[2] > rhi[2])
+          continue;
+        Probe& pr = probe_[e.tri];
+        if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
+        pr.seen = probeNow_;
+        const Tri& tu = w_.tris[e.tri];
+        std::array<exact::P, 3> qu;
+        bool loaded = false;  // the corners only for a triangle whose box meets a new one's
+        for (const NewTri& n : fresh) {
+          if (e.hi[0] < n.flo[0] || e.lo[0] > n.fhi[0] || e.hi[1] < n.flo[1] || e.lo[1] > n.fhi[1] ||
+              e.hi[2] < n.flo[2] || e.lo[2] > n.fhi[2])
+            continue;
+          if (!loaded) qu = {qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]}, loaded = true;
+          if (improperPair(n.t, n.q, tu, qu)) {
+            bad = true;
+            break;
           }
         }
+        if (bad) break;
+      }
+    }
     if (bad) {
       ++stats_.rejectedIntersection;
       return;
@@ -772,6 +780,7 @@ class Simplifier {
   struct Scratch {
     std::vector<uint32_t> na, nb, opposite, common, changed, removed, ring;
     std::vector<int8_t> newLevel;
+    std::vector<uint64_t> cells;  // hash cells of the self-intersection check
   } scratch_;
   struct NewTri {  // a triangle as a collapse would leave it
     Tri t;
