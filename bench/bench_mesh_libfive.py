@@ -14,6 +14,7 @@ tool's own cell size, bounds the mesh -> surface distance.
 """
 import argparse
 import filecmp
+import json
 import os
 import resource
 import subprocess
@@ -182,6 +183,39 @@ def accuracy(pts, tris, voxel, chunk=1 << 20):
     return mx, total / max(n, 1), failed
 
 
+def ply_triangles(path):
+    """The face count of a PLY header."""
+    with open(path, "rb") as fh:
+        for line in iter(fh.readline, b"end_header\n"):
+            if line.startswith(b"element face"):
+                return int(line.split()[2])
+    return 0
+
+
+def error_bound_voxels(ply, voxel):
+    """The certified error bound of `frep mesh`'s report beside the mesh, in voxels."""
+    with open(ply + ".report.json") as fh:
+        s = json.load(fh)["output"].get("simplification")
+    return s["error_bound"] / voxel if s else 0.0
+
+
+def summarise(rows, n):
+    """Ratios within this run at grid N: the adaptive mesh against the raw mesher and libfive."""
+    at = {(r[0], r[2]): r for r in rows if r[1] == n}
+    print(f"\nN={n}: triangles, error bound (voxels) and ratios of wall and CPU time, same run")
+    for key in (("frep adaptive", 1), ("frep adaptive", 2), ("before adaptive", 2)):
+        if key not in at:
+            continue
+        _, _, thr, wall, cpu, _, ply, voxel = at[key]
+        line = f"  {key[0]:15s} {thr} thr: {ply_triangles(ply):9d} triangles, bound {error_bound_voxels(ply, voxel):.3f}"
+        for ref in (("frep raw", thr), ("libfive DC", thr), ("frep adaptive", 2)):
+            if ref in at and ref != key:
+                r = at[ref]
+                line += f"; /{ref[0]} {thr if ref[0] != 'frep adaptive' else 2} thr: wall {wall / r[3]:.2f}x CPU {cpu / r[4]:.2f}x"
+        print(line, flush=True)
+    print(flush=True)
+
+
 def timed(cmd):
     """Run cmd; returns (stdout, wall seconds, CPU seconds of the child, user + system)."""
     r0, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.monotonic()
@@ -200,6 +234,9 @@ def main():
                     help="skip frep's adaptive (default tolerance) run above this N")
     ap.add_argument("--repeat", type=int, default=1, help="best of R runs (CPU time; not the adaptive run)")
     ap.add_argument("--keep", help="directory to keep the meshes in (default: a temporary one)")
+    ap.add_argument("--frep-before", help="another frep binary (e.g. an older build) whose default adaptive "
+                    "`frep mesh` is measured in the same run, for a before/after ratio")
+    ap.add_argument("--no-accuracy", action="store_true", help="skip the mesh -> surface distances (faster)")
     args = ap.parse_args()
     lib = os.path.join(args.libfive_build, "libfive", "src", "libfive.so")
     inc = os.path.join(args.libfive_src, "libfive", "include")
@@ -232,28 +269,39 @@ def main():
             rows.append(("libfive DC", n, workers, float(w_s), float(c_s), cpu, ply, 2.2 / n))
             print(f"libfive N={n} workers={workers}: render {w_s} s wall, {c_s} s CPU; process {cpu:.2f} s CPU",
                   flush=True)
-        for label, extra, threads in (("frep raw", ["--tolerance", "0"], 1), ("frep raw", ["--tolerance", "0"], 2),
-                                      ("frep adaptive", [], 1)):
-            if extra == [] and n > args.no_adaptive_above:
-                print(f"frep adaptive N={n}: skipped (--no-adaptive-above)")
+        # (label, binary, options, threads): the raw mesher in-process; the adaptive mesh in-process on
+        # one thread and as plain `frep mesh` does it by default (embedded farm, 2 local workers).
+        runs = [("frep raw", args.frep, ["--workers", "0", "--tolerance", "0"], 1),
+                ("frep raw", args.frep, ["--workers", "0", "--tolerance", "0"], 2),
+                ("frep adaptive", args.frep, ["--workers", "0"], 1),
+                ("frep adaptive", args.frep, ["--workers", "2"], 2)]
+        if args.frep_before:
+            runs.append(("before adaptive", args.frep_before, ["--workers", "2"], 2))
+        for label, binary, extra, threads in runs:
+            adaptive = "--tolerance" not in extra
+            if adaptive and n > args.no_adaptive_above:
+                print(f"{label} N={n}: skipped (--no-adaptive-above)")
                 continue
-            ply = os.path.join(work, f"frep_{label.split()[1]}_{n}_{threads}.ply")
-            cmd = [args.frep, "mesh", model, "-b", f"{LO},{HI}", "--res", str(n), "-O", ply,
-                   "--workers", "0", "--threads", str(threads), "--no-progress", *extra]
-            _, wall, cpu = min((timed(cmd) for _ in range(args.repeat if extra else 1)), key=lambda r: r[2])
+            ply = os.path.join(work, f"{label.replace(' ', '_')}_{n}_{threads}.ply")
+            cmd = [binary, "mesh", model, "-b", f"{LO},{HI}", "--res", str(n), "-O", ply,
+                   "--threads", str(threads), "--no-progress", *extra]
+            _, wall, cpu = min((timed(cmd) for _ in range(1 if adaptive else args.repeat)), key=lambda r: r[2])
             rows.append((label, n, threads, wall, cpu, cpu, ply, 2.2 / (n - 1)))  # --res N: N points
-            print(f"{label} N={n} threads={threads}: {wall:.2f} s wall, {cpu:.2f} s CPU", flush=True)
+            print(f"{label} N={n} threads={threads} ({' '.join(extra)}): {wall:.2f} s wall, {cpu:.2f} s CPU",
+                  flush=True)
+        summarise(rows, n)
 
     print("\ntool           N  thr   wall s    CPU s  proc CPU  triangles  M vox/CPU-s  Hausdorff max/mean (vox)"
           "  open/nm  misorient  degen  unprojected")
     prev = None
     for tool, n, thr, wall, cpu, pcpu, ply, voxel in rows:
         # The 2-thread meshes are usually byte-identical to the 1-thread ones: measure once.
-        if not (prev and filecmp.cmp(prev[0], ply, shallow=False)):
+        if not args.no_accuracy and not (prev and filecmp.cmp(prev[0], ply, shallow=False)):
             pts, tris = read_ply(ply)
             prev = (ply, len(tris), accuracy(pts, tris, voxel), edge_check(tris, len(pts)))
             del pts, tris
-        _, ntris, (mx, mean, failed), (bad, mis, degen) = prev
+        _, ntris, (mx, mean, failed), (bad, mis, degen) = prev if not args.no_accuracy else (
+            None, ply_triangles(ply), (float("nan"), float("nan"), 0), (0, 0, 0))
         print(f"{tool:13s} {n:4d} {thr:3d} {wall:8.2f} {cpu:8.2f} {pcpu:9.2f} {ntris:10d} {n ** 3 / cpu / 1e6:12.2f}"
               f"  {mx:11.4f} / {mean:.4f}  {bad:8d} {mis:10d} {degen:6d} {failed:12d}", flush=True)
     print("\nCPU s: libfive Mesh::render alone; frep: the whole process (parse, mesh, [simplify], write PLY)."

@@ -365,3 +365,62 @@ TEST(MeshSimplify, OpenRimOnTheBoxStaysOnTheBox) {
     for (const auto& p : simplifiedRim) EXPECT_EQ(p[2], g.origin[2]);
   }
 }
+
+// The error check samples only the upright sub-triangles' centroids of its m x m subdivision
+// (errorSampleCells). Brute force over random triangles: no point of the triangle (its corners,
+// points along its edges, random interior points) is farther from the nearest sample than from
+// the nearest centroid of ALL m^2 sub-triangles, the set it replaced; every sample lies strictly
+// inside, each once, m(m+1)/2 of them, and the first probe is the sub-triangle at the centroid.
+TEST(MeshSimplify, ErrorSamplesCoverTheTriangleAsTheFullSubdivisionDoes) {
+  uint64_t seed = 0x9e3779b97f4a7c15ull;
+  auto uniform = [&] {  // splitmix64: deterministic on every platform
+    uint64_t z = (seed += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return double((z ^ (z >> 31)) >> 11) * 0x1p-53;
+  };
+  using P2 = std::array<double, 2>;
+  for (int m : {1, 2, 3, 4, 5, 7, 10, 16}) {
+    const std::vector<std::array<int32_t, 2>>& cells = errorSampleCells(m);
+    ASSERT_EQ(cells.size(), size_t(m) * (m + 1) / 2) << "m " << m;
+    std::set<std::array<int32_t, 2>> distinct(cells.begin(), cells.end());
+    EXPECT_EQ(distinct.size(), cells.size());
+    for (const auto& c : cells) EXPECT_TRUE(c[0] >= 0 && c[1] >= 0 && c[0] + c[1] < m);
+    EXPECT_EQ(cells[0], (std::array<int32_t, 2>{std::min(m / 3, m - 1), std::min(m / 3, m - 1 - std::min(m / 3, m - 1))}));
+    for (int trial = 0; trial < 40; ++trial) {
+      P2 a{uniform(), uniform()}, b{uniform(), uniform()}, c{uniform(), uniform()};
+      if (trial % 4 == 0) c = {a[0] + 0.02 * uniform(), b[1] + 0.5};  // thin and obtuse ones too
+      const P2 u{(b[0] - a[0]) / m, (b[1] - a[1]) / m}, v{(c[0] - a[0]) / m, (c[1] - a[1]) / m};
+      auto at = [&](double s, double t) { return P2{a[0] + s * u[0] + t * v[0], a[1] + s * u[1] + t * v[1]}; };
+      std::vector<P2> used, all;
+      for (const auto& cell : cells) used.push_back(at(cell[0] + 1.0 / 3, cell[1] + 1.0 / 3));
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; i + j < m; ++j) {
+          all.push_back(at(i + 1.0 / 3, j + 1.0 / 3));
+          if (i + j <= m - 2) all.push_back(at(i + 2.0 / 3, j + 2.0 / 3));
+        }
+      std::vector<P2> probe;  // in subdivision coordinates (s, t), s, t >= 0, s + t <= m
+      for (int k = 0; k <= 64; ++k) {
+        const double f = m * k / 64.0;
+        probe.push_back({f, 0}), probe.push_back({0, f}), probe.push_back({m - f, f});
+      }
+      for (int k = 0; k < 400; ++k) {
+        double s = uniform(), t = uniform();
+        if (s + t > 1) s = 1 - s, t = 1 - t;
+        probe.push_back({m * s, m * t});
+      }
+      auto nearest = [](const P2& p, const std::vector<P2>& set) {
+        double best = INFINITY;
+        for (const P2& q : set) best = std::min(best, std::hypot(p[0] - q[0], p[1] - q[1]));
+        return best;
+      };
+      double coverUsed = 0, coverAll = 0;
+      for (const P2& st : probe) {
+        const P2 p = at(st[0], st[1]);
+        coverUsed = std::max(coverUsed, nearest(p, used));
+        coverAll = std::max(coverAll, nearest(p, all));
+      }
+      EXPECT_LE(coverUsed, coverAll * (1 + 1e-12)) << "m " << m << " trial " << trial;
+    }
+  }
+}

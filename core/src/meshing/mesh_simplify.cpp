@@ -112,10 +112,45 @@ double quality(const V3& a, const V3& b, const V3& c) {
   return s > 0 ? 2 * std::sqrt(3.0) * norm(cross(sub(b, a), sub(c, a))) / s : 0;
 }
 
-constexpr int kMaxSamplesPerSide = 64;  // error samples per triangle <= 64^2
+constexpr int kMaxSamplesPerSide = 64;  // the error check's subdivision: m <= 64
+constexpr size_t kProbes = 4;           // error samples tried first on every new triangle
+
+}  // namespace
+
+// The error check's samples of a triangle split m x m (withinLevel): the upright sub-triangles
+// (i, j), i + j < m, each standing for its centroid a + (i + 1/3) u + (j + 1/3) v (u, v: the
+// edges from a over m), probes first. Not the corners or edges: on a crease of the model the
+// sign test along the normal is ill-posed. The centroids form a lattice of spacing longest/m
+// (<= half a voxel); the upside-down sub-triangles' centroids would bring no point of the
+// triangle nearer to a sample (its farthest points are at the corners and edges, next to
+// upright ones; tested: ErrorSamplesCoverTheTriangleAsTheFullSubdivisionDoes) and are left out.
+// Probes: the upright sub-triangles at (or, from an upside-down one, next to) the centroid and
+// the midpoints between it and the corners, where a chord is deepest.
+const std::vector<std::array<int32_t, 2>>& errorSampleCells(int m) {
+  static const std::vector<std::vector<std::array<int32_t, 2>>> table = [] {
+    std::vector<std::vector<std::array<int32_t, 2>>> t(kMaxSamplesPerSide + 1);
+    for (int m = 1; m <= kMaxSamplesPerSide; ++m) {
+      std::vector<std::array<int32_t, 2>>& cells = t[m];
+      const double targets[kProbes][2] = {{m / 3.0, m / 3.0}, {m / 6.0, m / 6.0}, {2 * m / 3.0, m / 6.0}, {m / 6.0, 2 * m / 3.0}};
+      for (const auto& tg : targets) {
+        const int i = std::min(int(tg[0]), m - 1), j = std::min(int(tg[1]), m - 1 - i);
+        if (std::find(cells.begin(), cells.end(), std::array<int32_t, 2>{i, j}) == cells.end()) cells.push_back({i, j});
+      }
+      const auto probes = std::ptrdiff_t(cells.size());
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; i + j < m; ++j)
+          if (std::find(cells.begin(), cells.begin() + probes, std::array<int32_t, 2>{i, j}) == cells.begin() + probes)
+            cells.push_back({i, j});
+    }
+    return t;
+  }();
+  return table.at(size_t(m));
+}
+
+namespace {
+
 constexpr double kQuantum = 65536;      // exact predicates: 2^16 steps per voxel
 constexpr double kBucketVoxels = 2;     // spatial hash cell
-constexpr size_t kProbes = 4;           // error samples tried first on every new triangle
 
 // The state a simplification works on: the whole mesh, or one block of it (locked vertices and
 // the triangles around the block held fixed, placements confined to the block).
@@ -392,37 +427,11 @@ class Simplifier {
     double longest = std::max({norm(sub(b, a)), norm(sub(c, b)), norm(sub(a, c))});
     int m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
     const V3 u = scale(sub(b, a), 1.0 / m), v = scale(sub(c, a), 1.0 / m);
-    // The centroids of the m^2 sub-triangles (not the corners or edges: on a crease of the
-    // model the sign test along the normal is ill-posed): sub-triangle (i, j, up) has its
-    // centroid at a + (i + 1/3) u + (j + 1/3) v, or (i + 2/3, j + 2/3) when upside down.
-    // Probes first: the sub-triangles holding the centroid and the midpoints between it and
-    // the corners.
-    std::array<int, 3> probes[kProbes];
-    size_t nProbes = 0;
-    const double targets[kProbes][2] = {{m / 3.0, m / 3.0}, {m / 6.0, m / 6.0}, {2 * m / 3.0, m / 6.0}, {m / 6.0, 2 * m / 3.0}};
-    for (const auto& tg : targets) {
-      int i = std::min(int(tg[0]), m - 1), j = std::min(int(tg[1]), m - 1 - i);
-      int up = tg[0] - i + tg[1] - j < 1 || i + j > m - 2 ? 1 : 0;
-      std::array<int, 3> id{i, j, up};
-      if (std::find(probes, probes + nProbes, id) == probes + nProbes) probes[nProbes++] = id;
-    }
+    const std::vector<std::array<int32_t, 2>>& cells = errorSampleCells(m);
     std::vector<V3>& pts = samplePoints_;
     pts.clear();
-    size_t index = 0;
-    auto emit = [&](int i, int j, int up) {
-      if (index >= from && index < to) {
-        double o = up ? 1.0 / 3 : 2.0 / 3;
-        pts.push_back(add(a, add(scale(u, i + o), scale(v, j + o))));
-      }
-      ++index;
-    };
-    for (size_t k = 0; k < nProbes; ++k) emit(probes[k][0], probes[k][1], probes[k][2]);
-    for (int i = 0; i < m && index < to; ++i)
-      for (int j = 0; i + j < m; ++j)
-        for (int up = 1; up >= 0; --up) {
-          if (!up && i + j > m - 2) continue;
-          if (std::find(probes, probes + nProbes, std::array<int, 3>{i, j, up}) == probes + nProbes) emit(i, j, up);
-        }
+    for (size_t k = from; k < std::min(to, cells.size()); ++k)
+      pts.push_back(add(a, add(scale(u, cells[k][0] + 1.0 / 3), scale(v, cells[k][1] + 1.0 / 3))));
     return crossedAlong(pts, scale(d, e));
   }
 
@@ -431,13 +440,15 @@ class Simplifier {
     const uint32_t nvars = tape_->numVars();
     batch_.reserve(*tape_);
     const size_t perCall = BatchEvaluator<double>::kBatch / 2;
+    inputs_.resize(nvars);
+    for (uint32_t k = 0; k < nvars; ++k) inputs_[k] = batch_.in(k);
     for (size_t s = 0; s < pts.size(); s += perCall) {
       size_t n = std::min(perCall, pts.size() - s);
-      for (size_t i = 0; i < n; ++i)
-        for (int side = 0; side < 2; ++side) {
-          V3 q = side == 0 ? sub(pts[s + i], d) : add(pts[s + i], d);
-          for (uint32_t k = 0; k < nvars; ++k) batch_.in(k)[2 * i + side] = k < 3 ? q[k] : opt_.fixedCoords[k - 3];
-        }
+      for (size_t i = 0; i < n; ++i) {
+        const V3 lo = sub(pts[s + i], d), hi = add(pts[s + i], d);
+        for (uint32_t k = 0; k < std::min(nvars, 3u); ++k) inputs_[k][2 * i] = lo[k], inputs_[k][2 * i + 1] = hi[k];
+      }
+      for (uint32_t k = 3; k < nvars; ++k) std::fill_n(inputs_[k], 2 * n, opt_.fixedCoords[k - 3]);
       const double* f = batch_.eval(*tape_, 2 * n);
       stats_.modelEvals += 2 * n;
       for (size_t i = 0; i < n; ++i)
@@ -591,7 +602,7 @@ class Simplifier {
     }
 
     // Self-intersection: the new triangles against each other, then against every other
-    // triangle whose box meets theirs (one pass over the cells of the ring's box).
+    // triangle near them whose box meets theirs.
     const exact::P qp = quantise(p);
     auto qcorner = [&](uint32_t v) { return v == a || v == b ? qp : qpos_[v]; };
     ++stampNow_;
@@ -606,6 +617,7 @@ class Simplifier {
       for (int c = 1; c < 3; ++c)
         for (int k = 0; k < 3; ++k) n.lo[k] = std::min(n.lo[k], corner(tr[c])[k]), n.hi[k] = std::max(n.hi[k], corner(tr[c])[k]);
       for (int k = 0; k < 3; ++k) ringLo[k] = std::min(ringLo[k], n.lo[k]), ringHi[k] = std::max(ringHi[k], n.hi[k]);
+      roundOut(n.lo, n.hi, n.flo, n.fhi);
       fresh.push_back(n);
     }
     for (size_t i = 0; i < fresh.size(); ++i)
@@ -616,34 +628,48 @@ class Simplifier {
         }
     bool bad = false;
     ++probeNow_;
-    const std::array<int32_t, 6> range = cellRange(ringLo, ringHi, ringHi);
-    for (int32_t x = range[0]; x <= range[3] && !bad; ++x)
-      for (int32_t y = range[1]; y <= range[4] && !bad; ++y)
-        for (int32_t z = range[2]; z <= range[5] && !bad; ++z) {
-          auto it = buckets_.find(cellKey(x, y, z));
-          if (it == buckets_.end()) continue;
-          for (const Entry& e : it->second) {
-            // Disjoint boxes: no contact, not even a shared vertex.
-            if (e.hi[0] < ringLo[0] || e.lo[0] > ringHi[0] || e.hi[1] < ringLo[1] || e.lo[1] > ringHi[1] ||
-                e.hi[2] < ringLo[2] || e.lo[2] > ringHi[2])
-              continue;
-            Probe& pr = probe_[e.tri];
-            if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
-            pr.seen = probeNow_;
-            const Tri& tu = w_.tris[e.tri];
-            const std::array<exact::P, 3> qu{qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]};
-            for (const NewTri& n : fresh) {
-              if (e.hi[0] < n.lo[0] || e.lo[0] > n.hi[0] || e.hi[1] < n.lo[1] || e.lo[1] > n.hi[1] || e.hi[2] < n.lo[2] ||
-                  e.lo[2] > n.hi[2])
-                continue;
-              if (improperPair(n.t, n.q, tu, qu)) {
-                bad = true;
-                break;
-              }
-            }
-            if (bad) break;
+    // The cells the new triangles themselves may touch (as they would be filed): a triangle
+    // meeting one of them improperly shares a point with it, so both are filed under that point's
+    // cell. Fewer cells than the ring's box holds, when the ring is tilted or large.
+    std::vector<uint64_t>& cellKeys = scratch_.cells;
+    cellKeys.clear();
+    for (uint32_t t : changed) {
+      const Tri& tr = w_.tris[t];
+      forTriangleCells(corner(tr[0]), corner(tr[1]), corner(tr[2]), [&](uint64_t k) { cellKeys.push_back(k); });
+    }
+    std::sort(cellKeys.begin(), cellKeys.end());
+    cellKeys.erase(std::unique(cellKeys.begin(), cellKeys.end()), cellKeys.end());
+    // Float comparisons against boxes rounded outwards: a superset of the pairs whose boxes
+    // meet; the extra ones are apart by about the entries' margin, so the outcome is the same.
+    float rlo[3], rhi[3];
+    roundOut(ringLo, ringHi, rlo, rhi);
+    for (size_t ci = 0; ci < cellKeys.size() && !bad; ++ci) {
+      auto it = buckets_.find(cellKeys[ci]);
+      if (it == buckets_.end()) continue;
+      for (const Entry& e : it->second) {
+        // Disjoint boxes: no contact, not even a shared vertex.
+        if (e.hi[0] < rlo[0] || e.lo[0] > rhi[0] || e.hi[1] < rlo[1] || e.lo[1] > rhi[1] || e.hi[2] < rlo[2] ||
+            e.lo[2] > rhi[2])
+          continue;
+        Probe& pr = probe_[e.tri];
+        if (pr.skip == stampNow_ || pr.seen == probeNow_) continue;
+        pr.seen = probeNow_;
+        const Tri& tu = w_.tris[e.tri];
+        std::array<exact::P, 3> qu;
+        bool loaded = false;  // the corners only for a triangle whose box meets a new one's
+        for (const NewTri& n : fresh) {
+          if (e.hi[0] < n.flo[0] || e.lo[0] > n.fhi[0] || e.hi[1] < n.flo[1] || e.lo[1] > n.fhi[1] ||
+              e.hi[2] < n.flo[2] || e.lo[2] > n.fhi[2])
+            continue;
+          if (!loaded) qu = {qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]}, loaded = true;
+          if (improperPair(n.t, n.q, tu, qu)) {
+            bad = true;
+            break;
           }
         }
+        if (bad) break;
+      }
+    }
     if (bad) {
       ++stats_.rejectedIntersection;
       return;
@@ -750,15 +776,22 @@ class Simplifier {
   double tol_;
   SimplifyStats stats_;
   std::vector<V3> samplePoints_;
+  std::vector<double*> inputs_;  // the batch evaluator's input lanes, one array per coordinate
   struct Scratch {
     std::vector<uint32_t> na, nb, opposite, common, changed, removed, ring;
     std::vector<int8_t> newLevel;
+    std::vector<uint64_t> cells;  // hash cells of the self-intersection check
   } scratch_;
   struct NewTri {  // a triangle as a collapse would leave it
     Tri t;
     std::array<exact::P, 3> q;  // quantised corners
     V3 lo, hi;                  // box
+    float flo[3], fhi[3];       // the box rounded outwards to floats, like the entries' boxes
   };
+  static void roundOut(const V3& lo, const V3& hi, float* flo, float* fhi) {
+    for (int k = 0; k < 3; ++k)
+      flo[k] = std::nextafter(float(lo[k]), -INFINITY), fhi[k] = std::nextafter(float(hi[k]), INFINITY);
+  }
   std::vector<NewTri> freshTris_;
   std::vector<exact::P> qpos_;
   std::vector<char> alive_;

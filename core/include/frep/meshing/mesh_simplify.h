@@ -25,6 +25,7 @@
 // depends only on the input mesh: the farm's split-invariance carries over.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -66,5 +67,11 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
 // same mesh as simplifyMesh of the raw merged mesh.
 void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options,
                     const std::array<int32_t, 3>& lo, const std::array<int32_t, 3>& hi);
+
+// The error check's sample points of a triangle a, b, c split into m x m similar sub-triangles
+// (m = ceil(2 longest edge / voxel), 1..64): cell (i, j) is the point
+// a + (i + 1/3)(b - a)/m + (j + 1/3)(c - a)/m, the centroid of an upright sub-triangle; the
+// probes (tried first) lead. Exposed for its test.
+const std::vector<std::array<int32_t, 2>>& errorSampleCells(int m);
 
 }  // namespace frep
