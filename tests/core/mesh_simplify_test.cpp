@@ -65,8 +65,9 @@ Result simplifyAndCheck(const Expr& model, const GridSpec& g, double tolVoxels, 
   EXPECT_GT(worstQuality, 1e-4);
   // Every point of every triangle (10x10 per triangle, denser than the simplifier's own checks
   // for small triangles) is within the reported bound of the surface: certified by an inside and an
-  // outside point within that distance (along +-normal or one of 26 grid directions), as the
-  // segment between them crosses the surface inside the ball.
+  // outside point within that distance (the point itself, or along +-normal or one of 26 grid
+  // directions at that distance or 1/2, 1/4, 1/8 of it), as the segment between them crosses the
+  // surface inside the ball.
   PointEvaluator pe;
   std::set<std::array<mc::Vec3, 3>> untouched;  // the mesher's triangles, by corner positions
   for (const auto& t : raw.triangles) untouched.insert({raw.positions[t[0]], raw.positions[t[1]], raw.positions[t[2]]});
@@ -84,15 +85,21 @@ Result simplifyAndCheck(const Expr& model, const GridSpec& g, double tolVoxels, 
         std::array<double, 3> p;
         for (int k = 0; k < 3; ++k) p[k] = a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]);
         bool in = false, out = false;
+        double radius = bound;
         auto probe = [&](double dx, double dy, double dz) {
           double len = std::sqrt(dx * dx + dy * dy + dz * dz);
-          std::array<double, 3> q{p[0] + bound * dx / len, p[1] + bound * dy / len, p[2] + bound * dz / len};
+          std::array<double, 3> q{p[0] + radius * dx / len, p[1] + radius * dy / len, p[2] + radius * dz / len};
           (pe.eval(*tape, q.data()) >= 0 ? in : out) = true;
         };
-        probe(n[0] / ln, n[1] / ln, n[2] / ln);
-        probe(-n[0] / ln, -n[1] / ln, -n[2] / ln);
-        for (int d = 0; d < 27 && !(in && out); ++d)
-          if (d != 13) probe(d / 9 - 1, (d / 3) % 3 - 1, d % 3 - 1);
+        (pe.eval(*tape, p.data()) >= 0 ? in : out) = true;
+        // Shorter radii too (any two points in the ball will do): in a gap or a wall thinner than
+        // the bound every probe at the full radius may land on the same side.
+        for (int halvings = 0; halvings < 4 && !(in && out); ++halvings, radius *= 0.5) {
+          probe(n[0] / ln, n[1] / ln, n[2] / ln);
+          probe(-n[0] / ln, -n[1] / ln, -n[2] / ln);
+          for (int d = 0; d < 27 && !(in && out); ++d)
+            if (d != 13) probe(d / 9 - 1, (d / 3) % 3 - 1, d % 3 - 1);
+        }
         far += !(in && out);
         if (!(in && out) && getenv("FREP_DUMP") && far < 6) {
           double fa = pe.eval(*tape, a.data()), fb = pe.eval(*tape, b.data()), fc = pe.eval(*tape, c.data()), fp = pe.eval(*tape, p.data());
@@ -423,4 +430,36 @@ TEST(MeshSimplify, ErrorSamplesCoverTheTriangleAsTheFullSubdivisionDoes) {
       EXPECT_LE(coverUsed, coverAll * (1 + 1e-12)) << "m " << m << " trial " << trial;
     }
   }
+}
+
+// A ridge under a thin bent plate, closer than the tolerance. No other model here makes the
+// self-intersection check reject a collapse: the error check alone keeps two surfaces apart when
+// both stay within the tolerance of the model. Here the plate's underside has a concave crease
+// right above the ridge, midway between grid columns, so the mesher's chord across it lies
+// below the true crease (at z = gap instead of 0.3v + gap), and below the true ridge (0.3v).
+// With sharp features a collapse of two of the ridge's flank vertices goes to the true ridge
+// line, which passes the error check (the plate is a true surface there) but crosses that
+// chord: only the self-intersection check stops it. At tolerance 1 the rejected collapses are
+// on the plate's top, against its own underside. Without the check both results have improper
+// triangle pairs (180 and 42).
+TEST(MeshSimplify, RidgeUnderABentPlateNeedsTheIntersectionCheck) {
+  const GridSpec g = cubeGrid(1.0, 49);  // x = 0 and z = 0 are grid planes
+  const double v = g.voxel;
+  uint64_t rejected = 0;
+  for (const auto& [plateThickness, gap, tol] : {std::array<double, 3>{1.5, 0.05, 2.5}, {1.5, 0.1, 1.0}}) {
+    SCOPED_TRACE(tol);
+    // Creases along y at x = v/2. Ridge top at z = 0.3v, flanks at 45 degrees; the plate's
+    // underside at 0.3v + gap * v on the crease, sloping down at 0.6 to both sides, its top
+    // plateThickness * v above (vertically). At every grid column the point z = 0 is outside
+    // both, so the mesher keeps them apart.
+    const double top = 0.3 * v;
+    const Expr u = X() - 0.5 * v;
+    const Expr ridge = min(blockAt(0.013, 0.007, -0.2, 0.4, 0.35, 0.2 + top), top - Z() - abs(u));
+    const Expr underside = Z() - (top + gap * v) + 0.6 * abs(u);
+    const Expr plate = min(blockAt(-0.011, 0.003, 0.0, 0.37, 0.32, 0.4), min(underside, plateThickness * v - underside));
+    Result r = simplifyAndCheck(max(ridge, plate), g, tol);  // closed, embedded, within the bound
+    figures(("ridge under a bent plate, tol " + std::to_string(tol)).c_str(), r, r.volume, r.area);
+    rejected += r.stats.rejectedIntersection;
+  }
+  EXPECT_GT(rejected, 0u);  // 21 + 3 when written
 }
