@@ -22,6 +22,13 @@ double DistanceField::gradient(const double p[3], double g[3]) const {
   return value(p);
 }
 
+double DistanceField::gradientFromNearest(double f, const double* p, const double* q, double g[3]) const {
+  const double d = std::fabs(f);
+  const double s = f > 0.0 ? 1.0 : -1.0;  // inside: f = d grows away from the boundary
+  for (int k = 0; k < 3; ++k) g[k] = k < dims() && d != 0.0 ? s * (p[k] - q[k]) / d : 0.0;
+  return f;
+}
+
 Interval DistanceField::bound(const Interval box[3]) const {
   double c[3] = {0.0, 0.0, 0.0}, r2 = 0.0;
   for (int i = 0; i < dims(); ++i) {

@@ -245,15 +245,7 @@ double MeshField::distance(const double* p, double* q) const {
 
 double MeshField::gradient(const double* p, double* g) const {
   double q[3];
-  const double f = signedDistance(p, q);
-  const double d = std::fabs(f);
-  if (d == 0.0) {
-    g[0] = g[1] = g[2] = 0.0;
-    return f;
-  }
-  const double s = f > 0.0 ? 1.0 : -1.0;
-  for (int k = 0; k < 3; ++k) g[k] = s * (p[k] - q[k]) / d;
-  return f;
+  return gradientFromNearest(signedDistance(p, q), p, q, g);
 }
 
 double MeshField::windingNumber(const double* p) const {

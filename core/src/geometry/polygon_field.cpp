@@ -115,17 +115,7 @@ double PolygonField::distance(double x, double y, double* q) const {
 
 double PolygonField::gradient(const double* p, double* g) const {
   double q[2];
-  const double f = signedDistance(p, q);
-  const double d = std::fabs(f);
-  g[2] = 0.0;
-  if (d == 0.0) {
-    g[0] = g[1] = 0.0;
-    return f;
-  }
-  const double s = f > 0.0 ? 1.0 : -1.0;  // inside: f = d grows away from the boundary
-  g[0] = s * (p[0] - q[0]) / d;
-  g[1] = s * (p[1] - q[1]) / d;
-  return f;
+  return gradientFromNearest(signedDistance(p, q), p, q, g);
 }
 
 void bezierPoint(const double* ctrl, int degree, int dims, double t, double* out) {

@@ -39,6 +39,9 @@ class DistanceField : public FieldFunction {
   virtual bool exactInside() const { return false; }
 
  protected:
+  // The gradient of an exact signed distance f at p from q, the nearest boundary point:
+  // ±(p − q)/|f| over the dims() coordinates (the rest 0), 0 on the boundary. Returns f.
+  double gradientFromNearest(double f, const double* p, const double* q, double g[3]) const;
   // Called only for another object of the same dynamic type and content hash.
   virtual bool sameGeometry(const DistanceField& other) const = 0;
 };
