@@ -10,38 +10,12 @@
 #include "frep/expressions/tape.h"
 #include "frep/extremum/extremum.h"
 #include "frep/minkowski_algebra/reduction.h"
+#include "minkowski_test_shapes.h"
 
 namespace frep::minkowski {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-Vec3 col(const Mat3& r, int a) { return {r[a], r[3 + a], r[6 + a]}; }
-
-// Independent F-reps of single members (world coordinates): minus the distance for segments
-// and discs, r − |X − c| for spheres. Written without the reduction code.
-Expr memberExpr(const Shape& s) {
-  Expr q[3];
-  for (int i = 0; i < 3; ++i) q[i] = Expr::x(i) - s.pos[i];
-  Vec3 d = col(s.rot, s.axis);
-  switch (s.kind) {
-    case ShapeKind::Sphere: return s.size[0] - sqrt(square(q[0]) + square(q[1]) + square(q[2]));
-    case ShapeKind::Segment: {
-      const double l = s.size[0];
-      Expr t = (q[0] * d[0] + q[1] * d[1] + q[2] * d[2]) * (1.0 / l);
-      t = min(max(t, Expr(0.0)), Expr(1.0));
-      Expr e = square(q[0] - t * (l * d[0])) + square(q[1] - t * (l * d[1])) + square(q[2] - t * (l * d[2]));
-      return -sqrt(e);
-    }
-    case ShapeKind::Disc: {
-      Expr h = q[0] * d[0] + q[1] * d[1] + q[2] * d[2];
-      Expr rho = sqrt(square(q[0] - h * d[0]) + square(q[1] - h * d[1]) + square(q[2] - h * d[2]));
-      return -sqrt(square(h) + square(max(rho - s.size[0], Expr(0.0))));
-    }
-    case ShapeKind::Block: break;
-  }
-  return Expr(-1.0);
-}
+using namespace test_shapes;
 
 Bounds memberBox(const Shape& s, double pad) {
   double ext = std::fabs(s.size[0]) + pad;
@@ -51,17 +25,6 @@ Bounds memberBox(const Shape& s, double pad) {
     b.hi.push_back(s.pos[i] + ext);
   }
   return b;
-}
-
-// World bounding box of a reduction (from its support function).
-void worldBox(const Reduction& r, Vec3& lo, Vec3& hi) {
-  for (int i = 0; i < 3; ++i) {
-    Vec3 n{0, 0, 0};
-    n[i] = 1;
-    hi[i] = supportValue(r, n);
-    n[i] = -1;
-    lo[i] = -supportValue(r, n);
-  }
 }
 
 // discAxis: −1 no discs, 0..2 discs on that axis only, kAnyAxis discs on random axes.
@@ -111,7 +74,9 @@ TEST(MinkowskiAlgebra, RandomSumsAgreeInSignWithTheCertifiedSearch) {
     Sum head, all;
     for (int i = 0; i < k; ++i) {
       ASSERT_TRUE(all.add(m[i]));
-      if (i + 1 < k) ASSERT_TRUE(head.add(m[i]));
+      if (i + 1 < k) {
+        ASSERT_TRUE(head.add(m[i]));
+      }
     }
     Reduction rAll = reduce(all), rHead = reduce(head);
     ASSERT_TRUE(rAll.ok && rHead.ok) << rAll.reason;
@@ -192,30 +157,6 @@ TEST(MinkowskiAlgebra, MembersAloneAreMinusTheirDistance) {
       EXPECT_NEAR(unionValue(r, p), pe.eval(*t, p.data()), 1e-9) << s.describe();
     }
   }
-}
-
-// Midpoint lattice count of {f >= 0} at n^3 over the world box.
-double latticeVolume(const Reduction& r, int n) {
-  Vec3 lo, hi;
-  worldBox(r, lo, hi);
-  double h[3], count = 0;
-  for (int i = 0; i < 3; ++i) h[i] = (hi[i] - lo[i]) / n;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k) {
-        Vec3 p{lo[0] + (i + 0.5) * h[0], lo[1] + (j + 0.5) * h[1], lo[2] + (k + 0.5) * h[2]};
-        count += unionValue(r, p) >= 0;
-      }
-  return count * h[0] * h[1] * h[2];
-}
-
-Shape member(ShapeKind k, int axis, double size, Mat3 rot = identityRotation()) {
-  Shape s;
-  s.kind = k;
-  s.axis = axis;
-  s.size[0] = size;
-  s.rot = rot;
-  return s;
 }
 
 TEST(MinkowskiAlgebra, VolumesMatchSteinerFormulas) {

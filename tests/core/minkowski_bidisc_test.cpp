@@ -12,11 +12,12 @@
 #include "frep/extremum/extremum.h"
 #include "frep/minkowski_algebra/bidisc.h"
 #include "frep/minkowski_algebra/reduction.h"
+#include "minkowski_test_shapes.h"
 
 namespace frep::minkowski {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using namespace test_shapes;
 
 // max over t in [0, h] of min(a − |(w, t)|, b − |(u, h − t)|), by ternary search (the min of a
 // falling and a rising function is unimodal), written without the quadratic.
@@ -68,40 +69,6 @@ TEST(MinkowskiBidisc, GaugeIsOneLipschitz) {
   EXPECT_GT(worst, 0.9);  // and not a trivially flat function
 }
 
-Shape member(ShapeKind k, int axis, double size, Mat3 rot = identityRotation()) {
-  Shape s;
-  s.kind = k;
-  s.axis = axis;
-  s.size[0] = size;
-  s.rot = rot;
-  return s;
-}
-
-void worldBox(const Reduction& r, Vec3& lo, Vec3& hi) {
-  for (int i = 0; i < 3; ++i) {
-    Vec3 n{0, 0, 0};
-    n[i] = 1;
-    hi[i] = supportValue(r, n);
-    n[i] = -1;
-    lo[i] = -supportValue(r, n);
-  }
-}
-
-// Independent F-reps of the last member for the search: minus the distance to the segment or disc.
-Expr memberExpr(const Shape& s) {
-  Expr q[3];
-  for (int i = 0; i < 3; ++i) q[i] = Expr::x(i) - s.pos[i];
-  const Vec3 d{s.rot[s.axis], s.rot[3 + s.axis], s.rot[6 + s.axis]};
-  Expr h = q[0] * d[0] + q[1] * d[1] + q[2] * d[2];
-  if (s.kind == ShapeKind::Segment) {
-    const double l = s.size[0];
-    Expr t = min(max(h * (1.0 / l), Expr(0.0)), Expr(1.0));
-    return -sqrt(square(q[0] - t * (l * d[0])) + square(q[1] - t * (l * d[1])) + square(q[2] - t * (l * d[2])));
-  }
-  Expr rho = sqrt(square(q[0] - h * d[0]) + square(q[1] - h * d[1]) + square(q[2] - h * d[2]));
-  return -sqrt(square(h) + square(max(rho - s.size[0], Expr(0.0))));
-}
-
 // Random sums of 2–6 segments and discs on two axes (random pair, sizes, signs, placements, a
 // common random rotation in 2 of 3): the closed form against the certified search of
 // (one-axis union of the first k − 1) ⊕ (the second axis's disc by its own formula), 250
@@ -135,7 +102,9 @@ TEST(MinkowskiBidisc, RandomTwoAxisSumsAgreeInSignWithTheCertifiedSearch) {
     Sum head, all;
     for (int i = 0; i < k; ++i) {
       ASSERT_TRUE(all.add(m[i]));
-      if (i + 1 < k) ASSERT_TRUE(head.add(m[i]));
+      if (i + 1 < k) {
+        ASSERT_TRUE(head.add(m[i]));
+      }
     }
     Reduction rAll = reduce(all), rHead = reduce(head);
     ASSERT_TRUE(rAll.ok && rHead.ok) << rAll.reason << rHead.reason;
@@ -190,7 +159,9 @@ TEST(MinkowskiBidisc, PrimitivesAreTheSum) {
       EXPECT_EQ(prims.size(), 3u);  // §IV.B: bidisc = bicircle ∪ 2 cylinders
       EXPECT_EQ(std::count_if(prims.begin(), prims.end(), [](const Piece& p) { return p.kind == PieceKind::Bicircle; }), 1);
     }
-    if (trial % 4 == 1) EXPECT_EQ(prims.size(), 28u);
+    if (trial % 4 == 1) {
+      EXPECT_EQ(prims.size(), 28u);
+    }
     Vec3 lo, hi;
     worldBox(r, lo, hi);
     int n = 0;
@@ -223,30 +194,12 @@ TEST(MinkowskiBidisc, VolumeMatchesTheMixedVolumeFormula) {
   const double v = lx * ly * lz + ly * lz * 2 * b + lx * lz * 2 * a + lx * ly * 2 * (a + b) +
                    lx * (kPi * a * a + 4 * a * b) + ly * (kPi * b * b + 4 * a * b) + lz * 4 * a * b +
                    2 * kPi * a * b * (a + b);
-  Reduction r = reduce(s);
-  Vec3 lo, hi;
-  worldBox(r, lo, hi);
-  const int n = 160;
-  double h[3], count = 0;
-  for (int i = 0; i < 3; ++i) h[i] = (hi[i] - lo[i]) / n;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k)
-        count += unionValue(r, {lo[0] + (i + 0.5) * h[0], lo[1] + (j + 0.5) * h[1], lo[2] + (k + 0.5) * h[2]}) >= 0;
-  EXPECT_NEAR(count * h[0] * h[1] * h[2] / v, 1.0, 4e-3);
+  EXPECT_NEAR(latticeVolume(reduce(s), 160) / v, 1.0, 4e-3);
   // The bidisc alone: 2πab(a + b) (Fig. 5).
   Sum d;
   d.add(member(ShapeKind::Disc, 2, a, rot));
   d.add(member(ShapeKind::Disc, 0, b, rot));
-  Reduction rd = reduce(d);
-  worldBox(rd, lo, hi);
-  count = 0;
-  for (int i = 0; i < 3; ++i) h[i] = (hi[i] - lo[i]) / n;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k)
-        count += unionValue(rd, {lo[0] + (i + 0.5) * h[0], lo[1] + (j + 0.5) * h[1], lo[2] + (k + 0.5) * h[2]}) >= 0;
-  EXPECT_NEAR(count * h[0] * h[1] * h[2] / (2 * kPi * a * b * (a + b)), 1.0, 4e-3);
+  EXPECT_NEAR(latticeVolume(reduce(d), 160) / (2 * kPi * a * b * (a + b)), 1.0, 4e-3);
 }
 
 // Subtraction chain (eq. 19–21) with a bidisc: a block eroded by a sum is the block moved in by

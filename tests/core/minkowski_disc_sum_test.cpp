@@ -10,11 +10,12 @@
 #include "frep/minkowski_algebra/bidisc.h"
 #include "frep/minkowski_algebra/disc_sum_distance.h"
 #include "frep/minkowski_algebra/reduction.h"
+#include "minkowski_test_shapes.h"
 
 namespace frep::minkowski {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using namespace test_shapes;
 
 Vec3 randomRadii(std::mt19937& rng, int trial) {
   std::uniform_real_distribution<double> u(0.05, 1.0);
@@ -176,33 +177,6 @@ double mixedTwoDiscsBall() {
       s += std::sqrt(1 - sa * sa * sb * sb);  // |u × v|² = 1 − (u·v)²
     }
   return s * h * h / 12;
-}
-
-double latticeVolume(const Reduction& r, int n) {
-  Vec3 lo, hi;
-  for (int i = 0; i < 3; ++i) {
-    Vec3 e{0, 0, 0};
-    e[i] = 1;
-    hi[i] = supportValue(r, e);
-    e[i] = -1;
-    lo[i] = -supportValue(r, e);
-  }
-  double h[3], count = 0;
-  for (int i = 0; i < 3; ++i) h[i] = (hi[i] - lo[i]) / n;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k)
-        count += unionValue(r, {lo[0] + (i + 0.5) * h[0], lo[1] + (j + 0.5) * h[1], lo[2] + (k + 0.5) * h[2]}) >= 0;
-  return count * h[0] * h[1] * h[2];
-}
-
-Shape member(ShapeKind k, int axis, double size, Mat3 rot = identityRotation()) {
-  Shape s;
-  s.kind = k;
-  s.axis = axis;
-  s.size[0] = size;
-  s.rot = rot;
-  return s;
 }
 
 TEST(MinkowskiDiscSum, VolumesMatchTheMixedVolumeFormulas) {
