@@ -209,6 +209,48 @@ void carryOf(const Work& w, SimplifyCarry& carry) {
   for (size_t t = 0; t < w.tris.size(); ++t) carry.triangles[t] = uint8_t((w.level[t] + 1) | (w.made[t] ? 0x80 : 0));
 }
 
+// A 4-ary min-heap (by operator>): fewer levels, so fewer cache misses per pop than a binary
+// heap of the same elements. Pops in the same order as std::priority_queue for a total order.
+template <typename T>
+class MinHeap {
+ public:
+  bool empty() const { return h_.empty(); }
+  size_t size() const { return h_.size(); }
+  const T& top() const { return h_.front(); }
+  void push(const T& x) {
+    size_t i = h_.size();
+    h_.push_back(x);
+    while (i > 0) {
+      const size_t p = (i - 1) / 4;
+      if (!(h_[p] > x)) break;
+      h_[i] = h_[p];
+      i = p;
+    }
+    h_[i] = x;
+  }
+  void pop() {
+    const T x = h_.back();
+    h_.pop_back();
+    const size_t n = h_.size();
+    if (n == 0) return;
+    size_t i = 0;
+    for (;;) {
+      const size_t c0 = 4 * i + 1;
+      if (c0 >= n) break;
+      size_t best = c0;
+      for (size_t c = c0 + 1; c < std::min(c0 + 4, n); ++c)
+        if (h_[best] > h_[c]) best = c;
+      if (!(x > h_[best])) break;
+      h_[i] = h_[best];
+      i = best;
+    }
+    h_[i] = x;
+  }
+
+ private:
+  std::vector<T> h_;
+};
+
 class Simplifier {
  public:
   // deferIntersections: no self-intersection check per collapse; embedded() checks the result
@@ -312,6 +354,8 @@ class Simplifier {
       if (onBoxFace(w_.pos[v])) w_.locked[v] = 1;
     alive_.assign(nv, 1);
     version_.assign(nv, 0);
+    markA_.assign(nv, 0);
+    markB_.assign(nv, 0);
     vtris_.assign(nv, {});
     qpos_.resize(nv);
     for (size_t v = 0; v < nv; ++v) qpos_[v] = quantise(w_.pos[v]);
@@ -453,80 +497,118 @@ class Simplifier {
   }
 
   // ---- error against the model --------------------------------------------------------------
-  // Is every sample point p of triangle abc within e = tolerance * 2^level of the surface,
-  // along the normal? Certified when the model changes sign along [p - e d, p + e d] (inside at
-  // the start, outside at the end): the surface crosses it. d is the triangle's normal, or
-  // `primary` (for the mesher's slivers, whose own normal is noise). Measuring along the normal
-  // (not towards the nearest surface point) also keeps chords across a crease out: they are
-  // deeper along their normal than to the nearer face.
-  //
-  // The points come probes first (kProbes points spread over the triangle, where a chord is
-  // deepest), so a caller can test the probes of several triangles before any full check:
-  // [from, to) selects a range of that order.
-  bool withinLevel(const V3& a, const V3& b, const V3& c, int level, const V3* primary = nullptr, size_t from = 0,
-                   size_t to = SIZE_MAX) {
-    const double e = 0.8 * std::ldexp(tol_, level);  // 0.8: a margin for the gaps between samples
-    auto unit = [](V3 d) {
-      double l = norm(d);
-      return l > 0 && std::isfinite(l) ? scale(d, 1 / l) : V3{0, 0, 0};
-    };
-    const V3 d = primary ? unit(*primary) : unit(cross(sub(b, a), sub(c, a)));
-    if (d == V3{0, 0, 0}) return false;
-    double longest = std::max({norm(sub(b, a)), norm(sub(c, b)), norm(sub(a, c))});
-    int m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
-    const V3 u = scale(sub(b, a), 1.0 / m), v = scale(sub(c, a), 1.0 / m);
-    const std::vector<std::array<int32_t, 2>>& cells = errorSampleCells(m);
-    std::vector<V3>& pts = samplePoints_;
-    pts.clear();
-    for (size_t k = from; k < std::min(to, cells.size()); ++k)
-      pts.push_back(add(a, add(scale(u, cells[k][0] + 1.0 / 3), scale(v, cells[k][1] + 1.0 / 3))));
-    return crossedAlong(pts, scale(d, e));
+  // A triangle's error level (levels): the first level k <= maxK at which every sample point p
+  // of the triangle lies within e = tolerance * 2^k of the surface along the direction d, i.e.
+  // the model changes sign along [p - 0.8 e d, p + 0.8 e d] (inside at the start, outside at the
+  // end: the surface crosses it; 0.8 leaves a margin for the gaps between samples); maxK + 1
+  // when there is none. d is the triangle's normal, or `primary` (for the mesher's slivers, whose
+  // own normal is noise). Measuring along the normal (not towards the nearest surface point) also
+  // keeps chords across a crease out: they are deeper along their normal than to the nearer face.
+  struct LevelQuery {
+    V3 a, b, c;
+    V3 primary{0, 0, 0};  // zero: the triangle's own normal
+    int level = 0;        // the answer
+    // internal: unit direction, samples per side, whether the probes of `level` passed
+    V3 d{};
+    int m = 1;
+    bool probed = false, done = false;
+  };
+  struct SamplePair {
+    V3 lo, hi;       // f(lo) must be inside, f(hi) outside
+    uint32_t query;  // whose
+  };
+
+  // Answers every query. A level is checked in full only once its probes (kProbes points spread
+  // over the triangle, where a chord is deepest) pass, and a failing level moves on to the next
+  // one's probes: the answer is the same as checking every level in full, for far fewer
+  // evaluations. All queries advance together, so each round is one batch of the evaluator
+  // over every query's points. stopAbove: return false as soon as some query exceeds maxK.
+  bool levels(std::vector<LevelQuery>& qs, int maxK, bool stopAbove) {
+    for (LevelQuery& q : qs) {
+      auto unit = [](V3 d) {
+        double l = norm(d);
+        return l > 0 && std::isfinite(l) ? scale(d, 1 / l) : V3{0, 0, 0};
+      };
+      q.d = q.primary != V3{0, 0, 0} ? unit(q.primary) : unit(cross(sub(q.b, q.a), sub(q.c, q.a)));
+      const double longest = std::max({norm(sub(q.b, q.a)), norm(sub(q.c, q.b)), norm(sub(q.a, q.c))});
+      q.m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
+      q.level = 0;
+      q.probed = false;
+      q.done = q.d == V3{0, 0, 0};  // no direction: no level passes
+      if (q.done) q.level = maxK + 1;
+    }
+    for (;;) {
+      std::vector<SamplePair>& pairs = samplePairs_;
+      pairs.clear();
+      bool any = false;
+      for (uint32_t i = 0; i < qs.size(); ++i) {
+        LevelQuery& q = qs[i];
+        if (q.done) continue;
+        any = true;
+        const std::vector<std::array<int32_t, 2>>& cells = errorSampleCells(q.m);
+        const size_t from = q.probed ? kProbes : 0, to = q.probed ? cells.size() : std::min(kProbes, cells.size());
+        const double e = 0.8 * std::ldexp(tol_, q.level);
+        const V3 u = scale(sub(q.b, q.a), 1.0 / q.m), v = scale(sub(q.c, q.a), 1.0 / q.m), de = scale(q.d, e);
+        for (size_t k = from; k < to; ++k) {
+          const V3 p = add(q.a, add(scale(u, cells[k][0] + 1.0 / 3), scale(v, cells[k][1] + 1.0 / 3)));
+          pairs.push_back({sub(p, de), add(p, de), i});
+        }
+      }
+      if (!any) return true;
+      failed_.assign(qs.size(), 0);
+      crossed(pairs);
+      for (uint32_t i = 0; i < qs.size(); ++i) {
+        LevelQuery& q = qs[i];
+        if (q.done) continue;
+        if (!failed_[i]) {
+          // the probes passed: now the rest (none left: done); the rest passed: done
+          if (q.probed || errorSampleCells(q.m).size() <= kProbes)
+            q.done = true;
+          else
+            q.probed = true;
+        } else {
+          q.probed = false;
+          if (++q.level > maxK) {
+            q.done = true;
+            if (stopAbove) return false;
+          }
+        }
+      }
+    }
   }
 
-  // Is f(p - d) inside and f(p + d) outside at every point p of `pts`?
-  bool crossedAlong(const std::vector<V3>& pts, const V3& d) {
+  // Marks failed_[query] where f(lo) is not inside or f(hi) not outside.
+  void crossed(const std::vector<SamplePair>& pairs) {
     const uint32_t nvars = tape_->numVars();
     batch_.reserve(*tape_);
     const size_t perCall = BatchEvaluator<double>::kBatch / 2;
     inputs_.resize(nvars);
     for (uint32_t k = 0; k < nvars; ++k) inputs_[k] = batch_.in(k);
-    for (size_t s = 0; s < pts.size(); s += perCall) {
-      size_t n = std::min(perCall, pts.size() - s);
+    for (size_t s = 0; s < pairs.size(); s += perCall) {
+      const size_t n = std::min(perCall, pairs.size() - s);
       for (size_t i = 0; i < n; ++i) {
-        const V3 lo = sub(pts[s + i], d), hi = add(pts[s + i], d);
-        for (uint32_t k = 0; k < std::min(nvars, 3u); ++k) inputs_[k][2 * i] = lo[k], inputs_[k][2 * i + 1] = hi[k];
+        const SamplePair& sp = pairs[s + i];
+        for (uint32_t k = 0; k < std::min(nvars, 3u); ++k) inputs_[k][2 * i] = sp.lo[k], inputs_[k][2 * i + 1] = sp.hi[k];
       }
       for (uint32_t k = 3; k < nvars; ++k) std::fill_n(inputs_[k], 2 * n, opt_.fixedCoords[k - 3]);
       const double* f = batch_.eval(*tape_, 2 * n);
       stats_.modelEvals += 2 * n;
       for (size_t i = 0; i < n; ++i)
-        if (std::signbit(f[2 * i]) || !std::signbit(f[2 * i + 1])) return false;
+        if (std::signbit(f[2 * i]) || !std::signbit(f[2 * i + 1])) failed_[pairs[s + i].query] = 1;
     }
-    return true;
-  }
-
-  // The first level from k up to maxK at which the triangle's probes pass (maxK + 1: none).
-  int probeLevel(const V3& a, const V3& b, const V3& c, int k, int maxK, const V3* primary = nullptr) {
-    while (k <= maxK && !withinLevel(a, b, c, k, primary, 0, kProbes)) ++k;
-    return k;
-  }
-  // The first level from the probes' level `k` up to maxK at which every point passes (maxK + 1:
-  // none). A level is fully checked only once its probes pass (probes failing = the level
-  // fails), so the answer is the same as checking every level in full, for far fewer
-  // evaluations when the triangle's own level is high (small tolerances, crease chords).
-  int fullLevel(const V3& a, const V3& b, const V3& c, int k, int maxK, const V3* primary = nullptr) {
-    while (k <= maxK && !withinLevel(a, b, c, k, primary, kProbes)) k = probeLevel(a, b, c, k + 1, maxK, primary);
-    return k;
   }
 
   int levelOf(uint32_t t) {
     if (w_.level[t] < 0) {
       const Tri& tr = w_.tris[t];
-      const V3 &a = w_.pos[tr[0]], &b = w_.pos[tr[1]], &c = w_.pos[tr[2]];
-      V3 along = add(w_.normal[tr[0]], add(w_.normal[tr[1]], w_.normal[tr[2]]));
-      const V3* dir = quality(a, b, c) < opt_.minQuality && norm(along) > 0 ? &along : nullptr;
-      const int k = fullLevel(a, b, c, probeLevel(a, b, c, 0, maxLevel_, dir), maxLevel_, dir);
-      w_.level[t] = int8_t(std::min(k, maxLevel_));  // beyond the last level: no more allowance
+      std::vector<LevelQuery>& qs = scratch_.queries;
+      qs.assign(1, {});
+      LevelQuery& q = qs[0];
+      q.a = w_.pos[tr[0]], q.b = w_.pos[tr[1]], q.c = w_.pos[tr[2]];
+      const V3 along = add(w_.normal[tr[0]], add(w_.normal[tr[1]], w_.normal[tr[2]]));
+      if (quality(q.a, q.b, q.c) < opt_.minQuality && norm(along) > 0) q.primary = along;
+      levels(qs, maxLevel_, false);
+      w_.level[t] = int8_t(std::min(qs[0].level, maxLevel_));  // beyond the last level: no more allowance
     }
     return w_.level[t];
   }
@@ -536,28 +618,25 @@ class Simplifier {
     // Link condition: exactly two triangles hold the edge, and a and b have no other common
     // neighbour; neither opposite vertex may drop below valence 3.
     // Scratch lists kept between calls (no allocation per attempt).
-    std::vector<uint32_t>&na = scratch_.na, &nb = scratch_.nb, &opposite = scratch_.opposite, &common = scratch_.common,
-                         &changed = scratch_.changed, &removed = scratch_.removed, &ring = scratch_.ring;
-    for (auto* l : {&na, &nb, &opposite, &common, &changed, &removed, &ring}) l->clear();
+    std::vector<uint32_t>&opposite = scratch_.opposite, &changed = scratch_.changed, &removed = scratch_.removed,
+                         &ring = scratch_.ring;
+    for (auto* l : {&opposite, &changed, &removed, &ring}) l->clear();
+    // a's neighbours marked; b's neighbours counted once each if marked (the common ones).
+    const uint32_t mark = nextMark();
     for (uint32_t t : vtris_[a])
-      for (uint32_t v : w_.tris[t])
-        if (v != a) na.push_back(v);
+      for (uint32_t v : w_.tris[t]) markA_[v] = mark;
+    size_t common = 0;
     for (uint32_t t : vtris_[b]) {
       bool hasA = false;
       for (uint32_t v : w_.tris[t]) hasA |= v == a;
-      for (uint32_t v : w_.tris[t])
-        if (v != b) {
-          nb.push_back(v);
-          if (hasA && v != a) opposite.push_back(v);
-        }
+      for (uint32_t v : w_.tris[t]) {
+        if (v == a || v == b) continue;
+        if (hasA) opposite.push_back(v);
+        if (markA_[v] == mark && markB_[v] != mark) markB_[v] = mark, ++common;
+      }
     }
-    std::sort(na.begin(), na.end());
-    na.erase(std::unique(na.begin(), na.end()), na.end());
-    std::sort(nb.begin(), nb.end());
-    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
-    std::sort(opposite.begin(), opposite.end());
-    if (opposite.size() != 2 || opposite[0] == opposite[1] || common != opposite || vtris_[opposite[0]].size() <= 3 ||
+    // The opposite vertices are common neighbours, so "no other common neighbour" is a count.
+    if (opposite.size() != 2 || opposite[0] == opposite[1] || common != 2 || vtris_[opposite[0]].size() <= 3 ||
         vtris_[opposite[1]].size() <= 3) {
       ++stats_.rejectedTopology;
       return;
@@ -609,27 +688,7 @@ class Simplifier {
     int allowed = 0;
     for (uint32_t t : changed) allowed = std::max(allowed, levelOf(t));
     for (uint32_t t : removed) allowed = std::max(allowed, levelOf(t));
-    // The probes of every new triangle first (most failing collapses fail there), then the
-    // full check from each triangle's probe level; the outcome does not depend on this order.
-    std::vector<int8_t>& newLevel = scratch_.newLevel;
-    newLevel.assign(changed.size(), 0);
-    for (size_t i = 0; i < changed.size(); ++i) {
-      const Tri& tr = w_.tris[changed[i]];
-      newLevel[i] = int8_t(probeLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), 0, allowed));
-      if (newLevel[i] > allowed) {
-        ++stats_.rejectedError;
-        return;
-      }
-    }
-    for (size_t i = 0; i < changed.size(); ++i) {
-      const Tri& tr = w_.tris[changed[i]];
-      newLevel[i] = int8_t(fullLevel(corner(tr[0]), corner(tr[1]), corner(tr[2]), newLevel[i], allowed));
-      if (newLevel[i] > allowed) {
-        ++stats_.rejectedError;
-        return;
-      }
-    }
-    // The removed vertices stay within the allowed error of the new triangles.
+    // The removed vertices stay within the allowed error of the new triangles (cheap: first).
     const double e = std::ldexp(tol_, allowed);
     for (uint32_t v : {a, b}) {
       double d = INFINITY;
@@ -642,6 +701,20 @@ class Simplifier {
         return;
       }
     }
+    // Every new triangle's level, all checked together (levels()).
+    std::vector<LevelQuery>& qs = scratch_.queries;
+    qs.assign(changed.size(), {});
+    for (size_t i = 0; i < changed.size(); ++i) {
+      const Tri& tr = w_.tris[changed[i]];
+      qs[i].a = corner(tr[0]), qs[i].b = corner(tr[1]), qs[i].c = corner(tr[2]);
+    }
+    if (!levels(qs, allowed, true)) {
+      ++stats_.rejectedError;
+      return;
+    }
+    std::vector<int8_t>& newLevel = scratch_.newLevel;
+    newLevel.resize(changed.size());
+    for (size_t i = 0; i < changed.size(); ++i) newLevel[i] = int8_t(qs[i].level);
 
     // Self-intersection: the new triangles against each other, then against every other
     // triangle near them whose box meets theirs.
@@ -687,12 +760,13 @@ class Simplifier {
       if (!deferred_) insertBuckets(changed[i]);
     }
     ++stats_.collapses;
+    const uint32_t seen = nextMark();
+    markA_[a] = seen;
     for (uint32_t t : vtris_[a])
       for (uint32_t v : w_.tris[t])
-        if (v != a) ring.push_back(v);
-    std::sort(ring.begin(), ring.end());
-    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
-    for (uint32_t v : ring) pushCandidate(a, v);
+        if (markA_[v] != seen) markA_[v] = seen, ring.push_back(v);
+    for (uint32_t v : ring) pushCandidate(a, v);  // the order of pushes does not matter: the
+                                                   // candidates' order is total
   }
 
   // Self-intersection: the new triangles of collapsing a, b to p against each other, then
@@ -830,11 +904,13 @@ class Simplifier {
   SimplifyOptions opt_;
   double tol_;
   SimplifyStats stats_;
-  std::vector<V3> samplePoints_;
+  std::vector<SamplePair> samplePairs_;
+  std::vector<char> failed_;  // per query of levels()
   std::vector<double*> inputs_;  // the batch evaluator's input lanes, one array per coordinate
   struct Scratch {
-    std::vector<uint32_t> na, nb, opposite, common, changed, removed, ring;
+    std::vector<uint32_t> opposite, changed, removed, ring;
     std::vector<int8_t> newLevel;
+    std::vector<LevelQuery> queries;
     std::vector<uint64_t> cells;  // hash cells of the self-intersection check
   } scratch_;
   struct NewTri {  // a triangle as a collapse would leave it
@@ -865,7 +941,11 @@ class Simplifier {
     float lo[3], hi[3];
   };
   std::unordered_map<uint64_t, std::vector<Entry>> buckets_;
-  std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue_;
+  // Per-vertex marks (link condition, ring): == the current mark means "in the set".
+  std::vector<uint32_t> markA_, markB_;
+  uint32_t mark_ = 0;
+  uint32_t nextMark() { return ++mark_; }
+  MinHeap<Candidate> queue_;
   BatchEvaluator<double> batch_;
   int maxLevel_ = 0;  // the last error level
   bool deferred_;
