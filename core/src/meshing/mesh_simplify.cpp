@@ -115,6 +115,7 @@ double quality(const V3& a, const V3& b, const V3& c) {
 
 constexpr int kMaxSamplesPerSide = 64;  // the error check's subdivision: m <= 64
 constexpr size_t kProbes = 4;           // error samples tried first on every new triangle
+constexpr int kGlobalStage = 3;         // SimplifyOptions::progress: the global pass
 
 }  // namespace
 
@@ -271,17 +272,17 @@ class Simplifier {
   // the result.
   const SimplifyStats& run() {
     setUp();
-    const bool report = opt_.progress && !w_.confined;  // the global pass (stage 2) only
+    const bool report = opt_.progress && !w_.confined;  // the global pass only
     uint64_t examined = 0;
     while (!queue_.empty()) {
-      if (report && (examined & 4095) == 0) opt_.progress(2, examined, examined + queue_.size());
+      if (report && (examined & 4095) == 0) opt_.progress(kGlobalStage, examined, examined + queue_.size());
       ++examined;
       Candidate c = queue_.top();
       queue_.pop();
       if (!alive_[c.a] || !alive_[c.b] || version_[c.a] != c.va || version_[c.b] != c.vb) continue;
       tryCollapse(c.a, c.b);
     }
-    if (report) opt_.progress(2, examined, examined);
+    if (report) opt_.progress(kGlobalStage, examined, examined);
     int worst = -1;  // over the triangles that collapses made
     for (uint32_t t = 0; t < w_.tris.size(); ++t)
       if (tAlive_[t] && w_.made[t]) worst = std::max<int>(worst, w_.level[t]);
@@ -972,6 +973,10 @@ std::unique_ptr<Simplifier> simplifyChecked(Work&& w, const TapePtr& tape, const
 
 constexpr int kBlockVoxels = 32;  // the block passes' blocks (fixed in index space)
 constexpr int kShift[2] = {0, kBlockVoxels / 2};  // the second pass's blocks straddle the first's faces
+// A third pass, in the master only (simplifyMesh), of larger blocks aligned with the first
+// pass's: what the second pass leaves along its block faces lies inside them, so the serial
+// global pass gets less to do, and it works with more of the mesh at once.
+constexpr int kThirdBlockVoxels = 2 * kBlockVoxels;
 using BlockKey = std::array<int32_t, 3>;
 
 // The cells of block b of pass `pass` along one axis, clipped to the grid's cells.
@@ -1027,9 +1032,9 @@ bool bricksDid(const BlockKey& b, int pass, int brick, const std::array<int64_t,
 void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt, int pass,
                const std::function<bool(const BlockKey&)>& mine, SimplifyStats& stats) {
   const size_t nv = g.pos.size(), nt = g.tris.size();
-  const double side = kBlockVoxels * grid.voxel, margin = grid.voxel;
+  const double side = (pass < 2 ? kBlockVoxels : kThirdBlockVoxels) * grid.voxel, margin = grid.voxel;
   V3 origin;
-  for (int k = 0; k < 3; ++k) origin[k] = grid.origin[k] - kShift[pass] * grid.voxel;
+  for (int k = 0; k < 3; ++k) origin[k] = grid.origin[k] - (pass < 2 ? kShift[pass] : 0) * grid.voxel;
   auto blockOf = [&](const V3& p) {
     BlockKey b;
     for (int k = 0; k < 3; ++k) b[k] = int32_t(std::floor((p[k] - origin[k]) / side));
@@ -1221,6 +1226,7 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
   for (int pass = 0; pass < 2; ++pass)
     blockPass(w, tape, grid, options, pass,
               [&](const BlockKey& b) { return !bricksDid(b, pass, options.bricksSimplified, cells); }, stats);
+  blockPass(w, tape, grid, options, 2, [](const BlockKey&) { return true; }, stats);
   SimplifyStats s2;
   std::unique_ptr<Simplifier> second = simplifyChecked(std::move(w), tape, grid, options, s2);
   stats += s2;
