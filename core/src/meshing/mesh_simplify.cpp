@@ -514,10 +514,6 @@ class Simplifier {
     int m = 1;
     bool probed = false, done = false;
   };
-  struct SamplePair {
-    V3 lo, hi;       // f(lo) must be inside, f(hi) outside
-    uint32_t query;  // whose
-  };
 
   // Answers every query. A level is checked in full only once its probes (kProbes points spread
   // over the triangle, where a chord is deepest) pass, and a failing level moves on to the next
@@ -538,10 +534,13 @@ class Simplifier {
       q.done = q.d == V3{0, 0, 0};  // no direction: no level passes
       if (q.done) q.level = maxK + 1;
     }
+    const uint32_t nvars = tape_->numVars();
+    batch_.reserve(*tape_);
+    inputs_.resize(nvars);
+    for (uint32_t k = 0; k < nvars; ++k) inputs_[k] = batch_.in(k);
     for (;;) {
-      std::vector<SamplePair>& pairs = samplePairs_;
-      pairs.clear();
       bool any = false;
+      failed_.assign(qs.size(), 0);
       for (uint32_t i = 0; i < qs.size(); ++i) {
         LevelQuery& q = qs[i];
         if (q.done) continue;
@@ -550,14 +549,16 @@ class Simplifier {
         const size_t from = q.probed ? kProbes : 0, to = q.probed ? cells.size() : std::min(kProbes, cells.size());
         const double e = 0.8 * std::ldexp(tol_, q.level);
         const V3 u = scale(sub(q.b, q.a), 1.0 / q.m), v = scale(sub(q.c, q.a), 1.0 / q.m), de = scale(q.d, e);
-        for (size_t k = from; k < to; ++k) {
+        // Straight into the evaluator's lanes; a query that already failed this round stops.
+        for (size_t k = from; k < to && !failed_[i]; ++k) {
           const V3 p = add(q.a, add(scale(u, cells[k][0] + 1.0 / 3), scale(v, cells[k][1] + 1.0 / 3)));
-          pairs.push_back({sub(p, de), add(p, de), i});
+          for (int c = 0; c < 3; ++c) inputs_[c][2 * lanes_] = p[c] - de[c], inputs_[c][2 * lanes_ + 1] = p[c] + de[c];
+          laneQuery_[lanes_] = i;
+          if (++lanes_ == kPairsPerCall) crossed();
         }
       }
       if (!any) return true;
-      failed_.assign(qs.size(), 0);
-      crossed(pairs);
+      crossed();
       for (uint32_t i = 0; i < qs.size(); ++i) {
         LevelQuery& q = qs[i];
         if (q.done) continue;
@@ -578,25 +579,17 @@ class Simplifier {
     }
   }
 
-  // Marks failed_[query] where f(lo) is not inside or f(hi) not outside.
-  void crossed(const std::vector<SamplePair>& pairs) {
+  // Evaluates the pending lanes (pairs: f(p - e d) must be inside, f(p + e d) outside) and marks
+  // failed_[query] where a pair is not.
+  void crossed() {
+    if (lanes_ == 0) return;
     const uint32_t nvars = tape_->numVars();
-    batch_.reserve(*tape_);
-    const size_t perCall = BatchEvaluator<double>::kBatch / 2;
-    inputs_.resize(nvars);
-    for (uint32_t k = 0; k < nvars; ++k) inputs_[k] = batch_.in(k);
-    for (size_t s = 0; s < pairs.size(); s += perCall) {
-      const size_t n = std::min(perCall, pairs.size() - s);
-      for (size_t i = 0; i < n; ++i) {
-        const SamplePair& sp = pairs[s + i];
-        for (uint32_t k = 0; k < std::min(nvars, 3u); ++k) inputs_[k][2 * i] = sp.lo[k], inputs_[k][2 * i + 1] = sp.hi[k];
-      }
-      for (uint32_t k = 3; k < nvars; ++k) std::fill_n(inputs_[k], 2 * n, opt_.fixedCoords[k - 3]);
-      const double* f = batch_.eval(*tape_, 2 * n);
-      stats_.modelEvals += 2 * n;
-      for (size_t i = 0; i < n; ++i)
-        if (std::signbit(f[2 * i]) || !std::signbit(f[2 * i + 1])) failed_[pairs[s + i].query] = 1;
-    }
+    for (uint32_t k = 3; k < nvars; ++k) std::fill_n(inputs_[k], 2 * lanes_, opt_.fixedCoords[k - 3]);
+    const double* f = batch_.eval(*tape_, 2 * lanes_);
+    stats_.modelEvals += 2 * lanes_;
+    for (size_t i = 0; i < lanes_; ++i)
+      if (std::signbit(f[2 * i]) || !std::signbit(f[2 * i + 1])) failed_[laneQuery_[i]] = 1;
+    lanes_ = 0;
   }
 
   int levelOf(uint32_t t) {
@@ -905,7 +898,9 @@ class Simplifier {
   SimplifyOptions opt_;
   double tol_;
   SimplifyStats stats_;
-  std::vector<SamplePair> samplePairs_;
+  static constexpr size_t kPairsPerCall = BatchEvaluator<double>::kBatch / 2;
+  size_t lanes_ = 0;                            // pairs written to the evaluator's inputs
+  std::array<uint32_t, kPairsPerCall> laneQuery_{};  // whose each pair is
   std::vector<char> failed_;  // per query of levels()
   std::vector<double*> inputs_;  // the batch evaluator's input lanes, one array per coordinate
   struct Scratch {
@@ -1117,9 +1112,11 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
       for (uint32_t v : g.tris[t]) globalOf.push_back(v);
     std::sort(globalOf.begin(), globalOf.end());
     globalOf.erase(std::unique(globalOf.begin(), globalOf.end()), globalOf.end());
-    auto local = [&](uint32_t v) {
-      return uint32_t(std::lower_bound(globalOf.begin(), globalOf.end(), v) - globalOf.begin());
-    };
+    // global -> local by a per-thread table (every entry back to "none" after the block)
+    thread_local std::vector<uint32_t> localOf;
+    if (localOf.size() < nv) localOf.resize(nv, UINT32_MAX);
+    for (uint32_t i = 0; i < globalOf.size(); ++i) localOf[globalOf[i]] = i;
+    auto local = [&](uint32_t v) { return localOf[v]; };
     Work w;
     for (uint32_t v : globalOf) {
       w.pos.push_back(g.pos[v]);
@@ -1135,6 +1132,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
         w.level.push_back(g.level[t]);
         w.made.push_back(g.made[t]);
       }
+    for (uint32_t v : globalOf) localOf[v] = UINT32_MAX;
     w.confined = true;
     w.regionLo = lo;
     w.regionHi = hi;
