@@ -442,24 +442,61 @@ TEST(MeshSimplify, ErrorSamplesCoverTheTriangleAsTheFullSubdivisionDoes) {
 // chord: only the self-intersection check stops it. At tolerance 1 the rejected collapses are
 // on the plate's top, against its own underside. Without the check both results have improper
 // triangle pairs (180 and 42).
+// Creases along y at x = v/2. Ridge top at z = 0.3v, flanks at 45 degrees; the plate's
+// underside at 0.3v + gap * v on the crease, sloping down at 0.6 to both sides, its top
+// plateThickness * v above (vertically). At every grid column the point z = 0 is outside both,
+// so the mesher keeps them apart.
+Expr ridgeUnderBentPlate(double v, double plateThickness, double gap) {
+  const double top = 0.3 * v;
+  const Expr u = X() - 0.5 * v;
+  const Expr ridge = min(blockAt(0.013, 0.007, -0.2, 0.4, 0.35, 0.2 + top), top - Z() - abs(u));
+  const Expr underside = Z() - (top + gap * v) + 0.6 * abs(u);
+  const Expr plate = min(blockAt(-0.011, 0.003, 0.0, 0.37, 0.32, 0.4), min(underside, plateThickness * v - underside));
+  return max(ridge, plate);
+}
+
 TEST(MeshSimplify, RidgeUnderABentPlateNeedsTheIntersectionCheck) {
   const GridSpec g = cubeGrid(1.0, 49);  // x = 0 and z = 0 are grid planes
-  const double v = g.voxel;
   uint64_t rejected = 0;
   for (const auto& [plateThickness, gap, tol] : {std::array<double, 3>{1.5, 0.05, 2.5}, {1.5, 0.1, 1.0}}) {
     SCOPED_TRACE(tol);
-    // Creases along y at x = v/2. Ridge top at z = 0.3v, flanks at 45 degrees; the plate's
-    // underside at 0.3v + gap * v on the crease, sloping down at 0.6 to both sides, its top
-    // plateThickness * v above (vertically). At every grid column the point z = 0 is outside
-    // both, so the mesher keeps them apart.
-    const double top = 0.3 * v;
-    const Expr u = X() - 0.5 * v;
-    const Expr ridge = min(blockAt(0.013, 0.007, -0.2, 0.4, 0.35, 0.2 + top), top - Z() - abs(u));
-    const Expr underside = Z() - (top + gap * v) + 0.6 * abs(u);
-    const Expr plate = min(blockAt(-0.011, 0.003, 0.0, 0.37, 0.32, 0.4), min(underside, plateThickness * v - underside));
-    Result r = simplifyAndCheck(max(ridge, plate), g, tol);  // closed, embedded, within the bound
+    // closed, embedded, within the bound
+    Result r = simplifyAndCheck(ridgeUnderBentPlate(g.voxel, plateThickness, gap), g, tol);
     figures(("ridge under a bent plate, tol " + std::to_string(tol)).c_str(), r, r.volume, r.area);
     rejected += r.stats.rejectedIntersection;
   }
   EXPECT_GT(rejected, 0u);  // 21 + 3 when written
+}
+
+// The self-intersection check runs once per block; a block whose result fails it is simplified
+// again with the check at every collapse. That rerun is a function of the block's input too:
+// the ridge (whose blocks rerun) gives the same mesh simplified whole or brick by brick.
+TEST(MeshSimplify, BlocksSimplifiedAgainGiveTheSameMeshWhateverTheSplit) {
+  const GridSpec g = cubeGrid(1.0, 49);
+  const TapePtr tape = Tape::compile(ridgeUnderBentPlate(g.voxel, 1.5, 0.05), 3);
+  SimplifyOptions so;
+  so.tolerance = 2.5;
+  Mesh whole = meshGrid(tape, g);
+  const SimplifyStats ws = simplifyMesh(whole, tape, g, so);
+  ASSERT_GT(ws.rejectedIntersection, 0u);  // a block was simplified again
+  for (int brick : {16, 24, 40}) {
+    SCOPED_TRACE(brick);
+    std::vector<MeshPiece> pieces;
+    const int32_t cells = int32_t(g.dims[0] - 1);
+    for (int32_t x = 0; x < cells; x += brick)
+      for (int32_t y = 0; y < cells; y += brick)
+        for (int32_t z = 0; z < cells; z += brick) {
+          std::array<int32_t, 3> lo{x, y, z}, hi{std::min(cells, x + brick), std::min(cells, y + brick), std::min(cells, z + brick)};
+          pieces.push_back(meshRegion(tape, g, lo, hi));
+          simplifyRegion(pieces.back(), tape, g, so, lo, hi);
+        }
+    Mesh merged = mergePieces(pieces);
+    SimplifyOptions finish = so;
+    finish.bricksSimplified = brick;
+    const SimplifyStats fs = simplifyMesh(merged, tape, g, finish);
+    expectSameMesh(merged, whole);
+    EXPECT_EQ(fs.collapses, ws.collapses);
+    EXPECT_EQ(fs.rejectedIntersection, ws.rejectedIntersection);
+    EXPECT_EQ(fs.errorBound, ws.errorBound);
+  }
 }
