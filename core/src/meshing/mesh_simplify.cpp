@@ -538,6 +538,7 @@ class Simplifier {
     batch_.reserve(*tape_);
     inputs_.resize(nvars);
     for (uint32_t k = 0; k < nvars; ++k) inputs_[k] = batch_.in(k);
+    const uint32_t spatial = std::min(nvars, 3u);  // a 2D model (a prism) has no x[3]
     for (;;) {
       bool any = false;
       failed_.assign(qs.size(), 0);
@@ -552,7 +553,7 @@ class Simplifier {
         // Straight into the evaluator's lanes; a query that already failed this round stops.
         for (size_t k = from; k < to && !failed_[i]; ++k) {
           const V3 p = add(q.a, add(scale(u, cells[k][0] + 1.0 / 3), scale(v, cells[k][1] + 1.0 / 3)));
-          for (int c = 0; c < 3; ++c) inputs_[c][2 * lanes_] = p[c] - de[c], inputs_[c][2 * lanes_ + 1] = p[c] + de[c];
+          for (uint32_t c = 0; c < spatial; ++c) inputs_[c][2 * lanes_] = p[c] - de[c], inputs_[c][2 * lanes_ + 1] = p[c] + de[c];
           laneQuery_[lanes_] = i;
           if (++lanes_ == kPairsPerCall) crossed();
         }
