@@ -484,6 +484,7 @@ class Master {
       w.set_job_id(jobId_);
       w.mutable_welcome()->set_heartbeat_ms(uint32_t(opt_.heartbeatMs));
       w.mutable_welcome()->set_liveness(uint32_t(opt_.liveness));
+      *w.mutable_welcome()->mutable_job() = job_;  // once per connection; tasks name it by jobId_
       send(router, in.routingId, w);
       spdlog::info("worker {} joined ({} threads, {})", p.workerId, p.threads, e.hello().build());
       return;
@@ -878,7 +879,6 @@ class Master {
       t->add_lo(b.lo[a]);
       t->add_hi(b.hi[a]);
     }
-    *t->mutable_job() = job_;
     if (!send(router, rid, e)) {
       // No route to the peer: its connection closed without a bye (it crashed or reconnected)
       // and its liveness window has not run out yet. dispatch() already took a pending brick
