@@ -130,7 +130,7 @@ struct Arrival {
   Result result;
   zmq::message_t payload;
   BrickOutput out;  // "mesh", "render": the decoded result
-  KeptBrick kept;   // "sample": the payload (copied to the arena), origins and tiles
+  KeptBrick kept;   // "sample": where the payload is kept (journal or arena), origins and tiles
   std::string error;
   bool ok = false;
 };
@@ -276,12 +276,11 @@ class Master {
       auto t0 = Clock::now();
       BrickOutput out = computeBrick(tape, job_, b.lo, b.hi, opt_.threads);
       report_.perWorker["in-process"].computeSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
-      std::string payload = journal_ || op_ == Operation::Sample ? encodePayload(op_, out) : std::string();
-      if (journal_) journal_->append(b.id, payload);
       KeptBrick kept;
-      if (op_ == Operation::Sample) {
-        kept = keptOf(out);
-        kept.payload = arena_.add(payload.data(), payload.size());
+      if (op_ == Operation::Sample) kept = keptOf(out);
+      if (journal_ || op_ == Operation::Sample) {
+        const std::string payload = encodePayload(op_, out);
+        journalAndKeep(b.id, payload.data(), payload.size(), crc32Of(payload.data(), payload.size()), kept);
       }
       commit(b.id, std::move(out), "in-process", true, std::move(kept));
       progress_->update(done_, report_.pointEvals, 1);
@@ -644,12 +643,7 @@ class Master {
         a.ok = crc32Of(data, size) == crc && verifyPayload(data, size, bricks_[a.brick], a.out, a.kept, &a.error);
         // Journaled before it is merged (judge); a copy that turns out to be a duplicate is
         // harmless there (a resume merges the first record of a brick).
-        if (a.ok && journal_) {
-          const uint64_t at = journal_->add(a.brick, data, size, crc);
-          if (op_ == Operation::Sample) a.kept.inJournal = true, a.kept.journalAt = at, a.kept.size = size, a.kept.crc = crc;
-        } else if (a.ok && op_ == Operation::Sample) {
-          a.kept.payload = arena_.add(data, size);
-        }
+        if (a.ok) journalAndKeep(a.brick, data, size, crc, a.kept);
         a.payload = zmq::message_t();  // freed now: the next message's buffer reuses its memory
       });
     });
@@ -700,6 +694,18 @@ class Master {
       send(router, rid, c);
     }
     commit(id, std::move(out), a.workerId, true, std::move(a.kept));
+  }
+
+  // A verified payload: appended to the journal if there is one, and for "sample" kept until
+  // the merge: where the journal has it, or (no journal) a copy in the arena. Safe on the decode
+  // threads at once.
+  void journalAndKeep(uint64_t brick, const void* data, size_t size, uint32_t crc, KeptBrick& kept) {
+    if (journal_) {
+      const uint64_t at = journal_->add(brick, data, size, crc);
+      if (op_ == Operation::Sample) kept.inJournal = true, kept.journalAt = at, kept.size = size, kept.crc = crc;
+    } else if (op_ == Operation::Sample) {
+      kept.payload = arena_.add(data, size);
+    }
   }
 
   // Checks a payload (codec, inside the brick): "sample" is only scanned (its origins and tiles
