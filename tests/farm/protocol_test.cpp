@@ -43,6 +43,14 @@ int runWorker(const std::string& endpoint, std::vector<std::string> extra = {}) 
   return WorkerProcess(endpoint, {}, std::move(extra)).wait(20);
 }
 
+// A DEALER connected to the master, speaking for the test.
+zmq::socket_t peerOf(zmq::context_t& ctx, const std::string& endpoint) {
+  zmq::socket_t peer(ctx, zmq::socket_type::dealer);
+  peer.set(zmq::sockopt::linger, 0);
+  peer.connect(endpoint);
+  return peer;
+}
+
 }  // namespace
 
 TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
@@ -102,9 +110,7 @@ TEST(Protocol, WorkerOfAnotherProtocolMajorIsRefusedWithAReason) {
   MasterThread master(j, clusterOptions());
   const std::string ep = master.endpoint();
   zmq::context_t ctx(1);
-  zmq::socket_t peer(ctx, zmq::socket_type::dealer);
-  peer.set(zmq::sockopt::linger, 0);
-  peer.connect(ep);
+  zmq::socket_t peer = peerOf(ctx, ep);
   Envelope hello;
   hello.set_proto_major(kProtoMajor + 1);
   hello.mutable_hello()->set_worker_id("future");
@@ -390,9 +396,7 @@ TEST(Protocol, TheWelcomeCarriesTheJobAndTasksOnlyItsId) {
   MasterThread master(j, clusterOptions());
   const std::string ep = master.endpoint();
   zmq::context_t ctx(1);
-  zmq::socket_t peer(ctx, zmq::socket_type::dealer);
-  peer.set(zmq::sockopt::linger, 0);
-  peer.connect(ep);
+  zmq::socket_t peer = peerOf(ctx, ep);
   Envelope hello;
   hello.mutable_hello()->set_worker_id("inspector");
   send(peer, "", hello);
