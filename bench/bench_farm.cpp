@@ -58,7 +58,10 @@ double seconds(std::chrono::steady_clock::time_point t0) {
 }
 
 // The payload a fake worker returns for the brick at `lo`: `leaves` leaf blocks inside it, each
-// a typical surface leaf (about half its voxels in the band, so the compact FRB2 form).
+// a typical surface leaf (about half its voxels in the band, so the compact FRB2 form). 128 such
+// leaves make 151 kB; a real 64^3 surface brick of examples/blobby.hf at 1024^3 has 122 leaves
+// with 274 active voxels on average, 155 kB (docs/farm.md, "The FRB2 sample payload"). Against
+// another build: bench/bench_farm_ab.sh.
 std::string fakePayload(const std::array<int32_t, 3>& lo, int leaves) {
   BrickOutput b;
   for (int i = 0; i < leaves; ++i) {
