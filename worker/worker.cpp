@@ -235,7 +235,7 @@ int runWorker(const WorkerOptions& opt) {
   int heartbeatMs = 500, liveness = 5;
   auto lastMasterContact = Clock::now();
   int backoffMs = 1000;
-  uint64_t jobId = 0;                     // the job of the last welcome (jobIdOf(*job))
+  uint64_t jobId = 0;                  // the job of the last welcome (jobIdOf(*job))
   std::shared_ptr<const JobSpec> job;  // its spec: tasks carry only its id
 
   for (;;) {  // one iteration per connection
