@@ -1,10 +1,12 @@
 // Farm figures, all measured in this run:
 //  1. speed-up of a compute-heavy job from 1 to 2 local workers (this machine has 2 cores);
-//  2. the master's own throughput against fake workers that replay pre-encoded results (bricks
+//  2. what a task costs the master to build with the job in it (protocol 1.x) and without
+//     (protocol 2: the job goes once per worker, in the welcome);
+//  3. the master's own throughput against fake workers that replay pre-encoded results (bricks
 //     merged per second, the master's CPU per brick), decoding on the scheduling loop alone
 //     against decoding on all cores, and from it how many real workers one master keeps busy at
 //     the brick time measured in 1.
-// `bench_farm --master-only` runs 2 alone.
+// `bench_farm --master-only` runs 2 and 3.
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -58,7 +60,10 @@ double seconds(std::chrono::steady_clock::time_point t0) {
 }
 
 // The payload a fake worker returns for the brick at `lo`: `leaves` leaf blocks inside it, each
-// a typical surface leaf (about half its voxels in the band, so the compact FRB2 form).
+// a typical surface leaf (about half its voxels in the band, so the compact FRB2 form). 128 such
+// leaves make 151 kB; a real 64^3 surface brick of examples/blobby.hf at 1024^3 has 122 leaves
+// with 274 active voxels on average, 155 kB (docs/farm.md, "The FRB2 sample payload"). Against
+// another build: bench/bench_farm_ab.sh.
 std::string fakePayload(const std::array<int32_t, 3>& lo, int leaves) {
   BrickOutput b;
   for (int i = 0; i < leaves; ++i) {
@@ -263,6 +268,50 @@ double workerSpeedUp() {
   return brickSeconds;
 }
 
+// 2. What protocol 2 saves per task: a 1.x task carried the whole job, so the master copied and
+// serialized it (and the kernel and the worker moved and parsed it) once per brick. Measured
+// here: building and serializing a task's envelope with and without a job whose model reads a
+// 4 MiB file (a mesh of about 10^5 triangles), as the master's sendTask does.
+void taskCost() {
+  JobSpec j = job(kHeavyModel, 1024);
+  ModelFile* f = j.add_model_files();
+  f->set_path("part.stl");
+  f->set_contents(std::string(4 << 20, 's'));
+  f->set_hash(modelFileHash(f->contents()));
+  const uint64_t jobId = jobIdOf(j);  // the master hashes its job once
+  auto build = [&](bool withJob, std::string& bytes) {
+    Envelope e;
+    e.set_job_id(jobId);
+    Task* t = e.mutable_task();
+    t->set_brick_id(7);
+    t->set_attempt(1);
+    for (int a = 0; a < 3; ++a) t->add_lo(64), t->add_hi(128);
+    e.SerializeToString(&bytes);
+    if (withJob) {  // what tag 5 (Task.job, reserved since 2.0) added: the job, copied and serialized
+      JobSpec copy = j;
+      bytes += copy.SerializeAsString();
+    }
+  };
+  double secs[2] = {0, 0};
+  size_t size[2] = {0, 0};
+  const int n = 50;
+  for (int withJob = 0; withJob < 2; ++withJob) {
+    std::string bytes;
+    auto t0 = std::chrono::steady_clock::now();
+    for (int i = 0; i < n; ++i) build(withJob == 1, bytes);
+    secs[withJob] = seconds(t0) / n;
+    size[withJob] = bytes.size();
+  }
+  auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 5; ++i)
+    if (jobIdOf(j) != jobId) std::abort();  // what a 1.x worker did with every task's job
+  const double hash = seconds(t0) / 5;
+  std::printf("a task's envelope, job with a 4 MiB model file: protocol 1.x %zu bytes, %.0f us to build "
+              "(and %.0f us for the worker to hash the job, per task); protocol 2 %zu bytes, %.2f us (%.0fx less; "
+              "the job goes once per worker, in the welcome)\n\n",
+              size[1], 1e6 * secs[1], 1e6 * hash, size[0], 1e6 * secs[0], secs[1] / secs[0]);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -271,8 +320,9 @@ int main(int argc, char** argv) {
   const bool masterOnly = argc == 2 && std::string(argv[1]) == "--master-only";
   double brickSeconds = 0;
   if (!masterOnly) brickSeconds = workerSpeedUp();
+  taskCost();
 
-  // 2. The master's own ceiling: a 1024^3 grid in 64^3 bricks = 4096 bricks, each answered at
+  // 3. The master's own ceiling: a 1024^3 grid in 64^3 bricks = 4096 bricks, each answered at
   //    once with 128 leaf blocks (a surface crossing a 64^3 brick, 150 kB), with a journal.
   const int leavesPerBrick = 128;
   std::printf("master against fake workers replaying pre-encoded results (their cost not measured; a child process),\n"

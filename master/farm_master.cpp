@@ -16,7 +16,7 @@
 #include <thread>
 #include <zmq.hpp>
 
-#include <malloc.h>
+#include <string_view>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
@@ -27,6 +27,7 @@
 #include "frep/meshing/mesh_merge.h"
 #include "journal.h"
 #include "local_workers.h"
+#include "payload_arena.h"
 #include "progress.h"
 #include "wire.h"
 
@@ -97,22 +98,20 @@ struct Brick {
   size_t maxLeaves = 0;  // upper bound on leaves in the region (payload sanity check)
 };
 
-// "sample": what the master keeps of a merged brick until the job's end: its verified FRB2
-// payload (compact leaves take about half the bytes of decoded ones), its leaves' origins (where
-// they go in the sorted output) and its tiles. finish() decodes each payload once more, straight
-// into the output (Master::mergeLeaves).
+// "sample": what the master keeps of a merged brick until the job's end: where its verified
+// FRB2 payload is (compact leaves take about half the bytes of decoded ones): in the journal,
+// which holds it anyway (page cache, not the master's memory), or without a journal in the
+// payload arena; its leaves' origins (where they go in the sorted output) and its tiles.
+// Verifying a payload only scans it (scanBrick); finish() decodes it once, straight into the
+// output (Master::mergeLeaves).
 struct KeptBrick {
-  zmq::message_t payload;
+  PayloadArena::Piece payload;  // without a journal
+  bool inJournal = false;       // with one: the payload's offset, size and CRC-32 there
+  uint64_t journalAt = 0, size = 0;
+  uint32_t crc = 0;
   std::vector<std::array<int32_t, 3>> origins;  // of its leaves, in payload order
   std::vector<Tile> tiles;
 };
-
-// A payload held in a message without a copy.
-zmq::message_t messageOf(std::string&& bytes) {
-  auto* held = new std::string(std::move(bytes));
-  return zmq::message_t(held->data(), held->size(), [](void*, void* hint) { delete static_cast<std::string*>(hint); },
-                        held);
-}
 
 // What is kept of a decoded brick: its leaves' origins and its tiles (the caller adds the payload).
 KeptBrick keptOf(const BrickOutput& decoded) {
@@ -131,7 +130,7 @@ struct Arrival {
   Result result;
   zmq::message_t payload;
   BrickOutput out;  // "mesh", "render": the decoded result
-  KeptBrick kept;   // "sample": origins and tiles (the leaves are decoded into scratch, not kept)
+  KeptBrick kept;   // "sample": where the payload is kept (journal or arena), origins and tiles
   std::string error;
   bool ok = false;
 };
@@ -175,13 +174,10 @@ class Master {
       journal_ = std::make_unique<Journal>(opt_.journalPath, jobId_, opt_.resume, [&](uint64_t id, const std::string& payload) {
         if (id >= bricks_.size() || bricks_[id].phase == BrickPhase::Done) return;
         BrickOutput out;
-        std::string err;
-        if (!decodePayload(op_, payload.data(), payload.size(), out, &err) || !insideBrick(out, bricks_[id])) return;
         KeptBrick kept;
-        if (op_ == Operation::Sample) {
-          kept = keptOf(out);
-          kept.payload = messageOf(std::string(payload));
-        }
+        std::string err;
+        if (!verifyPayload(payload.data(), payload.size(), bricks_[id], out, kept, &err)) return;
+        if (op_ == Operation::Sample) kept.payload = arena_.add(payload.data(), payload.size());
         commit(id, std::move(out), "journal", false, std::move(kept));
         ++report_.bricksFromJournal;
       });
@@ -280,12 +276,11 @@ class Master {
       auto t0 = Clock::now();
       BrickOutput out = computeBrick(tape, job_, b.lo, b.hi, opt_.threads);
       report_.perWorker["in-process"].computeSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
-      std::string payload = journal_ || op_ == Operation::Sample ? encodePayload(op_, out) : std::string();
-      if (journal_) journal_->append(b.id, payload);
       KeptBrick kept;
-      if (op_ == Operation::Sample) {
-        kept = keptOf(out);
-        kept.payload = messageOf(std::move(payload));
+      if (op_ == Operation::Sample) kept = keptOf(out);
+      if (journal_ || op_ == Operation::Sample) {
+        const std::string payload = encodePayload(op_, out);
+        journalAndKeep(b.id, payload.data(), payload.size(), crc32Of(payload.data(), payload.size()), kept);
       }
       commit(b.id, std::move(out), "in-process", true, std::move(kept));
       progress_->update(done_, report_.pointEvals, 1);
@@ -488,6 +483,7 @@ class Master {
       w.set_job_id(jobId_);
       w.mutable_welcome()->set_heartbeat_ms(uint32_t(opt_.heartbeatMs));
       w.mutable_welcome()->set_liveness(uint32_t(opt_.liveness));
+      *w.mutable_welcome()->mutable_job() = job_;  // once per connection; tasks name it by jobId_
       send(router, in.routingId, w);
       spdlog::info("worker {} joined ({} threads, {})", p.workerId, p.threads, e.hello().build());
       return;
@@ -642,14 +638,13 @@ class Master {
       tbb::parallel_for(size_t(0), arrivals_.size(), [&](size_t i) {
         Arrival& a = arrivals_[i];
         const void* data = a.payload.data();
-        // "sample": decoded into this thread's scratch (warm memory), only origins and tiles kept.
-        BrickOutput& out = op_ == Operation::Sample ? scratch_.local() : a.out;
-        a.ok = crc32Of(data, a.payload.size()) == a.result.payload_crc32() &&
-               decodePayload(op_, data, a.payload.size(), out, &a.error) && insideBrick(out, bricks_[a.brick]);
-        if (a.ok && op_ == Operation::Sample) a.kept = keptOf(out);
+        const size_t size = a.payload.size();
+        const uint32_t crc = a.result.payload_crc32();
+        a.ok = crc32Of(data, size) == crc && verifyPayload(data, size, bricks_[a.brick], a.out, a.kept, &a.error);
         // Journaled before it is merged (judge); a copy that turns out to be a duplicate is
         // harmless there (a resume merges the first record of a brick).
-        if (a.ok && journal_) journal_->add(a.brick, data, a.payload.size(), a.result.payload_crc32());
+        if (a.ok) journalAndKeep(a.brick, data, size, crc, a.kept);
+        a.payload = zmq::message_t();  // freed now: the next message's buffer reuses its memory
       });
     });
     for (Arrival& a : arrivals_) judge(router, a);
@@ -698,8 +693,38 @@ class Master {
       c.mutable_cancel()->set_brick_id(id);
       send(router, rid, c);
     }
-    a.kept.payload = std::move(a.payload);
     commit(id, std::move(out), a.workerId, true, std::move(a.kept));
+  }
+
+  // A verified payload: appended to the journal if there is one, and for "sample" kept until
+  // the merge: where the journal has it, or (no journal) a copy in the arena. Safe on the decode
+  // threads at once.
+  void journalAndKeep(uint64_t brick, const void* data, size_t size, uint32_t crc, KeptBrick& kept) {
+    if (journal_) {
+      const uint64_t at = journal_->add(brick, data, size, crc);
+      if (op_ == Operation::Sample) kept.inJournal = true, kept.journalAt = at, kept.size = size, kept.crc = crc;
+    } else if (op_ == Operation::Sample) {
+      kept.payload = arena_.add(data, size);
+    }
+  }
+
+  // Checks a payload (codec, inside the brick): "sample" is only scanned (its origins and tiles
+  // to kept, its values left packed), the others are decoded into out.
+  bool verifyPayload(const void* data, size_t size, const Brick& b, BrickOutput& out, KeptBrick& kept,
+                     std::string* error) const {
+    if (op_ == Operation::Sample) return scanBrick(data, size, kept.origins, kept.tiles, error) && insideBrick(kept, b);
+    return decodePayload(op_, data, size, out, error) && insideBrick(out, b);
+  }
+
+  // "sample": every leaf and tile inside the brick, and no more leaves than it has.
+  static bool insideBrick(const KeptBrick& k, const Brick& b) {
+    for (auto& o : k.origins)
+      for (int a = 0; a < 3; ++a)
+        if (o[a] < b.lo[a] || o[a] >= b.hi[a]) return false;
+    for (auto& t : k.tiles)
+      for (int a = 0; a < 3; ++a)
+        if (t.origin[a] < b.lo[a] || t.origin[a] >= b.hi[a]) return false;
+    return k.origins.size() <= b.maxLeaves;
   }
 
   bool insideBrick(const BrickOutput& out, const Brick& b) const {
@@ -717,13 +742,7 @@ class Master {
       }
       return true;
     }
-    for (auto& l : out.leaves)
-      for (int a = 0; a < 3; ++a)
-        if (l.origin[a] < b.lo[a] || l.origin[a] >= b.hi[a]) return false;
-    for (auto& t : out.tiles)
-      for (int a = 0; a < 3; ++a)
-        if (t.origin[a] < b.lo[a] || t.origin[a] >= b.hi[a]) return false;
-    return out.leaves.size() <= b.maxLeaves;
+    return false;  // "sample" payloads are checked by scanning (verifyPayload)
   }
 
   void onFailed(const Envelope& e, const std::string& rid, Peer& p) {
@@ -866,7 +885,6 @@ class Master {
       t->add_lo(b.lo[a]);
       t->add_hi(b.hi[a]);
     }
-    *t->mutable_job() = job_;
     if (!send(router, rid, e)) {
       // No route to the peer: its connection closed without a bye (it crashed or reconnected)
       // and its liveness window has not run out yet. dispatch() already took a pending brick
@@ -960,12 +978,25 @@ class Master {
     }
   }
 
+  // A kept payload's bytes: in the arena, or read back from the journal into this thread's
+  // buffer and checked against the CRC-32 it was verified with (the file is the master's own,
+  // but what it merges must be exactly what it verified).
+  std::string_view keptPayload(const KeptBrick& k, size_t brick) {
+    if (!k.inJournal) return {k.payload.data(), k.payload.size()};
+    std::string& buffer = readBuffers_.local();
+    buffer.resize(k.size);
+    journal_->read(k.journalAt, buffer.data(), k.size);
+    if (crc32Of(buffer.data(), buffer.size()) != k.crc)
+      throw JournalIoError("journal " + journal_->path() + ": the record of brick " + std::to_string(brick) +
+                           " changed after it was written (its CRC-32 no longer matches)");
+    return buffer;
+  }
+
   // The bricks' leaves sorted by origin (as sample() sorts them) and their tiles, one slab of
   // bricks at a time: the bricks are planned x-slab by x-slab and the sort is by x first, so a
   // slab's leaves follow all the leaves of the slabs before it. Each brick's payload is decoded
-  // (on the decode threads, into warm scratch) and its leaves copied straight to their sorted
-  // places; the slab's payloads are then freed, so the master holds the payloads or the output,
-  // not both.
+  // (on the decode threads) straight into its leaves' sorted places; the slab's payloads are
+  // then released, so the master holds the payloads or the output, not both.
   void mergeLeaves(SampleResult& result) {
     size_t leaves = 0;
     for (const KeptBrick& k : kept_) {
@@ -983,7 +1014,7 @@ class Master {
     };
     std::vector<Ref> refs;
     std::vector<size_t> start, where;  // where[start[brick] + leaf]: the leaf's index in the output
-    size_t at = 0, untrimmed = 0;
+    size_t at = 0;
     for (size_t first = 0; first < kept_.size(); first += perSlab) {
       const size_t last = std::min(kept_.size(), first + perSlab);
       refs.clear();
@@ -1001,22 +1032,16 @@ class Master {
         tbb::parallel_for(first, last, [&](size_t i) {
           const KeptBrick& k = kept_[i];
           if (k.origins.empty()) return;
-          BrickOutput& out = scratch_.local();
+          const size_t* to = where.data() + start[i - first];
+          const std::string_view bytes = keptPayload(k, i);
           std::string err;
-          if (!decodePayload(op_, k.payload.data(), k.payload.size(), out, &err) || out.leaves.size() != k.origins.size())
+          if (!decodeBrickLeaves(bytes.data(), bytes.size(), k.origins.size(),
+                                 [&](size_t l) { return &result.leaves[to[l]]; }, &err))
             throw std::logic_error("brick " + std::to_string(i) + ": its verified payload no longer decodes: " + err);
-          for (size_t l = 0; l < out.leaves.size(); ++l) result.leaves[where[start[i - first] + l]] = out.leaves[l];
         });
       });
       at += refs.size();
-      for (size_t i = first; i < last; ++i) {
-        untrimmed += kept_[i].payload.size();
-        kept_[i] = KeptBrick{};
-      }
-      if (untrimmed > (size_t(64) << 20)) {
-        malloc_trim(0);  // give the freed pages back now (glibc keeps freed heap pages otherwise)
-        untrimmed = 0;
-      }
+      for (size_t i = first; i < last; ++i) kept_[i] = KeptBrick{};  // the arena unmaps emptied chunks
     }
     kept_.clear();
   }
@@ -1080,8 +1105,9 @@ class Master {
   std::deque<std::string> bannedOrder_;
   std::map<std::string, std::string> aliases_;  // old routing id -> new, of reconnected workers
   std::vector<BrickOutput> outputs_;  // "mesh", "render": the merged bricks' results, by brick
+  PayloadArena arena_;                // "sample": the kept payloads (before kept_ and arrivals_, which hold pieces of it)
   std::vector<KeptBrick> kept_;       // "sample": the merged bricks' payloads, by brick
-  tbb::enumerable_thread_specific<BrickOutput> scratch_;  // "sample": decoding, per thread
+  tbb::enumerable_thread_specific<std::string> readBuffers_;  // "sample": payloads read back from the journal
   std::vector<Arrival> arrivals_;  // results received, not yet verified (verifyArrivals)
   size_t arrivalBytes_ = 0;
   tbb::task_arena decoders_;       // the decode threads (FarmOptions::decodeThreads)

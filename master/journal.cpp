@@ -92,11 +92,11 @@ Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
     }
   }
   if (goodEnd > 0) {
-    file_ = openJournal(path, O_WRONLY, "wb");  // records go at end_ (pwrite), not O_APPEND
+    file_ = openJournal(path, O_RDWR, "r+b");  // records go at end_ (pwrite), not O_APPEND; read back (pread)
     if (!file_ || ::ftruncate(fileno(file_), goodEnd) != 0)
       throw JournalIoError("cannot truncate journal " + path + ": " + std::strerror(errno));
   } else {
-    file_ = openJournal(path, O_WRONLY | O_CREAT | O_TRUNC, "wb");
+    file_ = openJournal(path, O_RDWR | O_CREAT | O_TRUNC, "r+b");
     std::fwrite(kMagic, 1, 4, file_);
     std::fwrite(&jobId, sizeof jobId, 1, file_);
   }
@@ -110,7 +110,7 @@ Journal::~Journal() {
   if (file_) std::fclose(file_);
 }
 
-void Journal::add(uint64_t brick, const void* payload, size_t size, uint32_t crc) {
+uint64_t Journal::add(uint64_t brick, const void* payload, size_t size, uint32_t crc) {
   char head[kRecordHeader];
   const uint64_t size64 = size;
   std::memcpy(head, &brick, 8);
@@ -128,10 +128,21 @@ void Journal::add(uint64_t brick, const void* payload, size_t size, uint32_t crc
   };
   writeAt(head, sizeof head, at);
   writeAt(static_cast<const char*>(payload), size, at + kRecordHeader);
+  return at + kRecordHeader;
 }
 
-void Journal::append(uint64_t brick, const std::string& payload) {
-  add(brick, payload.data(), payload.size(), crc32Of(payload.data(), payload.size()));
+uint64_t Journal::append(uint64_t brick, const std::string& payload) {
+  return add(brick, payload.data(), payload.size(), crc32Of(payload.data(), payload.size()));
+}
+
+void Journal::read(uint64_t offset, void* into, size_t size) const {
+  char* p = static_cast<char*>(into);
+  while (size > 0) {
+    const ssize_t r = file_ ? ::pread(fileno(file_), p, size, off_t(offset)) : -1;
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) throw JournalIoError("cannot read back journal " + path_ + ": " + (r < 0 ? std::strerror(errno) : "it is shorter than what was written to it"));
+    p += r, size -= size_t(r), offset += uint64_t(r);
+  }
 }
 
 void Journal::flush() {

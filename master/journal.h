@@ -36,8 +36,13 @@ class Journal {
   // Appends a record (its payload's CRC-32 already known) straight to the kernel (pwrite), so
   // a killed master loses none of it. Safe to call from several threads at once: each record
   // takes its own stretch of the file (their order in it does not matter).
-  void add(uint64_t brick, const void* payload, size_t size, uint32_t crc);
-  void append(uint64_t brick, const std::string& payload);  // add, computing the CRC
+  // Returns where the payload starts in the file (for read).
+  uint64_t add(uint64_t brick, const void* payload, size_t size, uint32_t crc);
+  uint64_t append(uint64_t brick, const std::string& payload);  // add, computing the CRC
+  // Reads back `size` bytes at `offset` (a payload add placed there): the master keeps a merged
+  // brick's payload here, in the page cache, rather than a second copy in its own memory.
+  // Throws JournalIoError if the file is shorter or unreadable. Safe from several threads.
+  void read(uint64_t offset, void* into, size_t size) const;
   void flush();  // to the disk (fdatasync)
   void remove(); // after the output was written: the journal is no longer needed
   const std::string& path() const { return path_; }

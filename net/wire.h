@@ -11,8 +11,10 @@
 
 namespace frep::farm {
 
-constexpr uint32_t kProtoMajor = 1;
-constexpr uint32_t kProtoMinor = 3;  // 1: "render" jobs (RenderSpec); 2: ModelFile.hash (checked); 3: Hello.holding
+// Major 2: the job once per connection (Welcome.job), tasks carry its id only. Minors of major 1
+// (all kept): 1 "render" jobs (RenderSpec), 2 ModelFile.hash (checked), 3 Hello.holding.
+constexpr uint32_t kProtoMajor = 2;
+constexpr uint32_t kProtoMinor = 0;
 
 struct Incoming {
   std::string routingId;  // empty on the DEALER side

@@ -347,7 +347,12 @@ std::string encodeBrick(const BrickOutput& out) {
   return s;
 }
 
-bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* error) {
+namespace {
+// The one FRB2 parser behind decodeBrick, scanBrick and decodeBrickLeaves, so all three accept
+// exactly the same payloads. The sink sizes the output (begin), takes each tile, and says where
+// leaf i's values go (leaf: nullptr to check its bytes only, without expanding them).
+template <typename Sink>
+bool walkBrick(const void* data, size_t size, Sink& sink, std::string* error) {
   auto fail = [&](const char* why) {
     if (error) *error = why;
     return false;
@@ -360,32 +365,44 @@ bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* e
   r.get(nt);
   // Every leaf takes at least 92 bytes: reject absurd counts before allocating.
   if (uint64_t(nt) * 20 + uint64_t(nl) * 92 > size - 12) return fail("payload: counts exceed its size");
-  out.tiles.resize(nt);
-  for (Tile& t : out.tiles) {
+  if (!sink.begin(nl, nt)) return fail("payload: not the expected number of leaves");
+  for (uint32_t i = 0; i < nt; ++i) {
+    Tile t{};
     int32_t inside = 0;
     if (!r.get(t.origin[0]) || !r.get(t.origin[1]) || !r.get(t.origin[2]) || !r.get(t.size) || !r.get(inside))
       return fail("payload: truncated tile");
     if (t.size < kLeafDim || (t.size & (t.size - 1)) != 0) return fail("payload: bad tile size");
     t.inside = inside != 0;
+    sink.tile(i, t);
   }
-  out.leaves.resize(nl);
-  for (LeafBlock& l : out.leaves) {
+  for (uint32_t i = 0; i < nl; ++i) {
+    std::array<int32_t, 3> origin{};
     uint32_t flags = 0;
-    if (!r.get(l.origin[0]) || !r.get(l.origin[1]) || !r.get(l.origin[2]) || !r.get(flags) ||
-        !r.bytes(l.active.data(), sizeof l.active))
+    std::array<uint64_t, kLeafVoxels / 64> active{};
+    if (!r.get(origin[0]) || !r.get(origin[1]) || !r.get(origin[2]) || !r.get(flags) ||
+        !r.bytes(active.data(), sizeof active))
       return fail("payload: truncated leaf");
-    if ((l.origin[0] | l.origin[1] | l.origin[2]) & 7) return fail("payload: leaf origin not a multiple of 8");
+    if ((origin[0] | origin[1] | origin[2]) & 7) return fail("payload: leaf origin not a multiple of 8");
     if (flags & ~kCompact) return fail("payload: unknown leaf flags");
+    LeafBlock* l = sink.leaf(i, origin);
+    if (l) l->origin = origin, l->active = active;
     if (!(flags & kCompact)) {
-      if (!r.bytes(l.values.data(), sizeof l.values)) return fail("payload: truncated leaf values");
+      constexpr size_t kValueBytes = kLeafVoxels * sizeof(float);
+      if (size_t(r.end - r.p) < kValueBytes) return fail("payload: truncated leaf values");
+      if (l) std::memcpy(l->values.data(), r.p, kValueBytes);
+      r.p += kValueBytes;
       continue;
     }
     std::array<uint64_t, kLeafVoxels / 64> positive{};
     float magnitude = 0;
     if (!r.bytes(positive.data(), sizeof positive) || !r.get(magnitude)) return fail("payload: truncated leaf");
     size_t activeCount = 0;
-    for (uint64_t word : l.active) activeCount += size_t(__builtin_popcountll(word));
+    for (uint64_t word : active) activeCount += size_t(__builtin_popcountll(word));
     if (size_t(r.end - r.p) < activeCount * sizeof(float)) return fail("payload: truncated leaf values");
+    if (!l) {
+      r.p += activeCount * sizeof(float);
+      continue;
+    }
     // A byte (8 voxels) at a time: every voxel +-m from its sign bit (xor of a sign mask, which
     // the compiler vectorises), then the active ones, in voxel order, from the stream (a whole
     // active row of 8 in one copy).
@@ -394,10 +411,10 @@ bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* e
     const char* src = r.p;
     for (int k = 0; k < kLeafVoxels / 8; ++k) {
       const uint8_t signs = uint8_t(positive[size_t(k >> 3)] >> (8 * (k & 7)));
-      const uint8_t act = uint8_t(l.active[size_t(k >> 3)] >> (8 * (k & 7)));
-      float* v = l.values.data() + 8 * k;
+      const uint8_t act = uint8_t(active[size_t(k >> 3)] >> (8 * (k & 7)));
+      float* v = l->values.data() + 8 * k;
       uint32_t bits[8];
-      for (int i = 0; i < 8; ++i) bits[i] = m ^ kNegativeSigns[signs][i];
+      for (int b = 0; b < 8; ++b) bits[b] = m ^ kNegativeSigns[signs][b];
       std::memcpy(v, bits, sizeof bits);
       if (act == 0xFF) {
         std::memcpy(v, src, 8 * sizeof(float));
@@ -413,6 +430,52 @@ bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* e
   }
   if (r.p != r.end) return fail("payload: trailing bytes");
   return true;
+}
+}  // namespace
+
+bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* error) {
+  struct Sink {
+    BrickOutput& out;
+    bool begin(uint32_t nl, uint32_t nt) {
+      out.tiles.resize(nt);
+      out.leaves.resize(nl);
+      return true;
+    }
+    void tile(uint32_t i, const Tile& t) { out.tiles[i] = t; }
+    LeafBlock* leaf(uint32_t i, const std::array<int32_t, 3>&) { return &out.leaves[i]; }
+  } sink{out};
+  return walkBrick(data, size, sink, error);
+}
+
+bool scanBrick(const void* data, size_t size, std::vector<std::array<int32_t, 3>>& origins, std::vector<Tile>& tiles,
+               std::string* error) {
+  struct Sink {
+    std::vector<std::array<int32_t, 3>>& origins;
+    std::vector<Tile>& tiles;
+    bool begin(uint32_t nl, uint32_t nt) {
+      origins.resize(nl);
+      tiles.resize(nt);
+      return true;
+    }
+    void tile(uint32_t i, const Tile& t) { tiles[i] = t; }
+    LeafBlock* leaf(uint32_t i, const std::array<int32_t, 3>& o) {
+      origins[i] = o;
+      return nullptr;
+    }
+  } sink{origins, tiles};
+  return walkBrick(data, size, sink, error);
+}
+
+bool decodeBrickLeaves(const void* data, size_t size, size_t leaves, const std::function<LeafBlock*(size_t)>& slot,
+                       std::string* error) {
+  struct Sink {
+    size_t leaves;
+    const std::function<LeafBlock*(size_t)>& slot;
+    bool begin(uint32_t nl, uint32_t) { return nl == leaves; }
+    void tile(uint32_t, const Tile&) {}
+    LeafBlock* leaf(uint32_t i, const std::array<int32_t, 3>&) { return slot(i); }
+  } sink{leaves, slot};
+  return walkBrick(data, size, sink, error);
 }
 
 // ---- mesh pieces ----------------------------------------------------------------------------

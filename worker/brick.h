@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -93,6 +94,15 @@ BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::arr
 std::string encodeBrick(const BrickOutput& out);
 // Returns false (with a reason) on a malformed payload; never reads out of bounds.
 bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* error);
+// The same checks as decodeBrick (the same parser), keeping only the leaves' origins (in payload
+// order) and the tiles: the master verifies a result without expanding its values.
+bool scanBrick(const void* data, size_t size, std::vector<std::array<int32_t, 3>>& origins, std::vector<Tile>& tiles,
+               std::string* error);
+// Decodes a payload's leaves straight to where they go: leaf i to *slot(i) (its origin, mask and
+// values; tiles are skipped). Fails as decodeBrick does, and when the payload has not `leaves`
+// leaves (then before any slot is asked for).
+bool decodeBrickLeaves(const void* data, size_t size, size_t leaves, const std::function<LeafBlock*(size_t)>& slot,
+                       std::string* error);
 
 // Mesh piece codec (little-endian, version in the magic): "FRM3", regionLo (3 x i32), the
 // piece's MeshStats (6 x u64: cells visited, crossed, root evals, gradient evals, sample point

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
+#include <memory>
 #include <random>
 #include <thread>
 #include <zmq.hpp>
@@ -42,6 +43,13 @@ struct Outgoing {
   bool hasPayload = false;
 };
 
+// A task with the job it belongs to (the welcome's: tasks carry only its id, protocol 2).
+struct Lease {
+  Task task;
+  std::shared_ptr<const JobSpec> job;
+  uint64_t jobId = 0;
+};
+
 // The compute side: a queue of tasks in, a queue of finished messages out.
 class ComputeThread {
  public:
@@ -59,17 +67,17 @@ class ComputeThread {
     // A brick in progress cannot be interrupted; the process exits without waiting for it.
     thread_.detach();
   }
-  void push(const Task& t) {
+  void push(Lease lease) {
     {
       std::lock_guard<std::mutex> l(mutex_);
-      queue_.push_back(t);
+      queue_.push_back(std::move(lease));
     }
     cv_.notify_all();
   }
   void cancel(uint64_t brick) {
     std::lock_guard<std::mutex> l(mutex_);
     for (auto it = queue_.begin(); it != queue_.end(); ++it)
-      if (it->brick_id() == brick) {
+      if (it->task.brick_id() == brick) {
         queue_.erase(it);
         return;
       }
@@ -77,16 +85,17 @@ class ComputeThread {
   // Tasks not yet finished (queued and running), for hand-back on SIGTERM.
   std::vector<Task> unfinished() {
     std::lock_guard<std::mutex> l(mutex_);
-    std::vector<Task> v(queue_.begin(), queue_.end());
-    if (running_) v.push_back(*running_);
+    std::vector<Task> v;
+    for (const Lease& q : queue_) v.push_back(q.task);
+    if (running_) v.push_back(running_->task);
     return v;
   }
   // Every brick still here: queued, running, or computed and not yet sent (a reconnect's hello).
   std::vector<uint64_t> holding() {
     std::lock_guard<std::mutex> l(mutex_);
     std::vector<uint64_t> v;
-    for (const Task& t : queue_) v.push_back(t.brick_id());
-    if (running_) v.push_back(running_->brick_id());
+    for (const Lease& q : queue_) v.push_back(q.task.brick_id());
+    if (running_) v.push_back(running_->task.brick_id());
     for (const Outgoing& o : done_) {
       if (o.env.has_result()) v.push_back(o.env.result().brick_id());
       else if (o.env.has_failed()) v.push_back(o.env.failed().brick_id());
@@ -108,16 +117,16 @@ class ComputeThread {
  private:
   void loop() {
     for (;;) {
-      Task task;
+      Lease lease;
       {
         std::unique_lock<std::mutex> l(mutex_);
         cv_.wait(l, [&] { return stop_ || !queue_.empty(); });
         if (stop_) return;
-        task = queue_.front();
+        lease = std::move(queue_.front());
         queue_.pop_front();
-        running_ = std::make_unique<Task>(task);
+        running_ = std::make_unique<Lease>(lease);
       }
-      Outgoing out = compute(task);
+      Outgoing out = compute(lease);
       {
         std::lock_guard<std::mutex> l(mutex_);
         running_.reset();
@@ -128,10 +137,11 @@ class ComputeThread {
     }
   }
 
-  Outgoing compute(const Task& task) {
+  Outgoing compute(const Lease& lease) {
+    const Task& task = lease.task;
+    const JobSpec& job = *lease.job;
     Outgoing out;
-    uint64_t jobId = jobIdOf(task.job());
-    out.env.set_job_id(jobId);
+    out.env.set_job_id(lease.jobId);
     // Test hook (documented in docs/farm.md): crash on a chosen brick to exercise poisoning.
     if (const char* crash = std::getenv("FREP_TEST_CRASH_BRICK"))
       if (std::strtoull(crash, nullptr, 10) == task.brick_id()) std::abort();
@@ -159,12 +169,12 @@ class ComputeThread {
     if (const char* slow = std::getenv("FREP_TEST_SLOW_MS"))
       std::this_thread::sleep_for(std::chrono::milliseconds(std::atoi(slow)));
     try {
-      TapePtr tape = cache_.get(task.job(), jobId);
+      TapePtr tape = cache_.get(job, lease.jobId);
       if (task.lo_size() != 3 || task.hi_size() != 3) throw std::invalid_argument("task: lo/hi need 3 values");
       std::array<int32_t, 3> lo{task.lo(0), task.lo(1), task.lo(2)}, hi{task.hi(0), task.hi(1), task.hi(2)};
       auto t0 = Clock::now();
-      const Operation op = operationOf(task.job());
-      BrickOutput b = computeBrick(tape, task.job(), lo, hi, threads_);
+      const Operation op = operationOf(job);
+      BrickOutput b = computeBrick(tape, job, lo, hi, threads_);
       double secs = std::chrono::duration<double>(Clock::now() - t0).count();
       out.payload = encodePayload(op, b);
       out.hasPayload = true;
@@ -199,8 +209,8 @@ class ComputeThread {
   ModelCache cache_;
   std::mutex mutex_;
   std::condition_variable cv_;
-  std::deque<Task> queue_;
-  std::unique_ptr<Task> running_;
+  std::deque<Lease> queue_;
+  std::unique_ptr<Lease> running_;
   std::deque<Outgoing> done_;
   bool stop_ = false;
   std::thread thread_;
@@ -225,7 +235,8 @@ int runWorker(const WorkerOptions& opt) {
   int heartbeatMs = 500, liveness = 5;
   auto lastMasterContact = Clock::now();
   int backoffMs = 1000;
-  uint64_t jobId = 0;
+  uint64_t jobId = 0;                  // the job of the last welcome (jobIdOf(*job))
+  std::shared_ptr<const JobSpec> job;  // its spec: tasks carry only its id
 
   for (;;) {  // one iteration per connection
     zmq::socket_t sock(ctx, zmq::socket_type::dealer);
@@ -299,6 +310,15 @@ int runWorker(const WorkerOptions& opt) {
           const Envelope& e = in.envelope;
           switch (e.body_case()) {
             case Envelope::kWelcome:
+              // The job must be the one the envelope names: a master of another release, or
+              // a damaged frame, would have us compute something else under its id.
+              if (!e.welcome().has_job() || jobIdOf(e.welcome().job()) != e.job_id()) {
+                spdlog::error("worker {}: the master's welcome carries {} job {:016x}; refusing it", workerId,
+                              e.welcome().has_job() ? "a job that does not hash to its" : "no job for its", e.job_id());
+                std::_Exit(kWorkerRejected);
+              }
+              if (!job || jobId != e.job_id()) job = std::make_shared<const JobSpec>(e.welcome().job());
+              jobId = e.job_id();
               welcomed = true;
               if (e.welcome().heartbeat_ms() > 0) heartbeatMs = int(e.welcome().heartbeat_ms());
               if (e.welcome().liveness() > 0) liveness = int(e.welcome().liveness());
@@ -308,8 +328,21 @@ int runWorker(const WorkerOptions& opt) {
               spdlog::error("worker {}: refused by the master: {}", workerId, e.reject().reason());
               std::_Exit(kWorkerRejected);
             case Envelope::kTask:
-              jobId = e.job_id();
-              compute.push(e.task());
+              if (!job || e.job_id() != jobId) {
+                // Not the job of this connection's welcome: not the brick's fault. Hand it back
+                // and say hello again, whose welcome brings the job.
+                Envelope f;
+                f.set_job_id(e.job_id());
+                Failed* fl = f.mutable_failed();
+                fl->set_brick_id(e.task().brick_id());
+                fl->set_attempt(e.task().attempt());
+                fl->set_error("the worker was not welcomed to this job");
+                fl->set_handed_back(true);
+                send(sock, "", f);
+                sayHello();
+                break;
+              }
+              compute.push(Lease{e.task(), job, jobId});
               break;
             case Envelope::kCancel:
               compute.cancel(e.cancel().brick_id());

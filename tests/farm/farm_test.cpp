@@ -148,6 +148,42 @@ TEST(Farm, ResumeRecomputesOnlyUnjournaledBricks) {
   std::filesystem::remove(journal);
 }
 
+// The master keeps merged "sample" payloads in its journal and reads them back for the merge
+// (docs/farm.md, "Back-pressure"): a record changed in between is refused by the CRC-32 it was
+// verified with (an I/O error naming the journal and the brick), never merged.
+TEST(Farm, AJournalRecordChangedBeforeTheMergeIsRefused) {
+  const std::string journal =
+      std::filesystem::temp_directory_path() / ("frep-test-changed-" + std::to_string(getpid()) + ".journal");
+  FarmOptions o = fast(0);
+  o.journalPath = journal;
+  MasterThread m(job(96), o);  // 27 bricks, one slow worker: the job lasts seconds after its first record
+  WorkerProcess w(m.endpoint(), {"FREP_TEST_SLOW_MS=200"});
+  const std::uintmax_t firstPayload = 12 + 20;  // journal header, then the first record's
+  auto firstRecordWritten = [&] {  // its header and its whole payload
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(journal, ec);
+    if (ec || size < firstPayload) return false;
+    uint64_t payloadSize = 0;
+    std::ifstream in(journal, std::ios::binary);
+    in.seekg(12 + 12);
+    in.read(reinterpret_cast<char*>(&payloadSize), sizeof payloadSize);
+    return in && payloadSize >= 4 && size >= firstPayload + payloadSize;
+  };
+  while (!m.finished && !firstRecordWritten()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  kill(w.pid, SIGSTOP);  // no more bricks meanwhile, however slow this thread was
+  const bool late = m.finished;
+  {
+    std::fstream f(journal, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(std::streamoff(firstPayload));
+    f.put('X');  // the payload's magic, "FRB2", which every payload has
+  }
+  kill(w.pid, SIGCONT);
+  m.join();
+  if (late) GTEST_SKIP() << "the job ended before its journal could be changed (this thread stalled for seconds)";
+  EXPECT_NE(m.error.find("changed after it was written"), std::string::npos) << m.error;
+  std::filesystem::remove(journal);
+}
+
 TEST(Farm, JournalOfAnotherJobIsRefused) {
   std::string journal = std::filesystem::temp_directory_path() / ("frep-test-other-" + std::to_string(getpid()) + ".journal");
   FarmOptions o = fast(0);

@@ -157,3 +157,24 @@ TEST(Journal, RecordsAddedConcurrentlyAndAfterAResumeAllReplay) {
   EXPECT_TRUE(seen.count(torn) && seen.count(1000));
   std::remove(path.c_str());
 }
+
+// The master keeps a merged brick's payload in the journal (docs/farm.md, "Back-pressure"):
+// add says where it is, read gives back exactly those bytes, and a read past what was written
+// is an I/O error, never a short buffer.
+TEST(Journal, ReadGivesBackEachPayloadWhereAddPutIt) {
+  const std::string path = ::testing::TempDir() + "read_back.journal";
+  std::remove(path.c_str());
+  Journal j(path, 42, false, nullptr);
+  std::vector<std::string> payloads{"first", std::string(70000, 'x'), "", "last one"};
+  payloads[1][12345] = 'y';
+  std::vector<uint64_t> at;
+  for (size_t i = 0; i < payloads.size(); ++i) at.push_back(j.append(i, payloads[i]));
+  for (size_t i = 0; i < payloads.size(); ++i) {
+    std::string back(payloads[i].size(), '\0');
+    j.read(at[i], back.data(), back.size());
+    EXPECT_EQ(back, payloads[i]) << i;
+  }
+  std::string past(16, '\0');
+  EXPECT_THROW(j.read(at.back() + 4, past.data(), past.size()), frep::farm::JournalIoError);
+  std::remove(path.c_str());
+}

@@ -43,6 +43,14 @@ int runWorker(const std::string& endpoint, std::vector<std::string> extra = {}) 
   return WorkerProcess(endpoint, {}, std::move(extra)).wait(20);
 }
 
+// A DEALER connected to the master, speaking for the test.
+zmq::socket_t peerOf(zmq::context_t& ctx, const std::string& endpoint) {
+  zmq::socket_t peer(ctx, zmq::socket_type::dealer);
+  peer.set(zmq::sockopt::linger, 0);
+  peer.connect(endpoint);
+  return peer;
+}
+
 }  // namespace
 
 TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
@@ -102,9 +110,7 @@ TEST(Protocol, WorkerOfAnotherProtocolMajorIsRefusedWithAReason) {
   MasterThread master(j, clusterOptions());
   const std::string ep = master.endpoint();
   zmq::context_t ctx(1);
-  zmq::socket_t peer(ctx, zmq::socket_type::dealer);
-  peer.set(zmq::sockopt::linger, 0);
-  peer.connect(ep);
+  zmq::socket_t peer = peerOf(ctx, ep);
   Envelope hello;
   hello.set_proto_major(kProtoMajor + 1);
   hello.mutable_hello()->set_worker_id("future");
@@ -119,7 +125,8 @@ TEST(Protocol, WorkerOfAnotherProtocolMajorIsRefusedWithAReason) {
   Envelope r;
   ASSERT_TRUE(r.ParseFromArray(reply.data(), int(reply.size())));
   ASSERT_EQ(r.body_case(), Envelope::kReject);
-  EXPECT_NE(r.reject().reason().find("protocol major 2"), std::string::npos) << r.reject().reason();
+  EXPECT_NE(r.reject().reason().find("protocol major " + std::to_string(kProtoMajor + 1)), std::string::npos)
+      << r.reject().reason();
   EXPECT_EQ(runWorker(ep), 0);
   master.join();
   const FarmOutcome& out = master.outcome;
@@ -268,4 +275,203 @@ TEST(Protocol, PayloadCodecRejectsMalformedInput) {
     m.resize(rng() % (m.size() + 1));
     decodeBrick(m.data(), m.size(), back, &err);
   }
+}
+
+// scanBrick (the master's verification) and decodeBrickLeaves (its merge, into place) share
+// decodeBrick's parser: on every truncation and on random corruption of a payload with compact
+// and full leaves and tiles, all three accept the same inputs, and what they give agrees.
+TEST(Protocol, ScanAndDecodeInPlaceAcceptExactlyWhatDecodeAccepts) {
+  BrickOutput b;
+  for (int k = 0; k < 3; ++k) {
+    LeafBlock l{};
+    l.origin = {8 * k, 16, 24};
+    for (int i = 0; i < kLeafVoxels; ++i) {
+      const bool active = k == 0 || (i + k) % 3 == 0;
+      if (active) l.active[size_t(i >> 6)] |= uint64_t(1) << (i & 63);
+      // Leaf 2's inactive voxels are not all +-m: it travels in full.
+      l.values[size_t(i)] = active ? 0.01f * float(i - 200) : (k == 2 ? float(i % 5) : (i % 2 ? 0.5f : -0.5f));
+    }
+    b.leaves.push_back(l);
+  }
+  b.tiles = {Tile{{0, 0, 0}, 8, true}, Tile{{32, 0, 0}, 16, false}};
+  const std::string s = encodeBrick(b);
+  auto agree = [&](const std::string& m) {
+    BrickOutput full;
+    std::vector<std::array<int32_t, 3>> origins;
+    std::vector<Tile> tiles;
+    std::string e1, e2, e3;
+    const bool decoded = decodeBrick(m.data(), m.size(), full, &e1);
+    const bool scanned = scanBrick(m.data(), m.size(), origins, tiles, &e2);
+    std::vector<LeafBlock> placed(decoded ? full.leaves.size() : 3);
+    size_t asked = 0;
+    const bool inPlace = decodeBrickLeaves(
+        m.data(), m.size(), placed.size(), [&](size_t l) { return ++asked, &placed[placed.size() - 1 - l]; }, &e3);
+    ASSERT_EQ(decoded, scanned) << e1 << " / " << e2;
+    if (!decoded) {
+      EXPECT_EQ(e1, e2);
+      EXPECT_FALSE(inPlace);
+      return;
+    }
+    ASSERT_TRUE(inPlace) << e3;
+    ASSERT_EQ(origins.size(), full.leaves.size());
+    ASSERT_EQ(tiles.size(), full.tiles.size());
+    for (size_t l = 0; l < origins.size(); ++l) {
+      EXPECT_EQ(origins[l], full.leaves[l].origin);
+      EXPECT_EQ(placed[placed.size() - 1 - l].origin, full.leaves[l].origin);
+      EXPECT_EQ(placed[placed.size() - 1 - l].active, full.leaves[l].active);
+      EXPECT_EQ(std::memcmp(placed[placed.size() - 1 - l].values.data(), full.leaves[l].values.data(),
+                            sizeof full.leaves[l].values),
+                0);  // bit for bit (corruption makes NaNs)
+    }
+    // Another leaf count than the payload's is refused before any slot is asked for.
+    asked = 0;
+    EXPECT_FALSE(decodeBrickLeaves(m.data(), m.size(), placed.size() + 1, [&](size_t) { return ++asked, nullptr; }, &e3));
+    EXPECT_EQ(asked, 0u);
+  };
+  agree(s);
+  BrickOutput back;
+  std::string err;
+  ASSERT_TRUE(decodeBrick(s.data(), s.size(), back, &err));
+  for (size_t l = 0; l < b.leaves.size(); ++l) EXPECT_EQ(back.leaves[l].values, b.leaves[l].values);
+  for (size_t n = 0; n < s.size(); ++n) agree(s.substr(0, n));  // every truncation is refused by all
+  std::mt19937 rng(11);
+  for (int k = 0; k < 3000; ++k) {
+    std::string m = s;
+    for (int j = 0; j < 3; ++j) m[rng() % m.size()] = char(rng());
+    agree(m);
+  }
+}
+
+namespace {
+// A fake master: a ROUTER on a free loopback port, and the worker process connected to it.
+struct FakeMaster {
+  zmq::context_t ctx{1};
+  zmq::socket_t router{ctx, zmq::socket_type::router};
+  std::string endpoint;
+  FakeMaster() {
+    router.set(zmq::sockopt::linger, 0);
+    router.bind("tcp://127.0.0.1:*");
+    endpoint = router.get(zmq::sockopt::last_endpoint);
+  }
+  // The next message (waits up to 10 s).
+  Incoming next() {
+    Incoming in;
+    std::string err;
+    auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (std::chrono::steady_clock::now() < deadline) {
+      zmq::pollitem_t item{static_cast<void*>(router), 0, ZMQ_POLLIN, 0};
+      zmq::poll(&item, 1, std::chrono::milliseconds(100));
+      if (receive(router, true, in, &err)) {
+        EXPECT_EQ(err, "");
+        return in;
+      }
+    }
+    ADD_FAILURE() << "nothing from the worker";
+    return in;
+  }
+  // The next message that is not a heartbeat.
+  Incoming nextNotHeartbeat() {
+    for (;;) {
+      Incoming in = next();
+      if (in.envelope.body_case() != Envelope::kHeartbeat) return in;
+    }
+  }
+  void welcome(const std::string& rid, const JobSpec& job, uint64_t jobId) {
+    Envelope w;
+    w.set_job_id(jobId);
+    w.mutable_welcome()->set_heartbeat_ms(100);
+    *w.mutable_welcome()->mutable_job() = job;
+    send(router, rid, w);
+  }
+};
+}  // namespace
+
+// Protocol 2: the job travels once per connection, in the welcome; tasks carry its id only, so
+// a job with megabytes of model (here a 1 MiB comment) costs its bytes once per worker, not per brick.
+TEST(Protocol, TheWelcomeCarriesTheJobAndTasksOnlyItsId) {
+  JobSpec j = sphereJob();
+  std::string comment;
+  while (comment.size() < (1u << 20)) comment += "-- a comment line that only makes the model big\n";
+  j.set_model_source(comment + j.model_source());
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
+  zmq::context_t ctx(1);
+  zmq::socket_t peer = peerOf(ctx, ep);
+  Envelope hello;
+  hello.mutable_hello()->set_worker_id("inspector");
+  send(peer, "", hello);
+  Incoming in;
+  auto receiveBody = [&](Envelope::BodyCase want) {
+    std::string err;
+    for (auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+         std::chrono::steady_clock::now() < deadline;) {
+      zmq::pollitem_t item{static_cast<void*>(peer), 0, ZMQ_POLLIN, 0};
+      zmq::poll(&item, 1, std::chrono::milliseconds(100));
+      while (receive(peer, false, in, &err))
+        if (in.envelope.body_case() == want) return true;
+    }
+    return false;
+  };
+  ASSERT_TRUE(receiveBody(Envelope::kWelcome));
+  EXPECT_EQ(in.envelope.job_id(), jobIdOf(j));
+  EXPECT_EQ(jobIdOf(in.envelope.welcome().job()), jobIdOf(j));
+  EXPECT_GT(in.bytes, 1u << 20);
+  for (int k = 0; k < 2; ++k) {  // the worker's credit: two tasks
+    ASSERT_TRUE(receiveBody(Envelope::kTask));
+    EXPECT_EQ(in.envelope.job_id(), jobIdOf(j));
+    EXPECT_LT(in.bytes, 128u) << "a task carries the brick and the job's id, not the job";
+  }
+  Envelope bye;  // leaves: its bricks go back to the queue, uncharged
+  bye.mutable_bye()->set_reason("inspected");
+  send(peer, "", bye);
+  EXPECT_EQ(runWorker(ep), 0);
+  master.join();
+  ASSERT_EQ(master.error, "");
+  EXPECT_TRUE(master.outcome.report.poisoned.empty());
+  EXPECT_EQ(master.outcome.report.bricksComputed, master.outcome.report.bricks);
+}
+
+// A welcome whose job does not hash to the envelope's job id (a master of another release, a
+// damaged frame) is refused: the worker computes nothing under a wrong id and exits 78.
+TEST(Protocol, WorkerRefusesAWelcomeWhoseJobIsNotTheJobId) {
+  FakeMaster m;
+  WorkerProcess worker(m.endpoint);
+  Incoming hello = m.nextNotHeartbeat();
+  ASSERT_EQ(hello.envelope.body_case(), Envelope::kHello);
+  m.welcome(hello.routingId, sphereJob(), jobIdOf(sphereJob()) + 1);
+  EXPECT_EQ(worker.wait(20), 78);
+}
+
+// A task naming another job than the welcome's is handed back (not the brick's fault) and the
+// worker says hello again, so the master's welcome brings it the job.
+TEST(Protocol, ATaskOfAnUnknownJobIsHandedBackAndTheWorkerSaysHelloAgain) {
+  FakeMaster m;
+  WorkerProcess worker(m.endpoint);
+  Incoming hello = m.nextNotHeartbeat();
+  ASSERT_EQ(hello.envelope.body_case(), Envelope::kHello);
+  const JobSpec j = sphereJob();
+  m.welcome(hello.routingId, j, jobIdOf(j));
+  Envelope task;
+  task.set_job_id(jobIdOf(j) ^ 0x5a5a);
+  task.mutable_task()->set_brick_id(7);
+  task.mutable_task()->set_attempt(1);
+  for (int a = 0; a < 3; ++a) task.mutable_task()->add_lo(0), task.mutable_task()->add_hi(32);
+  send(m.router, hello.routingId, task);
+  Incoming failed = m.nextNotHeartbeat();
+  ASSERT_EQ(failed.envelope.body_case(), Envelope::kFailed);
+  EXPECT_EQ(failed.envelope.failed().brick_id(), 7u);
+  EXPECT_TRUE(failed.envelope.failed().handed_back());
+  Incoming again = m.nextNotHeartbeat();
+  EXPECT_EQ(again.envelope.body_case(), Envelope::kHello);
+  // The same task under the welcome's id is computed.
+  task.set_job_id(jobIdOf(j));
+  send(m.router, hello.routingId, task);
+  Incoming result = m.nextNotHeartbeat();
+  ASSERT_EQ(result.envelope.body_case(), Envelope::kResult);
+  EXPECT_EQ(result.envelope.job_id(), jobIdOf(j));
+  EXPECT_EQ(result.envelope.result().brick_id(), 7u);
+  Envelope bye;
+  bye.mutable_bye()->set_reason("done");
+  send(m.router, hello.routingId, bye);
+  EXPECT_EQ(worker.wait(20), 0);
 }

@@ -1,9 +1,11 @@
 // Fuzz target: what the farm decodes from the network. The first byte picks the decoder, the rest
 // is its input: 0 a brick result's FRB2 payload (decodeBrick), 1 a mesh piece's FRM3 payload
 // (decodeMeshPiece, then the master's merge of it), 2 an Envelope frame (wire.cpp's parse) and,
-// when it holds a task, the job a worker would compute (fuzz_target.h). Oracles: a payload
+// when it holds a welcome, the job a worker would compute (fuzz_target.h). Oracles: a payload
 // that decodes re-encodes to bytes that decode and re-encode to the same bytes (the codec has
-// one meaning per payload), and nothing crashes or reads out of bounds.
+// one meaning per payload), scanBrick and decodeBrickLeaves accept exactly what decodeBrick
+// accepts and give the same origins, tiles and leaves, and nothing crashes or reads out of bounds.
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -18,10 +20,32 @@ namespace {
 void sampleBrick(const uint8_t* data, size_t size) {
   farm::BrickOutput out;
   std::string err;
+  // The master's two other readers of the format accept exactly what decodeBrick accepts:
+  // scanBrick (verification: origins and tiles) and decodeBrickLeaves (the merge, into place).
+  std::vector<std::array<int32_t, 3>> origins;
+  std::vector<Tile> tiles;
+  std::string scanErr;
+  const bool scanned = farm::scanBrick(data, size, origins, tiles, &scanErr);
   if (!farm::decodeBrick(data, size, out, &err)) {
     FREP_FUZZ_CHECK(!err.empty());
+    FREP_FUZZ_CHECK(!scanned && scanErr == err);
     return;
   }
+  FREP_FUZZ_CHECK(scanned && origins.size() == out.leaves.size() && tiles.size() == out.tiles.size());
+  std::vector<LeafBlock> placed(out.leaves.size());
+  FREP_FUZZ_CHECK(farm::decodeBrickLeaves(
+      data, size, placed.size(), [&](size_t l) { return &placed[placed.size() - 1 - l]; }, &err));
+  for (size_t l = 0; l < out.leaves.size(); ++l) {
+    const LeafBlock& a = out.leaves[l];
+    const LeafBlock& b = placed[placed.size() - 1 - l];
+    FREP_FUZZ_CHECK(a.origin == origins[l] && b.origin == a.origin && b.active == a.active &&
+                    std::memcmp(a.values.data(), b.values.data(), sizeof a.values) == 0);
+  }
+  for (size_t t = 0; t < tiles.size(); ++t)
+    FREP_FUZZ_CHECK(tiles[t].origin == out.tiles[t].origin && tiles[t].size == out.tiles[t].size &&
+                    tiles[t].inside == out.tiles[t].inside);
+  FREP_FUZZ_CHECK(!farm::decodeBrickLeaves(data, size, placed.size() + 1, [&](size_t) -> LeafBlock* { return nullptr; },
+                                           &err));
   const std::string once = farm::encodeBrick(out);
   farm::BrickOutput again;
   FREP_FUZZ_CHECK(farm::decodeBrick(once.data(), once.size(), again, &err));
@@ -50,12 +74,13 @@ void meshPiece(const uint8_t* data, size_t size) {
 void envelope(const uint8_t* data, size_t size) {
   farm::Envelope e;
   if (!e.ParseFromArray(data, int(size))) return;
-  if (!e.has_task()) return;
-  const farm::JobSpec& job = e.task().job();
+  if (!e.has_welcome()) return;
+  // What a worker does with a welcome: the job must hash to the envelope's id, then it is read.
+  const farm::JobSpec& job = e.welcome().job();
+  if (farm::jobIdOf(job) != e.job_id()) return;
   try {
     (void)farm::operationOf(job);
     (void)farm::gridOf(job);
-    (void)farm::jobIdOf(job);
   } catch (const std::invalid_argument&) {
   }
 }

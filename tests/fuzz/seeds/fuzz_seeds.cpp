@@ -49,11 +49,15 @@ int main(int argc, char** argv) {
   meshJob.mutable_mesh()->set_tolerance(0.5);
   const std::string simplified = farm::encodeMeshPiece(farm::computeBrick(tape, meshJob, lo, {8, 8, 8}, 1).piece);
   put(payloads, "frm3_simplified", 1, simplified);
+  farm::Envelope welcome;  // protocol 2: the job once per connection, tasks name it by id
+  welcome.set_job_id(farm::jobIdOf(job));
+  welcome.mutable_welcome()->set_heartbeat_ms(500);
+  *welcome.mutable_welcome()->mutable_job() = job;
+  put(payloads, "envelope_welcome", 2, welcome.SerializeAsString());
   farm::Envelope task;
   task.set_job_id(farm::jobIdOf(job));
   task.mutable_task()->set_brick_id(3);
   for (int a = 0; a < 3; ++a) task.mutable_task()->add_lo(lo[size_t(a)]), task.mutable_task()->add_hi(hi[size_t(a)]);
-  *task.mutable_task()->mutable_job() = job;
   put(payloads, "envelope_task", 2, task.SerializeAsString());
 
   ::mkdir(journals.c_str(), 0755);
