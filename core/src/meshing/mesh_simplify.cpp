@@ -247,6 +247,28 @@ class MinHeap {
     }
     h_[i] = x;
   }
+  // Drops the elements `dead` accepts and rebuilds the heap (bottom-up, O(n)).
+  template <typename Dead>
+  void purge(Dead&& dead) {
+    h_.erase(std::remove_if(h_.begin(), h_.end(), dead), h_.end());
+    const size_t n = h_.size();
+    if (n < 2) return;
+    for (size_t k = (n - 2) / 4 + 1; k-- > 0;) {
+      const T x = h_[k];
+      size_t i = k;
+      for (;;) {
+        const size_t c0 = 4 * i + 1;
+        if (c0 >= n) break;
+        size_t best = c0;
+        for (size_t c = c0 + 1; c < std::min(c0 + 4, n); ++c)
+          if (h_[best] > h_[c]) best = c;
+        if (!(x > h_[best])) break;
+        h_[i] = h_[best];
+        i = best;
+      }
+      h_[i] = x;
+    }
+  }
 
  private:
   std::vector<T> h_;
@@ -274,7 +296,14 @@ class Simplifier {
     setUp();
     const bool report = opt_.progress && !w_.confined;  // the global pass only
     uint64_t examined = 0;
+    // Most entries go stale (a collapse re-pushes its ring): when the heap has doubled since the
+    // last purge, drop them, so pops sift through a shallower heap. Same pop order.
+    size_t purgeAt = 2 * queue_.size() + 1024;
     while (!queue_.empty()) {
+      if (queue_.size() >= purgeAt) {
+        queue_.purge([&](const Candidate& c) { return !alive_[c.a] || !alive_[c.b] || version_[c.a] != c.va || version_[c.b] != c.vb; });
+        purgeAt = 2 * queue_.size() + 1024;
+      }
       if (report && (examined & 4095) == 0) opt_.progress(kGlobalStage, examined, examined + queue_.size());
       ++examined;
       Candidate c = queue_.top();
