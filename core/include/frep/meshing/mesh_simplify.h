@@ -12,7 +12,9 @@
 //  - no fold, no degenerate triangle: no changed triangle turns by more than ~80 degrees or
 //    gets thinner than a quality bound (unless it was already);
 //  - no self-intersection: the new triangles against every triangle near them, with the exact
-//    predicates of frep/meshing/mesh_predicates.h on positions quantised to 2^-16 voxel;
+//    predicates of frep/meshing/mesh_predicates.h on positions quantised to 2^-16 voxel
+//    (checked once on each block's result; a block that fails is simplified again with this
+//    check at every collapse);
 //  - error against the model itself: at points spread over each new triangle (at most half a
 //    voxel apart, up to 64x64 points per triangle) the surface must be crossed within distance
 //    e along the triangle's normal: f(p - e n) inside and f(p + e n) outside. e is the
@@ -21,9 +23,8 @@
 //    the input mesh. The removed vertices must also stay within e of the new triangles.
 // Passes: two of independent 32^3 blocks (fixed in index space; in parallel, and in the workers
 // for the blocks inside their bricks: simplifyRegion), one of 64^3 blocks, then one over the
-// whole mesh. Each is
-// deterministic (ties broken by vertex index) and starts from the canonical mesh, so the output
-// depends only on the input mesh: the farm's split-invariance carries over.
+// whole mesh. Each is deterministic (ties broken by vertex index) and starts from the canonical
+// mesh, so the output depends only on the input mesh: the farm's split-invariance carries over.
 #pragma once
 
 #include <array>
