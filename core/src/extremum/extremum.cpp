@@ -423,22 +423,50 @@ struct ExtremumSolver::Impl {
   // polished by local ascent, and every box is contracted by constraint propagation against the
   // cut best + tolerance before it is bounded (boxes that cannot reach the cut are dropped
   // whole; the parts cut off a box are bounded by the cut).
-  ExtremumResult branchAndBoundTerms(const double* X, const double* warmT) {
+  //
+  // signOnly (cold searches only, warmT null): return as soon as the sign of the value this
+  // search would return is known, i.e. the incumbent is above 0 (the value only grows from
+  // there) or no point of the domain reaches 0 (contraction of the root box against the cut 0);
+  // the value returned then is the incumbent, with that sign. Until it returns, the search is
+  // the same as without signOnly (the root test only reads), so an undecided sign is the full
+  // search's. Returns with r.certified false and lo = hi = value when it stopped early.
+  ExtremumResult branchAndBoundTerms(const double* X, const double* warmT, bool signOnly = false) {
     tBest.assign(p, 0.0);
     tC.assign(p, 0.0);
     Search S(*this, X, tBest);
     S.seed(warmT, tC);
     const double tol = s.tolerance;
+    auto signKnown = [&]() {
+      S.r.value = sign * S.bestV;
+      S.r.lo = S.r.hi = S.r.value;
+      S.r.certified = false;
+      finish(S.r, S.bestT);
+      return std::move(S.r);
+    };
+    if (signOnly && S.bestV > 0) return signKnown();
     tf.setX(X);
+    if (signOnly) {
+      tLo.assign(plo.begin(), plo.end());
+      tHi.assign(phi.begin(), phi.end());
+      double ub = kInf, ub0 = kInf;
+      uint32_t passes = 0;
+      const bool alive = tf.contract(tLo.data(), tHi.data(), 0.0, ub, ub0, passes);
+      S.r.intervalEvals += passes;
+      if (!alive) return signKnown();  // every computed value is below 0: so is the incumbent's
+    }
     {
       // Polish the better of the domain centre and the warm start: pruning then starts from a
       // nearly optimal value. A gradient evaluation is counted as 1 + p body evaluations.
       std::vector<double>& at = tAsc;
       at = tBest;
-      const uint32_t calls = tf.ascend(at.data(), plo.data(), phi.data(), tol);
+      // signOnly: stop once above 0; if the body then is not above 0 too, the search has left
+      // the full search's path and is redone without signOnly.
+      const uint32_t calls = tf.ascend(at.data(), plo.data(), phi.data(), tol, signOnly ? 0.0 : kInf);
       S.r.pointEvals += uint64_t(calls) * (1 + p);
       S.tryPoint(at.data());
     }
+    if (signOnly && S.bestV > 0) return signKnown();
+    if (signOnly && tf.lastAscentValue() > 0) return branchAndBoundTerms(X, warmT, false);
     pool.clear();
     heap.clear();
     std::vector<double>& clo = tLo;
@@ -613,6 +641,11 @@ ExtremumSolver::~ExtremumSolver() = default;
 ExtremumResult ExtremumSolver::solve(const double* X, const double* warmT) {
   if (spec_->method == ExtremumMethod::Grid) return impl_->grid(X);
   return impl_->branchAndBound(X, warmT);
+}
+ExtremumResult ExtremumSolver::solveSign(const double* X) {
+  if (spec_->method == ExtremumMethod::BranchAndBound && impl_->useTerms)
+    return impl_->branchAndBoundTerms(X, nullptr, true);
+  return solve(X);
 }
 ExtremumResult ExtremumSolver::solveGrid(const double* X) { return impl_->grid(X); }
 ExtremumResult ExtremumSolver::solveBranchAndBound(const double* X, const double* warmT) {

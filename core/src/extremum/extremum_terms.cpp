@@ -579,8 +579,25 @@ double TermForm::upper(const double* tlo, const double* thi) {
   return best + slack;
 }
 
-double TermForm::pointGrad(const double* t) {
-  const uint32_t p = p_;
+namespace {
+// Values of the common ops as applyOp computes them (same bits), without its call.
+inline double pointValue(Op op, double a, double b, double c, double imm) {
+  switch (op) {
+    case Op::Add: return a + b;
+    case Op::Sub: return a - b;
+    case Op::Mul: return a * b;
+    case Op::Neg: return -a;
+    case Op::Min: return b < a ? b : a;
+    case Op::Max: return b > a ? b : a;
+    default: return applyOp(op, a, b, c, imm);
+  }
+}
+}  // namespace
+
+// P: the number of parameters when known at compile time (the loops over them unroll), else 0.
+template <uint32_t P>
+double TermForm::pointGradImpl(const double* t) {
+  const uint32_t p = P ? P : p_;
   for (uint32_t k : dep_) {
     const Nd& q = nodes_[k];
     double* d = &pd_[size_t(k) * p];
@@ -590,7 +607,7 @@ double TermForm::pointGrad(const double* t) {
       continue;
     }
     const double a = pv_[size_t(q.a)], b = q.b >= 0 ? pv_[size_t(q.b)] : 0.0, c = q.c >= 0 ? pv_[size_t(q.c)] : 0.0;
-    const double v = applyOp(q.op, a, b, c, q.imm);
+    const double v = pointValue(q.op, a, b, c, q.imm);
     pv_[k] = v;
     const bool depA = nodes_[size_t(q.a)].dep, depB = q.b >= 0 && nodes_[size_t(q.b)].dep;
     const double* da = &pd_[size_t(q.a) * p];
@@ -621,10 +638,11 @@ double TermForm::pointGrad(const double* t) {
     if (pass) {
       for (uint32_t j = 0; j < p; ++j) d[j] = pass[j];
     } else {
+      const bool useA = depA && pa != 0.0, useB = depB && pb != 0.0;
       for (uint32_t j = 0; j < p; ++j) {
         double s = 0.0;
-        if (depA && pa != 0.0) s += pa * da[j];
-        if (depB && pb != 0.0) s += pb * db[j];
+        if (useA) s += pa * da[j];
+        if (useB) s += pb * db[j];
         d[j] = std::isfinite(s) ? s : 0.0;
       }
     }
@@ -636,18 +654,30 @@ double TermForm::pointGrad(const double* t) {
   for (size_t i = 0; i < K; ++i) {
     const size_t node = size_t(terms_[i]);
     tv_[i] = pv_[node];
-    for (uint32_t j = 0; j < p; ++j) tg_[i * p + j] = nodes_[node].dep ? pd_[node * p + j] : 0.0;
+    const bool dep = nodes_[node].dep;
+    for (uint32_t j = 0; j < p; ++j) tg_[i * p + j] = dep ? pd_[node * p + j] : 0.0;
     f = std::min(f, tv_[i]);
   }
   return f;
 }
 
-uint32_t TermForm::ascend(double* t, const double* plo, const double* phi, double tol) {
+double TermForm::pointGrad(const double* t) {
+  switch (p_) {
+    case 1: return pointGradImpl<1>(t);
+    case 2: return pointGradImpl<2>(t);
+    case 3: return pointGradImpl<3>(t);
+    default: return pointGradImpl<0>(t);
+  }
+}
+
+uint32_t TermForm::ascend(double* t, const double* plo, const double* phi, double tol, double stopAbove) {
+  lastF_ = -kInf;
   const size_t K = terms_.size();
   const uint32_t p = p_;
   uint32_t calls = 1;
   double F = pointGrad(t);
-  if (!std::isfinite(F)) return calls;
+  lastF_ = F;
+  if (!std::isfinite(F) || F > stopAbove) return calls;
   std::vector<double>& av = av_;
   std::vector<double>& ag = ag_;
   av.assign(tv_.begin(), tv_.end());
@@ -680,6 +710,7 @@ uint32_t TermForm::ascend(double* t, const double* plo, const double* phi, doubl
     lam[i0] = 1.0;
     for (uint32_t j = 0; j < p; ++j) w[j] = ag[i0 * p + j];
     for (int sweep = 0; sweep < 6 && S.size() > 1; ++sweep) {
+      bool moved = false;  // a sweep that moves nothing leaves the same state for the next
       for (uint32_t a : S) {
         for (uint32_t b : S) {
           if (a == b || lam[a] <= 0.0) continue;
@@ -697,8 +728,10 @@ uint32_t TermForm::ascend(double* t, const double* plo, const double* phi, doubl
           lam[a] -= sMove;
           lam[b] += sMove;
           for (uint32_t j = 0; j < p; ++j) w[j] += sMove * (ag[b * p + j] - ag[a * p + j]);
+          moved = true;
         }
       }
+      if (!moved) break;
     }
     for (uint32_t j = 0; j < p; ++j) t1[j] = std::min(phi[j], std::max(plo[j], t[j] + w[j] / mu));
     double pred = kInf;
@@ -712,13 +745,14 @@ uint32_t TermForm::ascend(double* t, const double* plo, const double* phi, doubl
     ++calls;
     const double F1 = pointGrad(t1.data());
     if (F1 - F >= 0.1 * pred) {
+      // mu only grows: halving it after well-predicted steps (longer steps) took fewer steps
+      // but more work per step in the dual (more terms within reach), 3% more in all.
       const bool small = F1 - F < 1e-2 * tol;
       std::copy(t1.begin(), t1.end(), t);
-      F = F1;
+      F = lastF_ = F1;
       av.assign(tv_.begin(), tv_.end());
       ag.assign(tg_.begin(), tg_.end());
-      if (small) break;
-      if (F1 - F >= 0.75 * pred) mu *= 0.5;
+      if (small || F > stopAbove) break;
     } else {
       mu *= 4.0;
     }

@@ -29,6 +29,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "frep/expressions/expr.h"
@@ -73,9 +74,11 @@ class TermForm {
   double pointGrad(const double* t);
 
   // Local ascent of min_i T_i from t (in place, kept inside [lo, hi]) by proximal bundle steps;
-  // stops when a step gains less than a small fraction of tol. Returns the number of pointGrad
-  // calls.
-  uint32_t ascend(double* t, const double* lo, const double* hi, double tol);
+  // stops when a step gains less than a small fraction of tol, or once min_i T_i > stopAbove.
+  // Returns the number of pointGrad calls.
+  uint32_t ascend(double* t, const double* lo, const double* hi, double tol,
+                  double stopAbove = std::numeric_limits<double>::infinity());
+  double lastAscentValue() const { return lastF_; }  // min_i T_i where ascend left t
 
  private:
   struct Nd {
@@ -86,12 +89,15 @@ class TermForm {
     bool dep = false;     // depends on t
     bool square = false;  // x * x
   };
+  template <uint32_t P>
+  double pointGradImpl(const double* t);
   void evalValues(const double* tlo, const double* thi);
   void evalBox(const double* tlo, const double* thi);  // values and interval gradients
   void evalCentre(const double* c);
   bool project(uint32_t k);
 
   uint32_t n_ = 0, p_ = 0;
+  double lastF_ = 0.0;
   bool ok_ = false;
   std::vector<Nd> nodes_;          // topological order (operands first)
   std::vector<int32_t> terms_;     // node of each term

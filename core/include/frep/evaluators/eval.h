@@ -70,10 +70,15 @@ class BatchEvaluator {
   // false: every lane's search starts cold, so each value is a function of its point alone
   // (the PointEvaluator's value), at about twice the cost of warm-started lanes.
   void setExtremumWarmStarts(bool on) { warmStarts_ = on; }
+  // true (with warm starts off): an extremum that is the tape's last instruction and result
+  // runs ExtremumSolver::solveSign, so only the sign of each value is that of the cold search
+  // (what the mesher reads from its sample), at a fraction of the cost away from the surface.
+  void setExtremumSignsOnly(bool on) { signsOnly_ = on; }
 
  private:
   DomainCounts* domain_ = nullptr;
   bool warmStarts_ = true;
+  bool signsOnly_ = false;
   void bind(const Tape& tape);
   void runExtremum(const Tape& tape, const Instr& ins, size_t count);
   std::vector<T> regs_;  // numRegs * kBatch, register-major

@@ -87,6 +87,10 @@ class ExtremumSolver {
 
   // The spec's method. warmT: a previous result's t (numParams() values) to start from, or null.
   ExtremumResult solve(const double* X, const double* warmT = nullptr);
+  // A cold solve(X) cut short once the sign of its value is known: the value returned has the
+  // same sign bit as solve(X).value (for the mesher's signs), but it may be further from the
+  // extremum (certified is then false). Much cheaper away from the zero set.
+  ExtremumResult solveSign(const double* X);
   ExtremumResult solveGrid(const double* X);
   ExtremumResult solveBranchAndBound(const double* X, const double* warmT = nullptr);
   // Sound enclosure of the extremum over an X box (interval evaluator). signOnly: stop as soon
