@@ -35,7 +35,8 @@ inline bool finiteIv(const Interval& a) {
 
 // r = op(a, b) for Copy, Neg, Abs, Sqrt, x^2, +, -, *, min and max on finite operands. Returns
 // false when the op or its operands are not handled here (the caller then uses applyOp).
-inline bool fastOp(Op op, const Interval& a, const Interval& b, double imm, Interval& r) {
+// Always inlined: it runs for every node of every box, and the call costs as much as the op.
+[[gnu::always_inline]] inline bool fastOp(Op op, const Interval& a, const Interval& b, double imm, Interval& r) {
   switch (op) {
     case Op::Copy:
       if (!finiteIv(a)) return false;

@@ -661,6 +661,20 @@ double TermForm::pointGradImpl(const double* t) {
   return f;
 }
 
+double TermForm::pointMin(const double* t) {
+  for (uint32_t k : dep_) {
+    const Nd& q = nodes_[k];
+    if (q.op == Op::Var) {
+      pv_[k] = t[q.var - n_];
+      continue;
+    }
+    pv_[k] = pointValue(q.op, pv_[size_t(q.a)], q.b >= 0 ? pv_[size_t(q.b)] : 0.0, q.c >= 0 ? pv_[size_t(q.c)] : 0.0, q.imm);
+  }
+  double f = kInf;
+  for (int32_t node : terms_) f = std::min(f, pv_[size_t(node)]);
+  return f;
+}
+
 double TermForm::pointGrad(const double* t) {
   switch (p_) {
     case 1: return pointGradImpl<1>(t);

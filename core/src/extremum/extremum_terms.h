@@ -72,6 +72,8 @@ class TermForm {
   // Values and gradients (w.r.t. t) of the terms at the point t, in double precision (search
   // directions only, never bounds). Returns min_i T_i.
   double pointGrad(const double* t);
+  // min_i T_i at the point t, without gradients (double precision: a guide, never a bound).
+  double pointMin(const double* t);
 
   // Local ascent of min_i T_i from t (in place, kept inside [lo, hi]) by proximal bundle steps;
   // stops when a step gains less than a small fraction of tol, or once min_i T_i > stopAbove.
