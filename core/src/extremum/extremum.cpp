@@ -352,15 +352,16 @@ struct ExtremumSolver::Impl {
         std::copy(t, t + I.p, bestT.begin());
       }
     }
-    // Tries the domain's centre (written to c) and the warm start when it lies in the domain.
-    void seed(const double* warmT, std::vector<double>& c) {
+    // Tries the warm start when it lies in the domain, else the domain's centre (written to c;
+    // the centre of the root box is tried anyway when the search splits it).
+    // Returns whether the centre was tried.
+    bool seed(const double* warmT, std::vector<double>& c) {
       I.centre(I.plo.data(), I.phi.data(), c.data());
-      tryPoint(c.data());
-      if (warmT) {
-        bool inside = true;
-        for (uint32_t k = 0; k < I.p; ++k) inside = inside && warmT[k] >= I.plo[k] && warmT[k] <= I.phi[k];
-        if (inside) tryPoint(warmT);
-      }
+      bool inside = warmT;
+      for (uint32_t k = 0; inside && k < I.p; ++k) inside = warmT[k] >= I.plo[k] && warmT[k] <= I.phi[k];
+      if (inside) tryPoint(warmT);
+      else tryPoint(c.data());
+      return !inside;
     }
     // Whether a box with upper bound ub is dropped: it cannot beat the incumbent by more than
     // the tolerance (its bound is kept in prunedHi).
@@ -455,7 +456,7 @@ struct ExtremumSolver::Impl {
       if (!alive) return signKnown();  // every computed value is below 0: so is the incumbent's
     }
     {
-      // Polish the better of the domain centre and the warm start: pruning then starts from a
+      // Polish the warm start (else the domain centre): pruning then starts from a
       // nearly optimal value. A gradient evaluation is counted as 1 + p body evaluations.
       std::vector<double>& at = tAsc;
       at = tBest;
@@ -553,7 +554,7 @@ struct ExtremumSolver::Impl {
     for (uint32_t k = 0; k < n; ++k) Xi[k] = Interval(X[k]);
     std::vector<double> bestT(p), c(p);
     Search S(*this, X, bestT);
-    S.seed(warmT, c);
+    const bool centreTried = S.seed(warmT, c);
     pool.clear();
     heap.clear();
     tapes.clear();
@@ -575,7 +576,7 @@ struct ExtremumSolver::Impl {
       // The incumbent improves at the centres of the most promising boxes, evaluated when the
       // box comes off the heap (once per split rather than once per child).
       boxTape = tapes[top.second];
-      if (top.second == 0) return true;
+      if (top.second == 0 && centreTried) return true;
       centre(lo.data(), hi.data(), c.data());
       S.tryPoint(c.data(), boxTape.get());
       return !S.drop(top.first);

@@ -155,14 +155,34 @@ void TermForm::build(const Expr& objective, uint32_t n, uint32_t p, const std::v
   for (const Expr& t : ts) terms_.push_back(visit(t.ptr()));
   varNode_.assign(p, UINT32_MAX);
   for (size_t k = 0; k < nodes_.size(); ++k) (nodes_[k].dep ? dep_ : indep_).push_back(uint32_t(k));
-  val_.resize(nodes_.size());
+  val_.assign(nodes_.size() + 1, Interval());  // + the zero slot (the steps' missing operands)
   valC_.resize(nodes_.size());
   der_.resize(nodes_.size() * p);
   con_.resize(nodes_.size());
   for (size_t k = 0; k < nodes_.size(); ++k)
     if (nodes_[k].op == Op::Var && nodes_[k].dep) varNode_[nodes_[k].var - n] = uint32_t(k);
-  pv_.resize(nodes_.size());
-  pd_.resize(nodes_.size() * p);
+  pv_.assign(nodes_.size() + 1, 0.0);  // + the zero slot
+  pd_.assign((nodes_.size() + 1) * p, 0.0);
+  const uint32_t zero = uint32_t(nodes_.size());
+  steps_.clear();
+  for (uint32_t k : dep_) {
+    const Nd& q = nodes_[k];
+    Step st;
+    st.op = q.op;
+    st.k = k;
+    st.imm = q.imm;
+    st.square = q.square;
+    if (q.op == Op::Var) {
+      st.var = q.var - n;
+    } else {
+      st.a = q.a >= 0 ? uint32_t(q.a) : zero;
+      st.b = q.b >= 0 ? uint32_t(q.b) : zero;
+      st.c = q.c >= 0 ? uint32_t(q.c) : zero;
+      st.depA = q.a >= 0 && nodes_[size_t(q.a)].dep;
+      st.depB = q.b >= 0 && nodes_[size_t(q.b)].dep;
+    }
+    steps_.push_back(st);
+  }
   ok_ = true;
 }
 
@@ -189,14 +209,10 @@ void TermForm::setX(const double* X) {
 }
 
 void TermForm::evalValues(const double* tlo, const double* thi) {
-  for (uint32_t k : dep_) {
-    const Nd& q = nodes_[k];
-    if (q.op == Op::Var) {
-      val_[k] = Interval(tlo[q.var - n_], thi[q.var - n_]);
-      continue;
-    }
-    val_[k] = ival(q.op, val_[size_t(q.a)], q.b >= 0 ? val_[size_t(q.b)] : Interval(),
-                            q.c >= 0 ? val_[size_t(q.c)] : Interval(), q.imm, q.square);
+  Interval* val = val_.data();
+  for (const Step& q : steps_) {
+    if (q.op == Op::Var) val[q.k] = Interval(tlo[q.var], thi[q.var]);
+    else val[q.k] = ival(q.op, val[q.a], val[q.b], val[q.c], q.imm, q.square);
   }
 }
 
@@ -598,20 +614,21 @@ inline double pointValue(Op op, double a, double b, double c, double imm) {
 template <uint32_t P>
 double TermForm::pointGradImpl(const double* t) {
   const uint32_t p = P ? P : p_;
-  for (uint32_t k : dep_) {
-    const Nd& q = nodes_[k];
-    double* d = &pd_[size_t(k) * p];
+  double* pv = pv_.data();
+  double* pd = pd_.data();
+  for (const Step& q : steps_) {
+    double* d = pd + size_t(q.k) * p;
     if (q.op == Op::Var) {
-      pv_[k] = t[q.var - n_];
-      for (uint32_t j = 0; j < p; ++j) d[j] = j == q.var - n_ ? 1.0 : 0.0;
+      pv[q.k] = t[q.var];
+      for (uint32_t j = 0; j < p; ++j) d[j] = j == q.var ? 1.0 : 0.0;
       continue;
     }
-    const double a = pv_[size_t(q.a)], b = q.b >= 0 ? pv_[size_t(q.b)] : 0.0, c = q.c >= 0 ? pv_[size_t(q.c)] : 0.0;
+    const double a = pv[q.a], b = pv[q.b], c = pv[q.c];
     const double v = pointValue(q.op, a, b, c, q.imm);
-    pv_[k] = v;
-    const bool depA = nodes_[size_t(q.a)].dep, depB = q.b >= 0 && nodes_[size_t(q.b)].dep;
-    const double* da = &pd_[size_t(q.a) * p];
-    const double* db = q.b >= 0 ? &pd_[size_t(q.b) * p] : nullptr;
+    pv[q.k] = v;
+    const bool depA = q.depA, depB = q.depB;
+    const double* da = pd + size_t(q.a) * p;
+    const double* db = pd + size_t(q.b) * p;
     double pa = 0.0, pb = 0.0;
     const double* pass = nullptr;
     switch (q.op) {
@@ -630,8 +647,8 @@ double TermForm::pointGradImpl(const double* t) {
       case Op::Cos: pa = -ownSin(a); break;
       case Op::Atan: pa = 1.0 / (1.0 + a * a); break;
       case Op::Tanh: pa = 1.0 - v * v; break;
-      case Op::Min: pass = b < a ? db : da; if (!(b < a ? depB : depA)) pass = nullptr; break;
-      case Op::Max: pass = b > a ? db : da; if (!(b > a ? depB : depA)) pass = nullptr; break;
+      case Op::Min: if (b < a ? depB : depA) pass = b < a ? db : da; break;
+      case Op::Max: if (b > a ? depB : depA) pass = b > a ? db : da; break;
       case Op::RAnd: case Op::ROr: rFunctionPartials(q.op == Op::ROr, a, b, q.imm, pa, pb); break;
       default: break;
     }
@@ -653,25 +670,19 @@ double TermForm::pointGradImpl(const double* t) {
   double f = kInf;
   for (size_t i = 0; i < K; ++i) {
     const size_t node = size_t(terms_[i]);
-    tv_[i] = pv_[node];
+    tv_[i] = pv[node];
     const bool dep = nodes_[node].dep;
-    for (uint32_t j = 0; j < p; ++j) tg_[i * p + j] = dep ? pd_[node * p + j] : 0.0;
+    for (uint32_t j = 0; j < p; ++j) tg_[i * p + j] = dep ? pd[node * p + j] : 0.0;
     f = std::min(f, tv_[i]);
   }
   return f;
 }
 
 double TermForm::pointMin(const double* t) {
-  for (uint32_t k : dep_) {
-    const Nd& q = nodes_[k];
-    if (q.op == Op::Var) {
-      pv_[k] = t[q.var - n_];
-      continue;
-    }
-    pv_[k] = pointValue(q.op, pv_[size_t(q.a)], q.b >= 0 ? pv_[size_t(q.b)] : 0.0, q.c >= 0 ? pv_[size_t(q.c)] : 0.0, q.imm);
-  }
+  double* pv = pv_.data();
+  for (const Step& q : steps_) pv[q.k] = q.op == Op::Var ? t[q.var] : pointValue(q.op, pv[q.a], pv[q.b], pv[q.c], q.imm);
   double f = kInf;
-  for (int32_t node : terms_) f = std::min(f, pv_[size_t(node)]);
+  for (int32_t node : terms_) f = std::min(f, pv[size_t(node)]);
   return f;
 }
 
@@ -685,11 +696,21 @@ double TermForm::pointGrad(const double* t) {
 }
 
 uint32_t TermForm::ascend(double* t, const double* plo, const double* phi, double tol, double stopAbove) {
+  switch (p_) {
+    case 1: return ascendImpl<1>(t, plo, phi, tol, stopAbove);
+    case 2: return ascendImpl<2>(t, plo, phi, tol, stopAbove);
+    case 3: return ascendImpl<3>(t, plo, phi, tol, stopAbove);
+    default: return ascendImpl<0>(t, plo, phi, tol, stopAbove);
+  }
+}
+
+template <uint32_t P>
+uint32_t TermForm::ascendImpl(double* t, const double* plo, const double* phi, double tol, double stopAbove) {
   lastF_ = -kInf;
   const size_t K = terms_.size();
-  const uint32_t p = p_;
+  const uint32_t p = P ? P : p_;
   uint32_t calls = 1;
-  double F = pointGrad(t);
+  double F = pointGradImpl<P>(t);
   lastF_ = F;
   if (!std::isfinite(F) || F > stopAbove) return calls;
   std::vector<double>& av = av_;
@@ -757,7 +778,7 @@ uint32_t TermForm::ascend(double* t, const double* plo, const double* phi, doubl
     pred -= F;
     if (!(pred > 1e-3 * tol)) break;
     ++calls;
-    const double F1 = pointGrad(t1.data());
+    const double F1 = pointGradImpl<P>(t1.data());
     if (F1 - F >= 0.1 * pred) {
       // mu only grows: halving it after well-predicted steps (longer steps) took fewer steps
       // but more work per step in the dual (more terms within reach), 3% more in all.

@@ -91,8 +91,19 @@ class TermForm {
     bool dep = false;     // depends on t
     bool square = false;  // x * x
   };
+  // The t-dependent nodes in order, as pointGrad and evalValues walk them (operand indices
+  // always valid: a missing operand reads the zero slot at index nodes_.size()).
+  struct Step {
+    Op op;
+    bool depA = false, depB = false, square = false;
+    uint32_t k = 0, a = 0, b = 0, c = 0, var = 0;
+    double imm = 0.0;
+  };
+  std::vector<Step> steps_;
   template <uint32_t P>
   double pointGradImpl(const double* t);
+  template <uint32_t P>
+  uint32_t ascendImpl(double* t, const double* lo, const double* hi, double tol, double stopAbove);
   void evalValues(const double* tlo, const double* thi);
   void evalBox(const double* tlo, const double* thi);  // values and interval gradients
   void evalCentre(const double* c);
