@@ -747,6 +747,7 @@ uint32_t TermForm::ascendImpl(double* t, const double* plo, const double* phi, d
     for (int sweep = 0; sweep < 6 && S.size() > 1; ++sweep) {
       bool moved = false;  // a sweep that moves nothing leaves the same state for the next
       for (uint32_t a : S) {
+        if (lam[a] <= 0.0) continue;  // (lam[a] only decreases while a gives weight away)
         for (uint32_t b : S) {
           if (a == b || lam[a] <= 0.0) continue;
           double wd = 0.0, dd = 0.0;
