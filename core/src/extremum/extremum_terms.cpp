@@ -183,6 +183,32 @@ void TermForm::build(const Expr& objective, uint32_t n, uint32_t p, const std::v
     }
     steps_.push_back(st);
   }
+  // Steps whose gradient is the same at every point (affine in t, constant coefficients: the
+  // u = X - t kind of node) get it once here, by pointGrad's own arithmetic; pointGrad then
+  // only updates their values.
+  std::vector<char> constant(nodes_.size() + 1, 0);
+  for (size_t k = 0; k < nodes_.size(); ++k)
+    if (nodes_[k].op == Op::Const) pv_[k] = nodes_[k].imm;  // as setX
+  for (Step& st : steps_) {
+    const bool okA = !st.depA || constant[st.a], okB = !st.depB || constant[st.b];
+    auto isConst = [&](uint32_t i) { return i < nodes_.size() && nodes_[i].op == Op::Const; };
+    switch (st.op) {
+      case Op::Var: st.constGrad = true; break;
+      case Op::Neg: case Op::Copy: st.constGrad = okA; break;
+      case Op::Add: case Op::Sub: st.constGrad = okA && okB; break;
+      case Op::Mul:
+        st.constGrad = !st.square && ((st.depA && !st.depB && isConst(st.b) && okA) || (st.depB && !st.depA && isConst(st.a) && okB));
+        break;
+      default: break;
+    }
+    constant[st.k] = st.constGrad;
+    if (!st.constGrad) continue;
+    if (st.op == Op::Var) {
+      for (uint32_t j = 0; j < p; ++j) pd_[size_t(st.k) * p + j] = j == st.var ? 1.0 : 0.0;
+    } else {
+      stepGrad<0>(st, pv_[st.a], pv_[st.b], 0.0);  // the values these partials read are constants
+    }
+  }
   ok_ = true;
 }
 
@@ -611,58 +637,66 @@ inline double pointValue(Op op, double a, double b, double c, double imm) {
 }  // namespace
 
 // P: the number of parameters when known at compile time (the loops over them unroll), else 0.
+// The gradient of step q from its operands' gradients (pd_), a = its first operand's value,
+// b = its second's, v = its own.
+template <uint32_t P>
+void TermForm::stepGrad(const Step& q, double a, double b, double v) {
+  const uint32_t p = P ? P : p_;
+  double* pd = pd_.data();
+  double* d = pd + size_t(q.k) * p;
+  const bool depA = q.depA, depB = q.depB;
+  const double* da = pd + size_t(q.a) * p;
+  const double* db = pd + size_t(q.b) * p;
+  double pa = 0.0, pb = 0.0;
+  const double* pass = nullptr;
+  switch (q.op) {
+    case Op::Neg: pa = -1.0; break;
+    case Op::Copy: pa = 1.0; break;
+    case Op::Add: pa = 1.0; pb = 1.0; break;
+    case Op::Sub: pa = 1.0; pb = -1.0; break;
+    case Op::Mul: pa = b; pb = a; break;
+    case Op::Div: pa = 1.0 / b; pb = -v / b; break;
+    case Op::PowI: pa = q.imm * applyOp(Op::PowI, a, 0.0, 0.0, q.imm - 1.0); break;
+    case Op::Sqrt: pa = a > 0.0 ? 0.5 / v : 0.0; break;
+    case Op::Abs: pa = a > 0.0 ? 1.0 : a < 0.0 ? -1.0 : 0.0; break;
+    case Op::Exp: pa = v; break;
+    case Op::Log: pa = a > kLogFloor ? 1.0 / a : 0.0; break;
+    case Op::Sin: pa = ownCos(a); break;
+    case Op::Cos: pa = -ownSin(a); break;
+    case Op::Atan: pa = 1.0 / (1.0 + a * a); break;
+    case Op::Tanh: pa = 1.0 - v * v; break;
+    case Op::Min: if (b < a ? depB : depA) pass = b < a ? db : da; break;
+    case Op::Max: if (b > a ? depB : depA) pass = b > a ? db : da; break;
+    case Op::RAnd: case Op::ROr: rFunctionPartials(q.op == Op::ROr, a, b, q.imm, pa, pb); break;
+    default: break;
+  }
+  if (pass) {
+    for (uint32_t j = 0; j < p; ++j) d[j] = pass[j];
+  } else {
+    const bool useA = depA && pa != 0.0, useB = depB && pb != 0.0;
+    for (uint32_t j = 0; j < p; ++j) {
+      double s = 0.0;
+      if (useA) s += pa * da[j];
+      if (useB) s += pb * db[j];
+      d[j] = std::isfinite(s) ? s : 0.0;
+    }
+  }
+}
+
 template <uint32_t P>
 double TermForm::pointGradImpl(const double* t) {
   const uint32_t p = P ? P : p_;
   double* pv = pv_.data();
-  double* pd = pd_.data();
+  const double* pd = pd_.data();
   for (const Step& q : steps_) {
-    double* d = pd + size_t(q.k) * p;
     if (q.op == Op::Var) {
       pv[q.k] = t[q.var];
-      for (uint32_t j = 0; j < p; ++j) d[j] = j == q.var ? 1.0 : 0.0;
-      continue;
+      continue;  // constant gradient (build)
     }
-    const double a = pv[q.a], b = pv[q.b], c = pv[q.c];
-    const double v = pointValue(q.op, a, b, c, q.imm);
+    const double a = pv[q.a], b = pv[q.b];
+    const double v = pointValue(q.op, a, b, pv[q.c], q.imm);
     pv[q.k] = v;
-    const bool depA = q.depA, depB = q.depB;
-    const double* da = pd + size_t(q.a) * p;
-    const double* db = pd + size_t(q.b) * p;
-    double pa = 0.0, pb = 0.0;
-    const double* pass = nullptr;
-    switch (q.op) {
-      case Op::Neg: pa = -1.0; break;
-      case Op::Copy: pa = 1.0; break;
-      case Op::Add: pa = 1.0; pb = 1.0; break;
-      case Op::Sub: pa = 1.0; pb = -1.0; break;
-      case Op::Mul: pa = b; pb = a; break;
-      case Op::Div: pa = 1.0 / b; pb = -v / b; break;
-      case Op::PowI: pa = q.imm * applyOp(Op::PowI, a, 0.0, 0.0, q.imm - 1.0); break;
-      case Op::Sqrt: pa = a > 0.0 ? 0.5 / v : 0.0; break;
-      case Op::Abs: pa = a > 0.0 ? 1.0 : a < 0.0 ? -1.0 : 0.0; break;
-      case Op::Exp: pa = v; break;
-      case Op::Log: pa = a > kLogFloor ? 1.0 / a : 0.0; break;
-      case Op::Sin: pa = ownCos(a); break;
-      case Op::Cos: pa = -ownSin(a); break;
-      case Op::Atan: pa = 1.0 / (1.0 + a * a); break;
-      case Op::Tanh: pa = 1.0 - v * v; break;
-      case Op::Min: if (b < a ? depB : depA) pass = b < a ? db : da; break;
-      case Op::Max: if (b > a ? depB : depA) pass = b > a ? db : da; break;
-      case Op::RAnd: case Op::ROr: rFunctionPartials(q.op == Op::ROr, a, b, q.imm, pa, pb); break;
-      default: break;
-    }
-    if (pass) {
-      for (uint32_t j = 0; j < p; ++j) d[j] = pass[j];
-    } else {
-      const bool useA = depA && pa != 0.0, useB = depB && pb != 0.0;
-      for (uint32_t j = 0; j < p; ++j) {
-        double s = 0.0;
-        if (useA) s += pa * da[j];
-        if (useB) s += pb * db[j];
-        d[j] = std::isfinite(s) ? s : 0.0;
-      }
-    }
+    if (!q.constGrad) stepGrad<P>(q, a, b, v);
   }
   const size_t K = terms_.size();
   tv_.resize(K);

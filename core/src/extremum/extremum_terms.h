@@ -96,12 +96,15 @@ class TermForm {
   struct Step {
     Op op;
     bool depA = false, depB = false, square = false;
+    bool constGrad = false;  // affine in t with constant coefficients: gradient set once by build
     uint32_t k = 0, a = 0, b = 0, c = 0, var = 0;
     double imm = 0.0;
   };
   std::vector<Step> steps_;
   template <uint32_t P>
   double pointGradImpl(const double* t);
+  template <uint32_t P>
+  void stepGrad(const Step& q, double a, double b, double v);
   template <uint32_t P>
   uint32_t ascendImpl(double* t, const double* lo, const double* hi, double tol, double stopAbove);
   void evalValues(const double* tlo, const double* thi);
