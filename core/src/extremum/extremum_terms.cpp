@@ -778,18 +778,34 @@ uint32_t TermForm::ascendImpl(double* t, const double* plo, const double* phi, d
     lam.assign(K, 0.0);
     lam[i0] = 1.0;
     for (uint32_t j = 0; j < p; ++j) w[j] = ag[i0 * p + j];
-    for (int sweep = 0; sweep < 6 && S.size() > 1; ++sweep) {
+    // Per pair (a, b) of S: the gradient difference g_b - g_a and its square norm, computed on
+    // first use and kept for the later sweeps.
+    const size_t ns = S.size();
+    pairDone_.assign(ns * ns, 0);
+    pairD_.resize(ns * ns * p);
+    pairDD_.resize(ns * ns);
+    for (int sweep = 0; sweep < 6 && ns > 1; ++sweep) {
       bool moved = false;  // a sweep that moves nothing leaves the same state for the next
-      for (uint32_t a : S) {
+      for (size_t ia = 0; ia < ns; ++ia) {
+        const uint32_t a = S[ia];
         if (lam[a] <= 0.0) continue;  // (lam[a] only decreases while a gives weight away)
-        for (uint32_t b : S) {
+        for (size_t ib = 0; ib < ns; ++ib) {
+          const uint32_t b = S[ib];
           if (a == b || lam[a] <= 0.0) continue;
-          double wd = 0.0, dd = 0.0;
-          for (uint32_t j = 0; j < p; ++j) {
-            const double dj = ag[b * p + j] - ag[a * p + j];
-            wd += w[j] * dj;
-            dd += dj * dj;
+          const size_t pair = ia * ns + ib;
+          double* D = &pairD_[pair * p];
+          if (!pairDone_[pair]) {
+            double dd = 0.0;
+            for (uint32_t j = 0; j < p; ++j) {
+              D[j] = ag[b * p + j] - ag[a * p + j];
+              dd += D[j] * D[j];
+            }
+            pairDD_[pair] = dd;
+            pairDone_[pair] = 1;
           }
+          double wd = 0.0;
+          for (uint32_t j = 0; j < p; ++j) wd += w[j] * D[j];
+          const double dd = pairDD_[pair];
           double sMove;
           if (dd > 0.0) sMove = -(mu * (av[b] - av[a]) + wd) / dd;
           else sMove = av[b] < av[a] ? lam[a] : 0.0;
@@ -797,7 +813,7 @@ uint32_t TermForm::ascendImpl(double* t, const double* plo, const double* phi, d
           if (!(sMove > 0.0)) continue;
           lam[a] -= sMove;
           lam[b] += sMove;
-          for (uint32_t j = 0; j < p; ++j) w[j] += sMove * (ag[b * p + j] - ag[a * p + j]);
+          for (uint32_t j = 0; j < p; ++j) w[j] += sMove * D[j];
           moved = true;
         }
       }

@@ -123,6 +123,8 @@ class TermForm {
   std::vector<double> pv_, pd_, tv_, tg_;
   std::vector<double> av_, ag_, lam_, w_, t1_;  // ascent scratch
   std::vector<uint32_t> sel_;
+  std::vector<double> pairD_, pairDD_;
+  std::vector<char> pairDone_;
   std::vector<double> cbuf_, Gl_, Gh_, vv_, clam_, H_, L_;  // upper() scratch
   std::vector<Interval> Dv_;
   std::vector<uint32_t> csel_;
