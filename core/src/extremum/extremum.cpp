@@ -352,16 +352,22 @@ struct ExtremumSolver::Impl {
         std::copy(t, t + I.p, bestT.begin());
       }
     }
-    // Tries the warm start when it lies in the domain, else the domain's centre (written to c;
-    // the centre of the root box is tried anyway when the search splits it).
-    // Returns whether the centre was tried.
-    bool seed(const double* warmT, std::vector<double>& c) {
+    // (The centre of the root box is tried anyway when the search splits it.)
+    // The warm start when it lies in the domain, else the domain's centre (written to c), as
+    // bestT, not evaluated. Returns whether it is the centre.
+    bool start(const double* warmT, std::vector<double>& c) {
       I.centre(I.plo.data(), I.phi.data(), c.data());
       bool inside = warmT;
       for (uint32_t k = 0; inside && k < I.p; ++k) inside = warmT[k] >= I.plo[k] && warmT[k] <= I.phi[k];
-      if (inside) tryPoint(warmT);
-      else tryPoint(c.data());
+      if (inside) std::copy(warmT, warmT + I.p, bestT.begin());
+      else std::copy(c.begin(), c.end(), bestT.begin());
       return !inside;
+    }
+    // start, and the point evaluated. Returns whether it is the centre.
+    bool seed(const double* warmT, std::vector<double>& c) {
+      const bool atCentre = start(warmT, c);
+      tryPoint(atCentre ? c.data() : warmT);
+      return atCentre;
     }
     // Whether a box with upper bound ub is dropped: it cannot beat the incumbent by more than
     // the tolerance (its bound is kept in prunedHi).
@@ -435,7 +441,10 @@ struct ExtremumSolver::Impl {
     tBest.assign(p, 0.0);
     tC.assign(p, 0.0);
     Search S(*this, X, tBest);
-    S.seed(warmT, tC);
+    // The start of the ascent: the warm start (else the centre). Only a sign search evaluates it
+    // first (its value may decide the sign); the ascent's end, evaluated below, is not worse.
+    if (signOnly) S.seed(warmT, tC);
+    else S.start(warmT, tC);
     const double tol = s.tolerance;
     auto signKnown = [&]() {
       S.r.value = sign * S.bestV;
