@@ -640,7 +640,7 @@ inline double pointValue(Op op, double a, double b, double c, double imm) {
 // The gradient of step q from its operands' gradients (pd_), a = its first operand's value,
 // b = its second's, v = its own.
 template <uint32_t P>
-void TermForm::stepGrad(const Step& q, double a, double b, double v) {
+inline void TermForm::stepGrad(const Step& q, double a, double b, double v) {
   const uint32_t p = P ? P : p_;
   double* pd = pd_.data();
   double* d = pd + size_t(q.k) * p;

@@ -104,7 +104,7 @@ class TermForm {
   template <uint32_t P>
   double pointGradImpl(const double* t);
   template <uint32_t P>
-  void stepGrad(const Step& q, double a, double b, double v);
+  [[gnu::always_inline]] inline void stepGrad(const Step& q, double a, double b, double v);
   template <uint32_t P>
   uint32_t ascendImpl(double* t, const double* lo, const double* hi, double tol, double stopAbove);
   void evalValues(const double* tlo, const double* thi);
