@@ -610,7 +610,7 @@ struct ExtremumSolver::Impl {
   // cover of the domain (refined best-first), the lower side the best interval lower bound of g
   // at fixed u (sound: max_u g(X, u) >= g(X, u0) for every X). Stops as soon as the sign is
   // decided, the enclosure is tighter than the tolerance, or the budget is spent.
-  Interval bound(const Interval* X, bool signOnly) {
+  Interval bound(const Interval* X, bool signOnly, bool budgetOnly) {
     uint64_t evals = 0;
     std::vector<double> lo(p), hi(p), clo(p), chi(p), c(p);
     pool.clear();
@@ -636,7 +636,7 @@ struct ExtremumSolver::Impl {
     while (!heap.empty() && evals + 3 <= hard) {
       const double U = std::max(L, heap.front().first);
       if ((signOnly && (L > 0 || U < 0)) || U - L <= s.tolerance) break;
-      if (evals + 3 > soft && U - L <= 4.0 * wx) break;
+      if (evals + 3 > soft && (budgetOnly || U - L <= 4.0 * wx)) break;
       const HeapEntry top = popBox(lo, hi);
       const uint32_t d = widestDim(lo.data(), hi.data());
       const double mid = 0.5 * (lo[d] + hi[d]);
@@ -687,7 +687,9 @@ ExtremumResult ExtremumSolver::solveGrid(const double* X) { return impl_->grid(X
 ExtremumResult ExtremumSolver::solveBranchAndBound(const double* X, const double* warmT) {
   return impl_->branchAndBound(X, warmT);
 }
-Interval ExtremumSolver::bound(const Interval* X, bool signOnly) { return impl_->bound(X, signOnly); }
+Interval ExtremumSolver::bound(const Interval* X, bool signOnly, bool budgetOnly) {
+  return impl_->bound(X, signOnly, budgetOnly);
+}
 
 double ExtremumSolver::gradient(const double* X, double* grad) {
   ExtremumResult r = solve(X);

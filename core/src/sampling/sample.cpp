@@ -127,6 +127,9 @@ class Sampler {
       }
     }
     ++w.stats.intervalEvals;
+    // Signs only: a box an extremum bound leaves undecided within its budget has its points
+    // searched (sign-only searches are cheap), with the same signs as a longer bound would give.
+    w.interval.setExtremumBudgetOnly(opt_.pointwiseSearches && opt_.extremumSignsOnly);
     return w.interval.eval(tape, w.box.data());
   }
 

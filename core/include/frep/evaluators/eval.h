@@ -102,6 +102,8 @@ class IntervalEvaluator {
   // that inside/outside classification needs). An outer search needs tight upper bounds
   // instead: signOnly = false (the extremum solver sets it for its body).
   void setExtremumSignOnly(bool signOnly) { extremumSignOnly_ = signOnly; }
+  // true: the sign-only bound stops at its budget (ExtremumSolver::bound's budgetOnly).
+  void setExtremumBudgetOnly(bool on) { extremumBudgetOnly_ = on; }
 
  private:
   std::vector<Interval> regs_;
@@ -110,6 +112,7 @@ class IntervalEvaluator {
   ExtremumSlots extrema_;
   std::vector<Interval> xbuf_;
   bool extremumSignOnly_ = true;
+  bool extremumBudgetOnly_ = false;
 };
 
 // 4. Forward-mode gradient: value and d/dx[i] for every coordinate of the tape. An extremum

@@ -95,7 +95,9 @@ class ExtremumSolver {
   ExtremumResult solveBranchAndBound(const double* X, const double* warmT = nullptr);
   // Sound enclosure of the extremum over an X box (interval evaluator). signOnly: stop as soon
   // as the sign is decided (classification); otherwise refine for a tight upper bound.
-  Interval bound(const Interval* Xbox, bool signOnly = true);
+  // budgetOnly: stop at intervalBudget evaluations (no continuation for boxes whose bound is
+  // much wider than the X box explains).
+  Interval bound(const Interval* Xbox, bool signOnly = true, bool budgetOnly = false);
   // Danskin: value and d f / d X_i = d g / d X_i at the arg-extremum (grad: n values).
   double gradient(const double* X, double* grad);
 
