@@ -6,10 +6,12 @@
 //     band voxels and extrapolated (it would take half an hour);
 //  2. the same pair with the paper's a = 0 R-intersection (Pasko-Minkowski eq. 3.3) in the body:
 //     whether B&B certifies, and its cost (grid extrapolated from a subset at the same eps);
-//  3. box + ball volume (inside voxels x voxel volume) against Steiner's formula.
+//  3. box + ball volume (inside voxels x voxel volume) against Steiner's formula;
+//  4. (--signs) the mesher's sample of issue 17's non-convex slab + ball (band 0, a cold search
+//     per point): full searches vs sign-only searches (ExtremumSolver::solveSign), same signs.
 // Times are CPU seconds of this process (single thread; the machine may be shared), wall
 // seconds in brackets; ratios use CPU seconds.
-// Usage: bench_extremum [--quick | --128 | --a0 | --steiner]   (--quick: 64^3 only)
+// Usage: bench_extremum [--quick | --128 | --a0 | --steiner | --signs]   (--quick: 64^3 only)
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -173,6 +175,46 @@ void steiner(int res) {
               100 * (v - vExact) / vExact, run.seconds, (unsigned long long)run.voxels, g.voxel);
 }
 
+// The mesher's sample of an extremum model (docs/mesh.md): band 0, cold searches; full values vs
+// sign-only searches, on the L-shaped plate (+) ball r 0.3 of bench_minkowski_peers.py (min/max
+// form, B&B gap 1e-3, searched box = the ball's), over [-1.5, 1.5]^3.
+void signOnlySampling(int res) {
+  const Expr slab = min(min(min(min(X() + 1, 1 - X()), min(Y() + 1, 1 - Y())), min(Z() + 0.25, 0.25 - Z())),
+                        -min(min(min(X() + 0.2, 1.3 - X()), min(Y() + 0.2, 1.3 - Y())), min(Z() + 1, 1 - Z())));
+  const Expr ball = 0.09 - square(X()) - square(Y()) - square(Z());
+  TapePtr t = Tape::compile(minkowskiSum(slab, ball, 3, {{-.3, -.3, -.3}, {.3, .3, .3}}, MinkowskiOptions{}));
+  GridSpec g = GridSpec::fromBounds({-1.5, -1.5, -1.5}, {1.5, 1.5, 1.5}, res);
+  std::printf("\nnon-convex slab + ball r 0.3 at %d^3: the mesher's sample (band 0, a cold search per point)\n", res);
+  std::printf("  %-28s %9s %14s %10s\n", "searches", "cpu s", "search evals", "points");
+  SampleResult r[2];
+  double cpu[2];
+  uint64_t evals[2];
+  for (int signs = 0; signs < 2; ++signs) {
+    SampleOptions o;
+    o.threads = 1;
+    o.bandVoxels = 0;
+    o.pointwiseSearches = true;
+    o.extremumSignsOnly = signs == 1;
+    resetExtremumCounters();
+    const double c0 = cpuSeconds();
+    r[signs] = sample(t, g, o);
+    cpu[signs] = cpuSeconds() - c0;
+    evals[signs] = extremumCounters().pointEvals + extremumCounters().intervalEvals;
+    std::printf("  %-28s %9.3f %14llu %10llu\n", signs ? "sign only (solveSign)" : "full (cold solve)", cpu[signs],
+                (unsigned long long)evals[signs], (unsigned long long)r[signs].stats.pointEvals);
+  }
+  uint64_t differ = 0, points = 0;
+  for (size_t i = 0; i < r[0].leaves.size() && i < r[1].leaves.size(); ++i)
+    for (int off = 0; off < kLeafVoxels; ++off) {
+      if (!r[0].leaves[i].isActive(off)) continue;
+      ++points;
+      differ += std::signbit(r[0].leaves[i].values[off]) != std::signbit(r[1].leaves[i].values[off]);
+    }
+  std::printf("  sign only / full: cpu %.2fx less, search evaluations %.2fx fewer; signs differing: %llu of %llu\n",
+              cpu[0] / cpu[1], double(evals[0]) / double(evals[1]), (unsigned long long)differ,
+              (unsigned long long)points);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -181,6 +223,11 @@ int main(int argc, char** argv) {
   const bool onlyA0 = argc > 1 && std::strcmp(argv[1], "--a0") == 0;
   const bool onlySteiner = argc > 1 && std::strcmp(argv[1], "--steiner") == 0;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  if (argc > 1 && std::strcmp(argv[1], "--signs") == 0) {
+    signOnlySampling(48);
+    signOnlySampling(96);
+    return 0;
+  }
   std::printf("Extremum node: fast (B&B) vs the paper's grid search at equal error bound, single thread\n");
   if (!only128 && !onlySteiner && !onlyA0) fastVsGrid(64, true);
   if (!quick && !onlySteiner && !onlyA0) fastVsGrid(128, false);

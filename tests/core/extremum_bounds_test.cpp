@@ -342,3 +342,72 @@ TEST(ExtremumTerms, SampledValuesAreTheSameForAnyBrickSplit) {
   EXPECT_EQ(leaves, ref.leaves.size());
   EXPECT_GT(leaves, 10u);
 }
+
+// solveSign (the mesher's sampled signs) stops a cold search once the sign of its value is
+// known: the sign bit must be the cold search's everywhere, also within the tolerance of the
+// zero set (points found by bisection on the cold search's sign), for max and min, box, ball and
+// 1D domains.
+TEST(ExtremumTerms, SignSearchHasTheSignOfTheColdSearch) {
+  const Expr X = x(0), Y = x(1), Z = x(2);
+  const Expr ballR = 0.3 - len3(X, Y, Z);
+  const Expr slab = min(min(min(1.0 - abs(X), 1.0 - abs(Y)), 0.25 - abs(Z)),
+                        -min(min(min(X + 0.2, 1.3 - X), min(Y + 0.2, 1.3 - Y)), 1.0 - abs(Z)));
+  MinkowskiOptions o1;
+  o1.tolerance = 0.01;
+  SearchOptions so;
+  so.tolerance = 0.01;
+  Motion helix;
+  helix.translation = {cos(x(0)), sin(x(0)), 0.2 * x(0)};
+  const Expr torus = 0.3 - sqrt(square(sqrt(square(X) + square(Y)) - 1.0) + square(Z));
+  const std::vector<std::pair<const char*, Expr>> models = {
+      {"non-convex slab + ball", minkowskiSum(slab, ballR, 3, {{-.3, -.3, -.3}, {.3, .3, .3}}, o1)},
+      {"erosion", minkowskiDifference(box3(X, Y, Z, 1.0), ballR, 3, {{-.3, -.3, -.3}, {.3, .3, .3}}, so)},
+      {"offset (ball domain)", offsetRadius(torus, 3, 0.2, so)},
+      {"sweep", sweep(ballR, 3, helix, 0.0, 3.0, so)},
+  };
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  for (const auto& [name, m] : models) {
+    TapePtr t = Tape::compile(m);
+    ASSERT_EQ(t->extrema().size(), 1u) << name;
+    const ExtremumEntry& e = t->extrema()[0];
+    ExtremumSolver cold(e.spec, e.body), signs(e.spec, e.body);
+    uint64_t coldEvals = 0, signEvals = 0;
+    int nearZero = 0, inside = 0, outside = 0;
+    auto check = [&](const double* p) {
+      const ExtremumResult a = cold.solve(p), b = signs.solveSign(p);
+      ASSERT_EQ(std::signbit(a.value), std::signbit(b.value)) << name << " at " << p[0] << " " << p[1] << " " << p[2];
+      ASSERT_EQ(std::isnan(a.value), std::isnan(b.value)) << name;
+      coldEvals += a.pointEvals + a.intervalEvals;
+      signEvals += b.pointEvals + b.intervalEvals;
+      nearZero += std::fabs(a.value) <= e.spec->tolerance;
+      (std::signbit(a.value) ? outside : inside) += 1;
+    };
+    for (int i = 0; i < 300; ++i) {
+      const double p[3] = {3.2 * U(rng) - 1.6, 3.2 * U(rng) - 1.6, 3.2 * U(rng) - 1.6};
+      check(p);
+    }
+    // Bisection between an inside and an outside point down to 1e-6: the last points lie within
+    // the tolerance of the zero set, where the sign is decided by the full search.
+    for (int i = 0; i < 40; ++i) {
+      double a[3], b[3];
+      for (int k = 0; k < 3; ++k) {
+        a[k] = 3.2 * U(rng) - 1.6;
+        b[k] = 3.2 * U(rng) - 1.6;
+      }
+      const bool ina = !std::signbit(cold.solve(a).value), inb = !std::signbit(cold.solve(b).value);
+      if (ina == inb) continue;
+      for (int it = 0; it < 22; ++it) {
+        double c[3];
+        for (int k = 0; k < 3; ++k) c[k] = 0.5 * (a[k] + b[k]);
+        check(c);
+        if (!std::signbit(cold.solve(c).value) == ina) std::copy(c, c + 3, a);
+        else std::copy(c, c + 3, b);
+      }
+    }
+    EXPECT_GT(nearZero, 20) << name;
+    EXPECT_GT(inside, 20) << name;
+    EXPECT_GT(outside, 20) << name;
+    EXPECT_LT(signEvals, coldEvals) << name;
+  }
+}

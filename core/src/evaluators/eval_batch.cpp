@@ -423,10 +423,11 @@ void BatchEvaluator<T>::runExtremum(const Tape& tape, const Instr& ins, size_t c
   xbuf_.resize(nin);
   res_.resize(kBatch);
   bool haveWarm = false;
+  const bool signOnly = signsOnly_ && !warmStarts_ && &ins == &tape.code().back() && ins.out == tape.resultReg();
   // Results go to a side buffer first: out may share a register with an input.
   for (size_t i = 0; i < count; ++i) {
     for (size_t k = 0; k < nin; ++k) xbuf_[k] = double(regs_[size_t(e.inputRegs[k]) * kBatch + i]);
-    ExtremumResult r = solver.solve(xbuf_.data(), haveWarm ? warm_.data() : nullptr);
+    ExtremumResult r = signOnly ? solver.solveSign(xbuf_.data()) : solver.solve(xbuf_.data(), haveWarm ? warm_.data() : nullptr);
     res_[i] = r.value;
     if (warmStarts_ && !r.t.empty()) {
       warm_ = r.t;

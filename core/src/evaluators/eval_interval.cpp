@@ -61,7 +61,7 @@ Interval IntervalEvaluator::eval(const Tape& tape, const Interval* box) {
       const ExtremumEntry& e = tape.extrema()[ins.a];
       xbuf_.resize(e.inputRegs.size());
       for (size_t i = 0; i < e.inputRegs.size(); ++i) xbuf_[i] = r[e.inputRegs[i]];
-      Interval b = extrema_.get(tape, ins.a).bound(xbuf_.data(), extremumSignOnly_);
+      Interval b = extrema_.get(tape, ins.a).bound(xbuf_.data(), extremumSignOnly_, extremumBudgetOnly_);
       // The bound encloses the true extremum; a certified search returns a value up to its
       // tolerance below a maximum (above a minimum): widen by that much, so that a sign the
       // interval decides is also the sign of every value the point evaluators compute.

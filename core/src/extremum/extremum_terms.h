@@ -29,6 +29,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "frep/expressions/expr.h"
@@ -71,11 +72,15 @@ class TermForm {
   // Values and gradients (w.r.t. t) of the terms at the point t, in double precision (search
   // directions only, never bounds). Returns min_i T_i.
   double pointGrad(const double* t);
+  // min_i T_i at the point t, without gradients (double precision: a guide, never a bound).
+  double pointMin(const double* t);
 
   // Local ascent of min_i T_i from t (in place, kept inside [lo, hi]) by proximal bundle steps;
-  // stops when a step gains less than a small fraction of tol. Returns the number of pointGrad
-  // calls.
-  uint32_t ascend(double* t, const double* lo, const double* hi, double tol);
+  // stops when a step gains less than a small fraction of tol, or once min_i T_i > stopAbove.
+  // Returns the number of pointGrad calls.
+  uint32_t ascend(double* t, const double* lo, const double* hi, double tol,
+                  double stopAbove = std::numeric_limits<double>::infinity());
+  double lastAscentValue() const { return lastF_; }  // min_i T_i where ascend left t
 
  private:
   struct Nd {
@@ -86,12 +91,29 @@ class TermForm {
     bool dep = false;     // depends on t
     bool square = false;  // x * x
   };
+  // The t-dependent nodes in order, as pointGrad and evalValues walk them (operand indices
+  // always valid: a missing operand reads the zero slot at index nodes_.size()).
+  struct Step {
+    Op op;
+    bool depA = false, depB = false, square = false;
+    bool constGrad = false;  // affine in t with constant coefficients: gradient set once by build
+    uint32_t k = 0, a = 0, b = 0, c = 0, var = 0;
+    double imm = 0.0;
+  };
+  std::vector<Step> steps_;
+  template <uint32_t P>
+  double pointGradImpl(const double* t);
+  template <uint32_t P>
+  [[gnu::always_inline]] inline void stepGrad(const Step& q, double a, double b, double v);
+  template <uint32_t P>
+  uint32_t ascendImpl(double* t, const double* lo, const double* hi, double tol, double stopAbove);
   void evalValues(const double* tlo, const double* thi);
   void evalBox(const double* tlo, const double* thi);  // values and interval gradients
   void evalCentre(const double* c);
   bool project(uint32_t k);
 
   uint32_t n_ = 0, p_ = 0;
+  double lastF_ = 0.0;
   bool ok_ = false;
   std::vector<Nd> nodes_;          // topological order (operands first)
   std::vector<int32_t> terms_;     // node of each term
@@ -101,6 +123,8 @@ class TermForm {
   std::vector<double> pv_, pd_, tv_, tg_;
   std::vector<double> av_, ag_, lam_, w_, t1_;  // ascent scratch
   std::vector<uint32_t> sel_;
+  std::vector<double> pairD_, pairDD_;
+  std::vector<char> pairDone_;
   std::vector<double> cbuf_, Gl_, Gh_, vv_, clam_, H_, L_;  // upper() scratch
   std::vector<Interval> Dv_;
   std::vector<uint32_t> csel_;

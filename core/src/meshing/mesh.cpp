@@ -196,6 +196,7 @@ class RegionMesher {
     const bool extremumPath = tape_->hasExtrema() && opt_.extremumVertices;
     so.bandVoxels = extremumPath ? 0 : 1;
     so.pointwiseSearches = extremumPath;  // signs that do not depend on the region
+    so.extremumSignsOnly = extremumPath;  // ... and only signs: searches stop once theirs is known
     so.fixedCoords = opt_.fixedCoords;
     so.threads = opt_.threads;
     for (int a = 0; a < 3; ++a) {

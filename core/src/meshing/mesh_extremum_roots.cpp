@@ -92,15 +92,23 @@ struct Worker {
 
 void extremumEdgeVertices(const TapePtr& tape, const GridSpec& grid, const MeshOptions& opt,
                           const std::vector<ExtremumEdge>& edges, std::vector<MeshVertex>& vertices, MeshStats& stats) {
-  // 1. The grid points whose values the edges need, sorted and unique.
+  // 1. The grid points whose values the edges need, sorted and unique (each chunk of edges
+  // drops its own repeats in parallel first: neighbouring edges share most corners).
+  tbb::enumerable_thread_specific<std::vector<uint64_t>> chunkKeys;
+  parallelChunks(edges.size(), 256, opt.threads, [&](size_t b, size_t e) {
+    std::vector<uint64_t>& out = chunkKeys.local();
+    const size_t first = out.size();
+    for (size_t i = b; i < e; ++i) {
+      tetrahedraAround(edgeKeyParts(edges[i].key), grid, [&](const std::array<int64_t, 3>& c, const int* pm) {
+        const int m1 = 1 << pm[0], m2 = m1 | (1 << pm[1]);
+        for (int m : {0, m1, m2, 7}) out.push_back(pointKey(cornerOf(c, m)));
+      });
+    }
+    std::sort(out.begin() + long(first), out.end());
+    out.erase(std::unique(out.begin() + long(first), out.end()), out.end());
+  });
   std::vector<uint64_t> keys;
-  keys.reserve(edges.size() * 4);
-  for (const ExtremumEdge& edge : edges) {
-    tetrahedraAround(edgeKeyParts(edge.key), grid, [&](const std::array<int64_t, 3>& c, const int* pm) {
-      const int m1 = 1 << pm[0], m2 = m1 | (1 << pm[1]);
-      for (int m : {0, m1, m2, 7}) keys.push_back(pointKey(cornerOf(c, m)));
-    });
-  }
+  for (const std::vector<uint64_t>& k : chunkKeys) keys.insert(keys.end(), k.begin(), k.end());
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   std::vector<double> values(keys.size());

@@ -127,6 +127,9 @@ class Sampler {
       }
     }
     ++w.stats.intervalEvals;
+    // Signs only: a box an extremum bound leaves undecided within its budget has its points
+    // searched (sign-only searches are cheap), with the same signs as a longer bound would give.
+    w.interval.setExtremumBudgetOnly(opt_.pointwiseSearches && opt_.extremumSignsOnly);
     return w.interval.eval(tape, w.box.data());
   }
 
@@ -249,6 +252,7 @@ class Sampler {
     w.batch.reserve(tape);
     w.batch.countDomainErrors(&w.stats.domainErrors);
     w.batch.setExtremumWarmStarts(!opt_.pointwiseSearches);
+    w.batch.setExtremumSignsOnly(opt_.pointwiseSearches && opt_.extremumSignsOnly);
     for (size_t start = 0; start < n; start += B) {
       size_t count = std::min(B, n - start);
       for (size_t k = 0; k < count; ++k) {

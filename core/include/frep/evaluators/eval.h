@@ -70,10 +70,15 @@ class BatchEvaluator {
   // false: every lane's search starts cold, so each value is a function of its point alone
   // (the PointEvaluator's value), at about twice the cost of warm-started lanes.
   void setExtremumWarmStarts(bool on) { warmStarts_ = on; }
+  // true (with warm starts off): an extremum that is the tape's last instruction and result
+  // runs ExtremumSolver::solveSign, so only the sign of each value is that of the cold search
+  // (what the mesher reads from its sample), at a fraction of the cost away from the surface.
+  void setExtremumSignsOnly(bool on) { signsOnly_ = on; }
 
  private:
   DomainCounts* domain_ = nullptr;
   bool warmStarts_ = true;
+  bool signsOnly_ = false;
   void bind(const Tape& tape);
   void runExtremum(const Tape& tape, const Instr& ins, size_t count);
   std::vector<T> regs_;  // numRegs * kBatch, register-major
@@ -97,6 +102,8 @@ class IntervalEvaluator {
   // that inside/outside classification needs). An outer search needs tight upper bounds
   // instead: signOnly = false (the extremum solver sets it for its body).
   void setExtremumSignOnly(bool signOnly) { extremumSignOnly_ = signOnly; }
+  // true: the sign-only bound stops at its budget (ExtremumSolver::bound's budgetOnly).
+  void setExtremumBudgetOnly(bool on) { extremumBudgetOnly_ = on; }
 
  private:
   std::vector<Interval> regs_;
@@ -105,6 +112,7 @@ class IntervalEvaluator {
   ExtremumSlots extrema_;
   std::vector<Interval> xbuf_;
   bool extremumSignOnly_ = true;
+  bool extremumBudgetOnly_ = false;
 };
 
 // 4. Forward-mode gradient: value and d/dx[i] for every coordinate of the tape. An extremum

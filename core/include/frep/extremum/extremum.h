@@ -87,11 +87,17 @@ class ExtremumSolver {
 
   // The spec's method. warmT: a previous result's t (numParams() values) to start from, or null.
   ExtremumResult solve(const double* X, const double* warmT = nullptr);
+  // A cold solve(X) cut short once the sign of its value is known: the value returned has the
+  // same sign bit as solve(X).value (for the mesher's signs), but it may be further from the
+  // extremum (certified is then false). Much cheaper away from the zero set.
+  ExtremumResult solveSign(const double* X);
   ExtremumResult solveGrid(const double* X);
   ExtremumResult solveBranchAndBound(const double* X, const double* warmT = nullptr);
   // Sound enclosure of the extremum over an X box (interval evaluator). signOnly: stop as soon
   // as the sign is decided (classification); otherwise refine for a tight upper bound.
-  Interval bound(const Interval* Xbox, bool signOnly = true);
+  // budgetOnly: stop at intervalBudget evaluations (no continuation for boxes whose bound is
+  // much wider than the X box explains).
+  Interval bound(const Interval* Xbox, bool signOnly = true, bool budgetOnly = false);
   // Danskin: value and d f / d X_i = d g / d X_i at the arg-extremum (grad: n values).
   double gradient(const double* X, double* grad);
 

@@ -54,6 +54,9 @@ struct SampleOptions {
   // Extremum searches start cold in every lane, so every value is a function of its point (as
   // PointEvaluator's) whatever the region: the mesher's signs. Default: warm-started lanes.
   bool pointwiseSearches = false;
+  // With pointwiseSearches: a model whose result is an extremum node stores values of which
+  // only the sign is the cold search's (ExtremumSolver::solveSign): for readers of signs only.
+  bool extremumSignsOnly = false;
   // Index-space region to sample, [lo, hi) per axis; lo must be a multiple of 8. Default: all.
   std::array<int32_t, 3> regionLo{0, 0, 0};
   std::array<int32_t, 3> regionHi{-1, -1, -1};
