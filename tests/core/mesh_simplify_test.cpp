@@ -256,6 +256,23 @@ TEST(MeshSimplify, SameResultWhateverTheSplit) {
   expectSameMesh(a, b);
 }
 
+// The farm's bricks of `brick` cells: each meshed and its own blocks simplified (meshRegion,
+// simplifyRegion, as a worker does), then merged (not finished).
+namespace {
+Mesh bricksMeshedAndSimplified(const TapePtr& tape, const GridSpec& g, const SimplifyOptions& so, int brick) {
+  std::vector<MeshPiece> pieces;
+  const int32_t cells = int32_t(g.dims[0] - 1);
+  for (int32_t x = 0; x < cells; x += brick)
+    for (int32_t y = 0; y < cells; y += brick)
+      for (int32_t z = 0; z < cells; z += brick) {
+        std::array<int32_t, 3> lo{x, y, z}, hi{std::min(cells, x + brick), std::min(cells, y + brick), std::min(cells, z + brick)};
+        pieces.push_back(meshRegion(tape, g, lo, hi));
+        simplifyRegion(pieces.back(), tape, g, so, lo, hi);
+      }
+  return mergePieces(pieces);
+}
+}  // namespace
+
 // The farm's way: each brick's piece simplified on its own (simplifyRegion, in the workers), then
 // merged and finished: the same mesh as simplifying the whole, for bricks that are multiples of
 // the 32-voxel blocks or not.
@@ -269,16 +286,7 @@ TEST(MeshSimplify, BricksSimplifyingTheirOwnBlocksGiveTheSameMesh) {
   SimplifyStats ws = simplifyMesh(whole, tape, g, so);
   for (int brick : {32, 64, 72, 96}) {  // 72: some blocks straddle bricks
     SCOPED_TRACE(brick);
-    std::vector<MeshPiece> pieces;
-    const int32_t cells = int32_t(g.dims[0] - 1);
-    for (int32_t x = 0; x < cells; x += brick)
-      for (int32_t y = 0; y < cells; y += brick)
-        for (int32_t z = 0; z < cells; z += brick) {
-          std::array<int32_t, 3> lo{x, y, z}, hi{std::min(cells, x + brick), std::min(cells, y + brick), std::min(cells, z + brick)};
-          pieces.push_back(meshRegion(tape, g, lo, hi));
-          simplifyRegion(pieces.back(), tape, g, so, lo, hi);
-        }
-    Mesh merged = mergePieces(pieces);
+    Mesh merged = bricksMeshedAndSimplified(tape, g, so, brick);
     EXPECT_GT(merged.carry.counters.collapses, 1000u);  // the bricks did a real share
     SimplifyOptions finish = so;
     finish.bricksSimplified = brick;
@@ -446,6 +454,7 @@ TEST(MeshSimplify, ErrorSamplesCoverTheTriangleAsTheFullSubdivisionDoes) {
 // underside at 0.3v + gap * v on the crease, sloping down at 0.6 to both sides, its top
 // plateThickness * v above (vertically). At every grid column the point z = 0 is outside both,
 // so the mesher keeps them apart.
+namespace {
 Expr ridgeUnderBentPlate(double v, double plateThickness, double gap) {
   const double top = 0.3 * v;
   const Expr u = X() - 0.5 * v;
@@ -454,6 +463,7 @@ Expr ridgeUnderBentPlate(double v, double plateThickness, double gap) {
   const Expr plate = min(blockAt(-0.011, 0.003, 0.0, 0.37, 0.32, 0.4), min(underside, plateThickness * v - underside));
   return max(ridge, plate);
 }
+}  // namespace
 
 TEST(MeshSimplify, RidgeUnderABentPlateNeedsTheIntersectionCheck) {
   const GridSpec g = cubeGrid(1.0, 49);  // x = 0 and z = 0 are grid planes
@@ -481,16 +491,7 @@ TEST(MeshSimplify, BlocksSimplifiedAgainGiveTheSameMeshWhateverTheSplit) {
   ASSERT_GT(ws.rejectedIntersection, 0u);  // a block was simplified again
   for (int brick : {16, 24, 40}) {
     SCOPED_TRACE(brick);
-    std::vector<MeshPiece> pieces;
-    const int32_t cells = int32_t(g.dims[0] - 1);
-    for (int32_t x = 0; x < cells; x += brick)
-      for (int32_t y = 0; y < cells; y += brick)
-        for (int32_t z = 0; z < cells; z += brick) {
-          std::array<int32_t, 3> lo{x, y, z}, hi{std::min(cells, x + brick), std::min(cells, y + brick), std::min(cells, z + brick)};
-          pieces.push_back(meshRegion(tape, g, lo, hi));
-          simplifyRegion(pieces.back(), tape, g, so, lo, hi);
-        }
-    Mesh merged = mergePieces(pieces);
+    Mesh merged = bricksMeshedAndSimplified(tape, g, so, brick);
     SimplifyOptions finish = so;
     finish.bricksSimplified = brick;
     const SimplifyStats fs = simplifyMesh(merged, tape, g, finish);

@@ -232,9 +232,20 @@ class MinHeap {
   void pop() {
     const T x = h_.back();
     h_.pop_back();
+    if (!h_.empty()) siftDown(0, x);
+  }
+  // Drops the elements `dead` accepts and rebuilds the heap (bottom-up, O(n)).
+  template <typename Dead>
+  void purge(Dead&& dead) {
+    h_.erase(std::remove_if(h_.begin(), h_.end(), dead), h_.end());
+    if (h_.size() < 2) return;
+    for (size_t k = (h_.size() - 2) / 4 + 1; k-- > 0;) siftDown(k, h_[k]);
+  }
+
+ private:
+  // Puts x at i or below, moving smaller children up.
+  void siftDown(size_t i, const T x) {
     const size_t n = h_.size();
-    if (n == 0) return;
-    size_t i = 0;
     for (;;) {
       const size_t c0 = 4 * i + 1;
       if (c0 >= n) break;
@@ -247,30 +258,7 @@ class MinHeap {
     }
     h_[i] = x;
   }
-  // Drops the elements `dead` accepts and rebuilds the heap (bottom-up, O(n)).
-  template <typename Dead>
-  void purge(Dead&& dead) {
-    h_.erase(std::remove_if(h_.begin(), h_.end(), dead), h_.end());
-    const size_t n = h_.size();
-    if (n < 2) return;
-    for (size_t k = (n - 2) / 4 + 1; k-- > 0;) {
-      const T x = h_[k];
-      size_t i = k;
-      for (;;) {
-        const size_t c0 = 4 * i + 1;
-        if (c0 >= n) break;
-        size_t best = c0;
-        for (size_t c = c0 + 1; c < std::min(c0 + 4, n); ++c)
-          if (h_[best] > h_[c]) best = c;
-        if (!(x > h_[best])) break;
-        h_[i] = h_[best];
-        i = best;
-      }
-      h_[i] = x;
-    }
-  }
 
- private:
   std::vector<T> h_;
 };
 
@@ -813,7 +801,7 @@ class Simplifier {
     V3 ringLo{INFINITY, INFINITY, INFINITY}, ringHi{-INFINITY, -INFINITY, -INFINITY};
     for (uint32_t t : changed) {
       const Tri& tr = w_.tris[t];
-      NewTri n{renamed(tr), {qcorner(tr[0]), qcorner(tr[1]), qcorner(tr[2])}, corner(tr[0]), corner(tr[0])};
+      NewTri n{renamed(tr), {qcorner(tr[0]), qcorner(tr[1]), qcorner(tr[2])}, corner(tr[0]), corner(tr[0]), {}, {}};
       for (int c = 1; c < 3; ++c)
         for (int k = 0; k < 3; ++k) n.lo[k] = std::min(n.lo[k], corner(tr[c])[k]), n.hi[k] = std::max(n.hi[k], corner(tr[c])[k]);
       for (int k = 0; k < 3; ++k) ringLo[k] = std::min(ringLo[k], n.lo[k]), ringHi[k] = std::max(ringHi[k], n.hi[k]);
