@@ -116,6 +116,7 @@ double quality(const V3& a, const V3& b, const V3& c) {
 constexpr int kMaxSamplesPerSide = 64;  // the error check's subdivision: m <= 64
 constexpr size_t kProbes = 4;           // error samples tried first on every new triangle
 constexpr int kGlobalStage = 3;         // SimplifyOptions::progress: the global pass
+constexpr int kClusterLevels = 2;       // cell contractions: cells of 2 and 4 voxels
 
 }  // namespace
 
@@ -282,6 +283,11 @@ class Simplifier {
   // the result.
   const SimplifyStats& run() {
     setUp();
+    // Cells of 2, 4, 8 voxels first (deferred mode only: the rerun of a block that failed the
+    // intersection check goes edge by edge), then the greedy edge collapses.
+    if (deferred_)
+      for (int level = 1; level <= kClusterLevels; ++level) contractCells(level);
+    pushAllCandidates();
     const bool report = opt_.progress && !w_.confined;  // the global pass only
     uint64_t examined = 0;
     // Most entries go stale (a collapse re-pushes its ring): when the heap has doubled since the
@@ -384,12 +390,18 @@ class Simplifier {
       for (uint32_t v : w_.tris[t]) vtris_[v].push_back(t);
       if (!deferred_) insertBuckets(t);
     }
-    for (uint32_t t = 0; t < w_.tris.size(); ++t)
+  }
+
+  // Every edge of the mesh as a collapse candidate.
+  void pushAllCandidates() {
+    for (uint32_t t = 0; t < w_.tris.size(); ++t) {
+      if (!tAlive_[t]) continue;
       for (int c = 0; c < 3; ++c) {
         uint32_t a = w_.tris[t][c], b = w_.tris[t][(c + 1) % 3];
         // Each undirected edge once (in a closed mesh; a block's open rim is locked anyway).
         if (a < b || !std::count(vtris_[b].begin(), vtris_[b].end(), t)) pushCandidate(a, b);
       }
+    }
   }
 
   // ---- positions ------------------------------------------------------------------------
@@ -781,6 +793,224 @@ class Simplifier {
                                                    // candidates' order is total
   }
 
+  // ---- cell contractions --------------------------------------------------------------------
+  // Before the greedy collapses, the vertices of one cell of 2^level voxels (by the grid edge
+  // they came from) are merged into one in a single step where that is safe: dual contouring's
+  // one vertex per cell (Ju et al.), reached from the marching tetrahedra's mesh, with the same
+  // checks as an edge collapse. One contraction of k vertices does the work of k - 1 edge
+  // collapses with one placement and one error check of its fan, instead of k - 1 of each and
+  // the heap traffic of every ring they change. Cells go in key order, each connected group of
+  // a cell's vertices once: the outcome is a function of the input (split-invariance).
+  void contractCells(int level) {
+    std::vector<std::pair<uint64_t, uint32_t>>& byCell = scratch_.byCell;
+    byCell.clear();
+    for (uint32_t v = 0; v < w_.pos.size(); ++v) {
+      if (!alive_[v] || w_.locked[v] || vtris_[v].empty()) continue;
+      const auto parts = edgeKeyParts(w_.key[v]);
+      byCell.push_back({edgeKey(parts[0] >> level, parts[1] >> level, parts[2] >> level, 0), v});
+    }
+    std::sort(byCell.begin(), byCell.end());
+    std::vector<uint32_t>& group = scratch_.group;
+    std::vector<uint32_t>& component = scratch_.component;
+    for (size_t i = 0; i < byCell.size();) {
+      size_t j = i;
+      while (j < byCell.size() && byCell[j].first == byCell[i].first) ++j;
+      if (j - i >= 2) {
+        group.clear();
+        const uint32_t inGroup = nextMark();
+        for (size_t k = i; k < j; ++k) group.push_back(byCell[k].second), markA_[byCell[k].second] = inGroup;
+        // Connected pieces of the group (two sheets through one cell are two pieces).
+        const uint32_t taken = nextMark();
+        for (uint32_t seed : group) {
+          if (markB_[seed] == taken) continue;
+          component.assign(1, seed);
+          markB_[seed] = taken;
+          for (size_t q = 0; q < component.size(); ++q)
+            for (uint32_t t : vtris_[component[q]])
+              for (uint32_t u : w_.tris[t])
+                if (markA_[u] == inGroup && markB_[u] != taken) markB_[u] = taken, component.push_back(u);
+          if (component.size() >= 2) {
+            std::sort(component.begin(), component.end());
+            tryContract(component);
+            // tryContract used the marks: restore the group's for its other pieces
+            for (uint32_t u : group) markA_[u] = inGroup;
+          }
+        }
+      }
+      i = j;
+    }
+  }
+
+  // Merges the connected vertices C into one if the surface stays a closed 2-manifold of the
+  // same genus and the checks of an edge collapse pass (shape, error against the model).
+  void tryContract(const std::vector<uint32_t>& C) {
+    std::vector<uint32_t>&star = scratch_.changed, &gone = scratch_.removed, &ring = scratch_.ring;
+    star.clear(), gone.clear(), ring.clear();
+    std::vector<Fan>& fan = scratch_.fan;
+    fan.clear();
+    const uint32_t inC = nextMark();
+    for (uint32_t c : C) markA_[c] = inC;
+    ++stampNow_;
+    for (uint32_t c : C)
+      for (uint32_t t : vtris_[c]) {
+        if (probe_[t].skip == stampNow_) continue;
+        probe_[t].skip = stampNow_;
+        const Tri& tr = w_.tris[t];
+        int n = 0, at = 0;
+        for (int k = 0; k < 3; ++k)
+          if (markA_[tr[k]] == inC) ++n, at = k;
+        if (n == 1)
+          fan.push_back({t, tr[at], tr[(at + 1) % 3], tr[(at + 2) % 3]});
+        else
+          gone.push_back(t);
+      }
+    // Topology: the far edges u -> w of the fan form one simple cycle through every vertex next
+    // to C, and the star of C is a disk (Euler: F = 2|C| + |fan| - 2, the edges other than the
+    // cycle's being shared by two of its triangles), so C becomes one vertex inside that cycle.
+    const size_t nc = C.size(), nf = fan.size();
+    bool ok = nf >= 3 && gone.size() + nf == 2 * nc + nf - 2;
+    const uint32_t onCycle = nextMark();
+    std::vector<uint32_t>& next = scratch_.next;
+    if (ok) {
+      if (next.size() < w_.pos.size()) next.resize(w_.pos.size());
+      for (const Fan& f : fan) {
+        if (markB_[f.u] == onCycle) ok = false;
+        markB_[f.u] = onCycle, next[f.u] = f.w;
+      }
+    }
+    if (ok) {
+      uint32_t u = fan[0].u;
+      size_t steps = 0;
+      do {
+        if (markB_[u] != onCycle || steps > nf) { ok = false; break; }
+        u = next[u], ++steps;
+      } while (u != fan[0].u);
+      ok = ok && steps == nf;
+    }
+    if (ok)  // every vertex of the star outside C is on the cycle
+      for (uint32_t t : gone)
+        for (uint32_t v : w_.tris[t]) ok = ok && (markA_[v] == inC || markB_[v] == onCycle);
+    if (ok)  // the cycle's vertices keep at least three triangles
+      for (const Fan& f : fan) {
+        size_t inStar = 0;
+        for (uint32_t t : vtris_[f.u]) inStar += probe_[t].skip == stampNow_;
+        ok = ok && vtris_[f.u].size() - inStar + 2 >= 3;
+      }
+    if (ok && nf == 3)  // three cycle vertices that already bound a triangle: a closed tetrahedron
+      for (uint32_t t : vtris_[fan[0].u]) {
+        if (probe_[t].skip == stampNow_) continue;
+        int n = 0;
+        for (uint32_t v : w_.tris[t]) n += v == fan[1].u || v == fan[2].u;
+        ok = ok && n < 2;
+      }
+    if (!ok) {
+      ++stats_.rejectedTopology;
+      return;
+    }
+
+    // Placement: the least-squares point of the merged quadric (on edges and corners of the
+    // model), else the member where the quadric is least.
+    Quadric q = w_.quad[C[0]];
+    V3 mid = w_.pos[C[0]];
+    double weight = w_.quad[C[0]].weight;
+    for (size_t k = 1; k < nc; ++k) q += w_.quad[C[k]], mid = add(mid, w_.pos[C[k]]), weight += w_.quad[C[k]].weight;
+    mid = scale(mid, 1.0 / double(nc));
+    uint32_t survivor = C[0];
+    double cost = q(w_.pos[C[0]]);
+    for (size_t k = 1; k < nc; ++k) {
+      const double ck = q(w_.pos[C[k]]);
+      if (ck < cost) cost = ck, survivor = C[k];
+    }
+    V3 p = w_.pos[survivor];
+    bool atMember = true;
+    if (opt_.sharpFeatures) {
+      const V3 x = q.minimiser(mid);
+      double reach = grid_.voxel;
+      for (uint32_t c : C) reach = std::max(reach, 2 * norm(sub(w_.pos[c], mid)));
+      const double cx = q(x);
+      bool inside = true;
+      for (int k = 0; k < 3 && w_.confined; ++k) inside = inside && x[k] >= w_.regionLo[k] && x[k] <= w_.regionHi[k];
+      if (inside && norm(sub(x, mid)) <= reach && std::isfinite(cx) && cx <= cost) cost = cx, p = x, atMember = false;
+    }
+    if (cost > tol_ * tol_ * weight) {
+      ++stats_.rejectedError;
+      return;
+    }
+
+    // Shape, as for an edge collapse: no fan triangle turns over or degenerates, and below the
+    // quality bound the worst of the star does not get more than 10% worse.
+    double worstBefore = 1, worstAfter = 1;
+    for (uint32_t t : gone) worstBefore = std::min(worstBefore, quality(w_.pos[w_.tris[t][0]], w_.pos[w_.tris[t][1]], w_.pos[w_.tris[t][2]]));
+    for (const Fan& f : fan) {
+      const V3 &o0 = w_.pos[f.c], &o1 = w_.pos[f.u], &o2 = w_.pos[f.w];
+      const double q0 = quality(o0, o1, o2);
+      worstBefore = std::min(worstBefore, q0);
+      const V3 n0 = q0 < opt_.minQuality ? add(w_.normal[f.c], add(w_.normal[f.u], w_.normal[f.w])) : cross(sub(o1, o0), sub(o2, o0));
+      const V3 n1 = cross(sub(o1, p), sub(o2, p));
+      const double l1 = norm(n1);
+      worstAfter = std::min(worstAfter, quality(p, o1, o2));
+      if (!(l1 > 1e-12 * grid_.voxel * grid_.voxel) || dot(n0, n1) <= 0.2 * norm(n0) * l1) {
+        ++stats_.rejectedShape;
+        return;
+      }
+    }
+    if (worstAfter < opt_.minQuality && worstAfter < 0.9 * worstBefore) {
+      ++stats_.rejectedShape;
+      return;
+    }
+
+    // Error: the merged vertices stay within e of the fan, and every fan triangle within e of
+    // the surface (levels), e the worst level of the star.
+    int allowed = 0;
+    for (const Fan& f : fan) allowed = std::max(allowed, levelOf(f.t));
+    for (uint32_t t : gone) allowed = std::max(allowed, levelOf(t));
+    const double e = std::ldexp(tol_, allowed);
+    for (uint32_t c : C) {
+      double d = INFINITY;
+      for (const Fan& f : fan) d = std::min(d, pointTriangleDistance(w_.pos[c], p, w_.pos[f.u], w_.pos[f.w]));
+      if (d > e) {
+        ++stats_.rejectedError;
+        return;
+      }
+    }
+    std::vector<LevelQuery>& qs = scratch_.queries;
+    qs.assign(nf, {});
+    for (size_t i = 0; i < nf; ++i) qs[i].a = p, qs[i].b = w_.pos[fan[i].u], qs[i].c = w_.pos[fan[i].w];
+    if (!levels(qs, allowed, true)) {
+      ++stats_.rejectedError;
+      return;
+    }
+
+    // Apply: the survivor keeps its key (and normal) when the point is its own position.
+    for (uint32_t t : gone) {
+      tAlive_[t] = 0;
+      for (uint32_t v : w_.tris[t]) {
+        if (markA_[v] == inC) continue;
+        auto& l = vtris_[v];
+        l.erase(std::find(l.begin(), l.end(), t));
+      }
+    }
+    std::vector<uint32_t>& around = vtris_[survivor];
+    around.clear();
+    for (size_t i = 0; i < nf; ++i) {
+      const Fan& f = fan[i];
+      for (uint32_t& v : w_.tris[f.t])
+        if (v == f.c) v = survivor;
+      around.push_back(f.t);
+      w_.level[f.t] = int8_t(qs[i].level);
+      w_.made[f.t] = 1;
+      madeNow_[f.t] = 1;
+    }
+    for (uint32_t c : C)
+      if (c != survivor) alive_[c] = 0, vtris_[c].clear();
+    if (!atMember) w_.moved[survivor] = 1;
+    w_.pos[survivor] = p;
+    qpos_[survivor] = quantise(p);
+    w_.quad[survivor] = q;
+    ++version_[survivor];
+    stats_.collapses += nc - 1;
+  }
+
   // Self-intersection: the new triangles of collapsing a, b to p against each other, then
   // against every other triangle near them whose box meets theirs.
   bool noIntersection(uint32_t a, uint32_t b, const V3& p, const exact::P& qp, const std::vector<uint32_t>& changed,
@@ -921,11 +1151,17 @@ class Simplifier {
   std::array<uint32_t, kPairsPerCall> laneQuery_{};  // whose each pair is
   std::vector<char> failed_;  // per query of levels()
   std::vector<double*> inputs_;  // the batch evaluator's input lanes, one array per coordinate
+  struct Fan {  // a triangle of a contraction's star with one corner in the contracted set
+    uint32_t t, c, u, w;  // triangle t = (c, u, w) in its winding, c in the set
+  };
   struct Scratch {
     std::vector<uint32_t> opposite, changed, removed, ring;
     std::vector<int8_t> newLevel;
     std::vector<LevelQuery> queries;
     std::vector<uint64_t> cells;  // hash cells of the self-intersection check
+    std::vector<std::pair<uint64_t, uint32_t>> byCell;  // cell contractions
+    std::vector<uint32_t> group, component, next;
+    std::vector<Fan> fan;
   } scratch_;
   struct NewTri {  // a triangle as a collapse would leave it
     Tri t;
