@@ -116,7 +116,7 @@ double quality(const V3& a, const V3& b, const V3& c) {
 constexpr int kMaxSamplesPerSide = 64;  // the error check's subdivision: m <= 64
 constexpr size_t kProbes = 4;           // error samples tried first on every new triangle
 constexpr int kGlobalStage = 3;         // SimplifyOptions::progress: the global pass
-constexpr int kClusterLevels = 2;       // cell contractions: cells of 2 and 4 voxels
+constexpr int kClusterLevels = 2;       // cell contractions: cells of 1, 2 and 4 voxels
 
 }  // namespace
 
@@ -283,10 +283,10 @@ class Simplifier {
   // the result.
   const SimplifyStats& run() {
     setUp();
-    // Cells of 2, 4, 8 voxels first (deferred mode only: the rerun of a block that failed the
+    // Cells of 1, 2 and 4 voxels first (deferred mode only: the rerun of a block that failed the
     // intersection check goes edge by edge), then the greedy edge collapses.
     if (deferred_)
-      for (int level = 1; level <= kClusterLevels; ++level) contractCells(level);
+      for (int level = 0; level <= kClusterLevels; ++level) contractCells(level);
     pushAllCandidates();
     const bool report = opt_.progress && !w_.confined;  // the global pass only
     uint64_t examined = 0;
@@ -625,7 +625,7 @@ class Simplifier {
   int levelOf(uint32_t t) {
     if (w_.level[t] < 0) {
       const Tri& tr = w_.tris[t];
-      std::vector<LevelQuery>& qs = scratch_.queries;
+      std::vector<LevelQuery>& qs = scratch_.ownLevel;  // not queries: errorPasses holds those
       qs.assign(1, {});
       LevelQuery& q = qs[0];
       q.a = w_.pos[tr[0]], q.b = w_.pos[tr[1]], q.c = w_.pos[tr[2]];
@@ -635,6 +635,31 @@ class Simplifier {
       w_.level[t] = int8_t(std::min(qs[0].level, maxLevel_));  // beyond the last level: no more allowance
     }
     return w_.level[t];
+  }
+
+  // The error check of a collapse or a contraction, whose new triangles are qs: the removed
+  // vertices (gone) lie within e of the new triangles and every new triangle within e of the
+  // surface (levels), e = tolerance * 2^allowed, allowed the worst level of the replaced
+  // triangles (at least 0: the mesher's chords across a crease may be deeper than the
+  // tolerance). That worst level is measured only when the tolerance alone does not pass: the
+  // same outcome and the same levels, and most of the mesher's triangles never need theirs.
+  bool errorPasses(std::vector<LevelQuery>& qs, const std::vector<V3>& gone, const std::vector<uint32_t>& replaced) {
+    int allowed = 0;
+    for (bool measured = false;; measured = true) {
+      const double e = std::ldexp(tol_, allowed);
+      bool near = true;
+      for (size_t i = 0; i < gone.size() && near; ++i) {
+        double d = INFINITY;
+        for (const LevelQuery& q : qs) d = std::min(d, pointTriangleDistance(gone[i], q.a, q.b, q.c));
+        near = d <= e;
+      }
+      if (near && levels(qs, allowed, true)) return true;
+      if (measured) return false;
+      int worst = 0;
+      for (uint32_t t : replaced) worst = std::max(worst, levelOf(t));
+      if (worst == allowed) return false;
+      allowed = worst;
+    }
   }
 
   // ---- one collapse ---------------------------------------------------------------------------
@@ -708,31 +733,19 @@ class Simplifier {
       return;
     }
 
-    // Error: allowed level = the worst of the replaced triangles (at least the tolerance).
-    int allowed = 0;
-    for (uint32_t t : changed) allowed = std::max(allowed, levelOf(t));
-    for (uint32_t t : removed) allowed = std::max(allowed, levelOf(t));
-    // The removed vertices stay within the allowed error of the new triangles (cheap: first).
-    const double e = std::ldexp(tol_, allowed);
-    for (uint32_t v : {a, b}) {
-      double d = INFINITY;
-      for (uint32_t t : changed) {
-        const Tri& tr = w_.tris[t];
-        d = std::min(d, pointTriangleDistance(w_.pos[v], corner(tr[0]), corner(tr[1]), corner(tr[2])));
-      }
-      if (d > e) {
-        ++stats_.rejectedError;
-        return;
-      }
-    }
-    // Every new triangle's level, all checked together (levels()).
+    // Error: within the tolerance, or within the worst of the replaced triangles (errorPasses).
     std::vector<LevelQuery>& qs = scratch_.queries;
     qs.assign(changed.size(), {});
     for (size_t i = 0; i < changed.size(); ++i) {
       const Tri& tr = w_.tris[changed[i]];
       qs[i].a = corner(tr[0]), qs[i].b = corner(tr[1]), qs[i].c = corner(tr[2]);
     }
-    if (!levels(qs, allowed, true)) {
+    std::vector<V3>& gonePoints = scratch_.gonePoints;
+    gonePoints = {w_.pos[a], w_.pos[b]};
+    std::vector<uint32_t>& replaced = scratch_.replaced;
+    replaced = changed;
+    replaced.insert(replaced.end(), removed.begin(), removed.end());
+    if (!errorPasses(qs, gonePoints, replaced)) {
       ++stats_.rejectedError;
       return;
     }
@@ -959,24 +972,17 @@ class Simplifier {
       return;
     }
 
-    // Error: the merged vertices stay within e of the fan, and every fan triangle within e of
-    // the surface (levels), e the worst level of the star.
-    int allowed = 0;
-    for (const Fan& f : fan) allowed = std::max(allowed, levelOf(f.t));
-    for (uint32_t t : gone) allowed = std::max(allowed, levelOf(t));
-    const double e = std::ldexp(tol_, allowed);
-    for (uint32_t c : C) {
-      double d = INFINITY;
-      for (const Fan& f : fan) d = std::min(d, pointTriangleDistance(w_.pos[c], p, w_.pos[f.u], w_.pos[f.w]));
-      if (d > e) {
-        ++stats_.rejectedError;
-        return;
-      }
-    }
+    // Error: within the tolerance, or within the worst of the star's triangles (errorPasses).
     std::vector<LevelQuery>& qs = scratch_.queries;
     qs.assign(nf, {});
     for (size_t i = 0; i < nf; ++i) qs[i].a = p, qs[i].b = w_.pos[fan[i].u], qs[i].c = w_.pos[fan[i].w];
-    if (!levels(qs, allowed, true)) {
+    std::vector<V3>& gonePoints = scratch_.gonePoints;
+    gonePoints.clear();
+    for (uint32_t c : C) gonePoints.push_back(w_.pos[c]);
+    std::vector<uint32_t>& replaced = scratch_.replaced;
+    replaced = gone;
+    for (const Fan& f : fan) replaced.push_back(f.t);
+    if (!errorPasses(qs, gonePoints, replaced)) {
       ++stats_.rejectedError;
       return;
     }
@@ -1157,10 +1163,11 @@ class Simplifier {
   struct Scratch {
     std::vector<uint32_t> opposite, changed, removed, ring;
     std::vector<int8_t> newLevel;
-    std::vector<LevelQuery> queries;
+    std::vector<LevelQuery> queries, ownLevel;
     std::vector<uint64_t> cells;  // hash cells of the self-intersection check
     std::vector<std::pair<uint64_t, uint32_t>> byCell;  // cell contractions
-    std::vector<uint32_t> group, component, next;
+    std::vector<uint32_t> group, component, next, replaced;
+    std::vector<V3> gonePoints;
     std::vector<Fan> fan;
   } scratch_;
   struct NewTri {  // a triangle as a collapse would leave it
