@@ -317,9 +317,12 @@ class Simplifier {
   // After a deferred run: does no triangle a collapse made meet a triangle near it improperly
   // (the same exact predicates as the per-collapse check, once per final triangle)?
   bool embedded() {
-    buckets_.clear();
+    // The triangles filed once, in one array sorted by cell (no hash map of lists to build).
+    std::vector<std::pair<uint64_t, Entry>>& filed = scratch_.filed;
+    filed.clear();
     for (uint32_t t = 0; t < w_.tris.size(); ++t)
-      if (tAlive_[t]) insertBuckets(t);
+      if (tAlive_[t]) fileTriangle(t, [&](uint64_t k, const Entry& e) { filed.push_back({k, e}); });
+    std::sort(filed.begin(), filed.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
     std::vector<uint64_t>& cellKeys = scratch_.cells;
     for (uint32_t t = 0; t < w_.tris.size(); ++t) {
       if (!tAlive_[t] || !madeNow_[t]) continue;
@@ -337,9 +340,9 @@ class Simplifier {
       ++probeNow_;
       probe_[t].seen = probeNow_;
       for (uint64_t key : cellKeys) {
-        auto it = buckets_.find(key);
-        if (it == buckets_.end()) continue;
-        for (const Entry& e : it->second) {
+        auto at = std::lower_bound(filed.begin(), filed.end(), key, [](const auto& x, uint64_t k) { return x.first < k; });
+        for (; at != filed.end() && at->first == key; ++at) {
+          const Entry& e = at->second;
           if (e.hi[0] < flo[0] || e.lo[0] > fhi[0] || e.hi[1] < flo[1] || e.lo[1] > fhi[1] || e.hi[2] < flo[2] ||
               e.lo[2] > fhi[2])
             continue;
@@ -502,18 +505,23 @@ class Simplifier {
           f(cellKey(x, y, z));
         }
   }
-  void insertBuckets(uint32_t t) {
+  // Calls f(cell, entry) for the cells triangle t is filed under. The entry carries the
+  // triangle's box (float, rounded outwards past a 1e-3 voxel margin), so a query scans its
+  // cells' entries in order and touches a triangle only if the boxes meet.
+  template <typename F>
+  void fileTriangle(uint32_t t, F&& f) const {
     const Tri& tr = w_.tris[t];
     const V3 &a = w_.pos[tr[0]], &b = w_.pos[tr[1]], &c = w_.pos[tr[2]];
-    // The entry carries the triangle's box (float, rounded outwards past a 1e-3 voxel margin), so
-    // a query scans its cells' entries in order and touches a triangle only if the boxes meet.
     Entry e{t, {}, {}};
     const double margin = 1e-3 * grid_.voxel;
     for (int k = 0; k < 3; ++k) {
       e.lo[k] = std::nextafter(float(std::min({a[k], b[k], c[k]}) - margin), -INFINITY);
       e.hi[k] = std::nextafter(float(std::max({a[k], b[k], c[k]}) + margin), INFINITY);
     }
-    forTriangleCells(a, b, c, [&](uint64_t k) { buckets_[k].push_back(e); });
+    forTriangleCells(a, b, c, [&](uint64_t k) { f(k, e); });
+  }
+  void insertBuckets(uint32_t t) {
+    fileTriangle(t, [&](uint64_t k, const Entry& e) { buckets_[k].push_back(e); });
   }
   // Before any corner of t moves (the same cells as its insertion).
   void eraseBuckets(uint32_t t) {
@@ -1157,6 +1165,10 @@ class Simplifier {
   std::array<uint32_t, kPairsPerCall> laneQuery_{};  // whose each pair is
   std::vector<char> failed_;  // per query of levels()
   std::vector<double*> inputs_;  // the batch evaluator's input lanes, one array per coordinate
+  struct Entry {
+    uint32_t tri;
+    float lo[3], hi[3];
+  };
   struct Fan {  // a triangle of a contraction's star with one corner in the contracted set
     uint32_t t, c, u, w;  // triangle t = (c, u, w) in its winding, c in the set
   };
@@ -1165,6 +1177,7 @@ class Simplifier {
     std::vector<int8_t> newLevel;
     std::vector<LevelQuery> queries, ownLevel;
     std::vector<uint64_t> cells;  // hash cells of the self-intersection check
+    std::vector<std::pair<uint64_t, Entry>> filed;  // embedded()
     std::vector<std::pair<uint64_t, uint32_t>> byCell;  // cell contractions
     std::vector<uint32_t> group, component, next, replaced;
     std::vector<V3> gonePoints;
@@ -1193,10 +1206,6 @@ class Simplifier {
   };
   std::vector<Probe> probe_;
   uint32_t stampNow_ = 0, probeNow_ = 0;
-  struct Entry {
-    uint32_t tri;
-    float lo[3], hi[3];
-  };
   std::unordered_map<uint64_t, std::vector<Entry>> buckets_;
   // Per-vertex marks (link condition, ring): == the current mark means "in the set".
   std::vector<uint32_t> markA_, markB_;
@@ -1214,14 +1223,14 @@ class Simplifier {
 // thrown away and w simplified again with the check at every collapse, so the outcome is still a
 // function of w alone (split-invariance) and always embedded. The per-collapse check cost ~40%
 // of the simplification and almost never rejects anything (docs/mesh.md).
-std::unique_ptr<Simplifier> simplifyChecked(Work&& w, const TapePtr& tape, const GridSpec& grid,
+// `input` makes w (called a second time for the rerun: no copy is kept for a rare event).
+std::unique_ptr<Simplifier> simplifyChecked(const std::function<Work()>& input, const TapePtr& tape, const GridSpec& grid,
                                             const SimplifyOptions& opt, SimplifyStats& stats) {
-  Work input = w;
-  auto s = std::make_unique<Simplifier>(std::move(w), tape, grid, opt, true);
+  auto s = std::make_unique<Simplifier>(input(), tape, grid, opt, true);
   stats = s->run();
   if (s->embedded()) return s;
   const uint64_t spent = stats.modelEvals;
-  s = std::make_unique<Simplifier>(std::move(input), tape, grid, opt, false);
+  s = std::make_unique<Simplifier>(input(), tape, grid, opt, false);
   stats = s->run();
   stats.modelEvals += spent;
   return s;
@@ -1305,26 +1314,47 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
   auto inside = [](const V3& p, const V3& lo, const V3& hi) {
     return p[0] > lo[0] && p[0] < hi[0] && p[1] > lo[1] && p[1] < hi[1] && p[2] > lo[2] && p[2] < hi[2];
   };
-  std::vector<std::vector<uint32_t>> vt(nv);
-  for (uint32_t t = 0; t < nt; ++t)
-    for (uint32_t v : g.tris[t]) vt[v].push_back(t);
-  // Owned vertices by block (ordered: the write-back order is fixed).
-  std::map<BlockKey, std::vector<uint32_t>> owned;
-  for (uint32_t v = 0; v < nv; ++v) {
-    if (vt[v].empty()) continue;
-    BlockKey b = blockOf(g.pos[v]);
-    V3 lo, hi;
-    shrunk(b, lo, hi);
-    bool ok = true;
-    for (uint32_t t : vt[v])
-      for (uint32_t u : g.tris[t]) ok = ok && inside(g.pos[u], lo, hi);
-    if (ok) owned[b].push_back(v);
-  }
-  for (auto it = owned.begin(); it != owned.end();) it = mine(it->first) ? std::next(it) : owned.erase(it);
+  // The blocks this pass does (those `mine` accepts among the vertices' blocks): none, nothing
+  // to set up (e.g. the master's first pass when the bricks did every block).
+  std::vector<BlockKey> vblock(nv);
   std::vector<BlockKey> blocks;
-  for (auto& [b, vs] : owned) blocks.push_back(b);
-  // Obstacle candidates: every triangle under each block its box meets.
-  std::map<BlockKey, std::vector<uint32_t>> near;
+  for (uint32_t v = 0; v < nv; ++v) blocks.push_back(vblock[v] = blockOf(g.pos[v]));
+  std::sort(blocks.begin(), blocks.end());
+  blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
+  blocks.erase(std::remove_if(blocks.begin(), blocks.end(), [&](const BlockKey& b) { return !mine(b); }), blocks.end());
+  if (blocks.empty()) {
+    if (opt.progress) opt.progress(pass, 0, 0);
+    return;
+  }
+  auto blockIndex = [&](const BlockKey& b) -> int64_t {
+    auto it = std::lower_bound(blocks.begin(), blocks.end(), b);
+    return it != blocks.end() && *it == b ? it - blocks.begin() : -1;
+  };
+  // Triangles around each vertex, flat (offsets into one array).
+  std::vector<uint32_t> vtStart(nv + 1, 0), vtList(3 * nt);
+  for (const Tri& tr : g.tris)
+    for (uint32_t v : tr) ++vtStart[v + 1];
+  for (size_t v = 0; v < nv; ++v) vtStart[v + 1] += vtStart[v];
+  {
+    std::vector<uint32_t> fill(vtStart.begin(), vtStart.end() - 1);
+    for (uint32_t t = 0; t < nt; ++t)
+      for (uint32_t v : g.tris[t]) vtList[fill[v]++] = t;
+  }
+  // Owned vertices by block, in increasing order (the write-back order is fixed).
+  std::vector<std::vector<uint32_t>> owned(blocks.size());
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (vtStart[v] == vtStart[v + 1]) continue;
+    const int64_t b = blockIndex(vblock[v]);
+    if (b < 0) continue;
+    V3 lo, hi;
+    shrunk(blocks[size_t(b)], lo, hi);
+    bool ok = true;
+    for (uint32_t i = vtStart[v]; i < vtStart[v + 1] && ok; ++i)
+      for (uint32_t u : g.tris[vtList[i]]) ok = ok && inside(g.pos[u], lo, hi);
+    if (ok) owned[size_t(b)].push_back(v);
+  }
+  // Obstacle candidates: every triangle under each block its box meets (increasing order).
+  std::vector<std::vector<uint32_t>> near(blocks.size());
   for (uint32_t t = 0; t < nt; ++t) {
     V3 lo = g.pos[g.tris[t][0]], hi = lo;
     for (uint32_t v : g.tris[t])
@@ -1333,8 +1363,8 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     for (int32_t x = a[0]; x <= b[0]; ++x)
       for (int32_t y = a[1]; y <= b[1]; ++y)
         for (int32_t z = a[2]; z <= b[2]; ++z) {
-          auto it = owned.find({x, y, z});
-          if (it != owned.end()) near[{x, y, z}].push_back(t);
+          const int64_t i = blockIndex({x, y, z});
+          if (i >= 0) near[size_t(i)].push_back(t);
         }
   }
 
@@ -1348,56 +1378,70 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
   };
   std::vector<Result> results(blocks.size());
   std::vector<char> vAlive(nv, 1), tAlive(nt, 1);
+  // activeIn[t]: the block one of whose own vertices t has (a triangle with an owned vertex lies
+  // in that block's shrunk box, so it is one block's only: each entry has one writer).
+  std::vector<uint32_t> activeIn(nt, UINT32_MAX);
   auto solve = [&](size_t i) {
     const BlockKey& b = blocks[i];
     Result& r = results[i];
-    const std::vector<uint32_t>& own = owned.at(b);
+    const std::vector<uint32_t>& own = owned[i];
+    if (own.empty()) return;
     std::vector<uint32_t> active, globalOf;  // the block's triangles; local vertex -> global
-    for (uint32_t v : own) active.insert(active.end(), vt[v].begin(), vt[v].end());
+    for (uint32_t v : own)
+      for (uint32_t k = vtStart[v]; k < vtStart[v + 1]; ++k)
+        if (activeIn[vtList[k]] != i) activeIn[vtList[k]] = uint32_t(i), active.push_back(vtList[k]);
     std::sort(active.begin(), active.end());
-    active.erase(std::unique(active.begin(), active.end()), active.end());
     V3 lo, hi;
     shrunk(b, lo, hi);
     std::vector<uint32_t> obstacles;
-    for (uint32_t t : near.at(b)) {
-      if (std::binary_search(active.begin(), active.end(), t)) continue;
+    for (uint32_t t : near[i]) {
+      if (std::binary_search(active.begin(), active.end(), t)) continue;  // (activeIn[t] may be
+                                                                           // another block's write)
       V3 tl = g.pos[g.tris[t][0]], th = tl;
       for (uint32_t v : g.tris[t])
         for (int k = 0; k < 3; ++k) tl[k] = std::min(tl[k], g.pos[v][k]), th[k] = std::max(th[k], g.pos[v][k]);
       if (th[0] >= lo[0] && tl[0] <= hi[0] && th[1] >= lo[1] && tl[1] <= hi[1] && th[2] >= lo[2] && tl[2] <= hi[2])
         obstacles.push_back(t);
     }
-    for (uint32_t t : active)
-      for (uint32_t v : g.tris[t]) globalOf.push_back(v);
-    for (uint32_t t : obstacles)
-      for (uint32_t v : g.tris[t]) globalOf.push_back(v);
-    std::sort(globalOf.begin(), globalOf.end());
-    globalOf.erase(std::unique(globalOf.begin(), globalOf.end()), globalOf.end());
-    // global -> local by a per-thread table (every entry back to "none" after the block)
+    // global -> local by a per-thread table (every entry back to "none" after the block); local
+    // numbers in increasing global order
     thread_local std::vector<uint32_t> localOf;
     if (localOf.size() < nv) localOf.resize(nv, UINT32_MAX);
+    for (const std::vector<uint32_t>* list : {&active, &obstacles})
+      for (uint32_t t : *list)
+        for (uint32_t v : g.tris[t])
+          if (localOf[v] == UINT32_MAX) localOf[v] = 0, globalOf.push_back(v);
+    std::sort(globalOf.begin(), globalOf.end());
     for (uint32_t i = 0; i < globalOf.size(); ++i) localOf[globalOf[i]] = i;
     auto local = [&](uint32_t v) { return localOf[v]; };
-    Work w;
-    for (uint32_t v : globalOf) {
-      w.pos.push_back(g.pos[v]);
-      w.normal.push_back(g.normal[v]);
-      w.key.push_back(g.key[v]);
-      w.quad.push_back(g.quad[v]);
-      w.moved.push_back(g.moved[v]);
-      w.locked.push_back(!std::binary_search(own.begin(), own.end(), v));
-    }
-    for (const std::vector<uint32_t>* list : {&active, &obstacles})
-      for (uint32_t t : *list) {
-        w.tris.push_back({local(g.tris[t][0]), local(g.tris[t][1]), local(g.tris[t][2])});
-        w.level.push_back(g.level[t]);
-        w.made.push_back(g.made[t]);
+    auto input = [&] {
+      Work w;
+      const size_t n = globalOf.size(), m = active.size() + obstacles.size();
+      w.pos.reserve(n), w.normal.reserve(n), w.key.reserve(n), w.quad.reserve(n), w.moved.reserve(n), w.locked.reserve(n);
+      w.tris.reserve(m), w.level.reserve(m), w.made.reserve(m);
+      size_t at = 0;  // own is sorted: a merge walk marks the locked vertices
+      for (uint32_t v : globalOf) {
+        w.pos.push_back(g.pos[v]);
+        w.normal.push_back(g.normal[v]);
+        w.key.push_back(g.key[v]);
+        w.quad.push_back(g.quad[v]);
+        w.moved.push_back(g.moved[v]);
+        while (at < own.size() && own[at] < v) ++at;
+        w.locked.push_back(!(at < own.size() && own[at] == v));
       }
+      for (const std::vector<uint32_t>* list : {&active, &obstacles})
+        for (uint32_t t : *list) {
+          w.tris.push_back({local(g.tris[t][0]), local(g.tris[t][1]), local(g.tris[t][2])});
+          w.level.push_back(g.level[t]);
+          w.made.push_back(g.made[t]);
+        }
+      w.confined = true;
+      w.regionLo = lo;
+      w.regionHi = hi;
+      return w;
+    };
+    std::unique_ptr<Simplifier> simplified = simplifyChecked(input, tape, grid, opt, r.stats);
     for (uint32_t v : globalOf) localOf[v] = UINT32_MAX;
-    w.confined = true;
-    w.regionLo = lo;
-    w.regionHi = hi;
-    std::unique_ptr<Simplifier> simplified = simplifyChecked(std::move(w), tape, grid, opt, r.stats);
     const Simplifier& s = *simplified;
     const Work& out = s.work();
     for (uint32_t i = 0; i < globalOf.size(); ++i) {
@@ -1487,7 +1531,7 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
               [&](const BlockKey& b) { return !bricksDid(b, pass, options.bricksSimplified, cells); }, stats);
   blockPass(w, tape, grid, options, 2, [](const BlockKey&) { return true; }, stats);
   SimplifyStats s2;
-  std::unique_ptr<Simplifier> second = simplifyChecked(std::move(w), tape, grid, options, s2);
+  std::unique_ptr<Simplifier> second = simplifyChecked([&w] { return w; }, tape, grid, options, s2);
   stats += s2;
   stats.errorBound = s2.errorBound;  // over every triangle a collapse made, in either pass
   mesh = second->output(mesh.stats);
