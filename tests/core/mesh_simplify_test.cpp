@@ -501,3 +501,30 @@ TEST(MeshSimplify, BlocksSimplifiedAgainGiveTheSameMeshWhateverTheSplit) {
     EXPECT_EQ(fs.errorBound, ws.errorBound);
   }
 }
+
+// The cell contractions (the connected vertices of a 1-, 2- or 4-voxel cell merged into one
+// before the edge collapses) must keep sheets that share a cell apart: a spherical shell and a
+// gap between two blocks, both narrower than two voxels, so that cells of 2 and 4 voxels hold
+// vertices of both sides. Each side is its own connected piece of the cell and contracts on its
+// own (or not at all); the result keeps two closed surfaces (Euler characteristic 4), embedded,
+// within the bound, and far fewer triangles than the mesher's.
+TEST(MeshSimplify, ThinWallsAndGapsStayApartWhenCellsAreContracted) {
+  const GridSpec g = cubeGrid(1.0, 64);
+  const double v = g.voxel;
+  const Expr shell = 0.9 * v - abs(sqrt(square(X() - 0.01) + square(Y() + 0.02) + square(Z())) - 0.7);
+  const Expr gap = max(blockAt(-0.4 - 0.75 * v, 0.01, 0.02, 0.4, 0.5, 0.45), blockAt(0.4 + 0.75 * v, 0.01, 0.02, 0.4, 0.5, 0.45));
+  const double t = 1.8 * v, shellVolume = 4.0 / 3.0 * kPi * (std::pow(0.7 + t / 2, 3) - std::pow(0.7 - t / 2, 3));
+  struct Case {
+    const char* name;
+    Expr model;
+    double volume;
+  };
+  for (const Case& c : {Case{"shell 1.8 voxels thick", shell, shellVolume}, Case{"blocks 1.5 voxels apart", gap, 2 * 0.8 * 1.0 * 0.9}}) {
+    const char* name = c.name;
+    Result r = simplifyAndCheck(c.model, g, 0.1);
+    figures(name, r, c.volume, r.area);
+    EXPECT_NEAR(r.volume, c.volume, r.stats.errorBound * r.area + 1e-3 * c.volume) << name;
+    EXPECT_EQ(mc::eulerCharacteristic(r.mesh.triangles, r.mesh.positions.size()), 4) << name;
+    EXPECT_LT(r.mesh.triangles.size(), r.rawTriangles / 4) << name;
+  }
+}
