@@ -548,7 +548,7 @@ class Simplifier {
     int level = 0;        // the answer
     // internal: unit direction, samples per side, whether the probes of `level` passed
     V3 d{};
-    int m = 1;
+    int m = 1, limit = 0;  // limit: the maxK of the last call
     bool probed = false, done = false;
   };
 
@@ -557,8 +557,20 @@ class Simplifier {
   // one's probes: the answer is the same as checking every level in full, for far fewer
   // evaluations. All queries advance together, so each round is one batch of the evaluator
   // over every query's points. stopAbove: return false as soon as some query exceeds maxK.
-  bool levels(std::vector<LevelQuery>& qs, int maxK, bool stopAbove) {
+  // resume: qs were answered by a call with a smaller maxK that failed; the queries that went
+  // past it go on from where they stopped (the same answers as a fresh call, without checking
+  // the lower levels again).
+  bool levels(std::vector<LevelQuery>& qs, int maxK, bool stopAbove, bool resume = false) {
+    if (resume) {
+      for (LevelQuery& q : qs)
+        if (q.d == V3{0, 0, 0})
+          q.level = maxK + 1;  // as a fresh call answers
+        else if (q.done && q.level == q.limit + 1)
+          q.done = false;
+    }
+    for (LevelQuery& q : qs) q.limit = maxK;
     for (LevelQuery& q : qs) {
+      if (resume) break;
       auto unit = [](V3 d) {
         double l = norm(d);
         return l > 0 && std::isfinite(l) ? scale(d, 1 / l) : V3{0, 0, 0};
@@ -653,6 +665,7 @@ class Simplifier {
   // same outcome and the same levels, and most of the mesher's triangles never need theirs.
   bool errorPasses(std::vector<LevelQuery>& qs, const std::vector<V3>& gone, const std::vector<uint32_t>& replaced) {
     int allowed = 0;
+    bool started = false;  // levels() ran: the second round resumes it
     for (bool measured = false;; measured = true) {
       const double e = std::ldexp(tol_, allowed);
       bool near = true;
@@ -661,7 +674,11 @@ class Simplifier {
         for (const LevelQuery& q : qs) d = std::min(d, pointTriangleDistance(gone[i], q.a, q.b, q.c));
         near = d <= e;
       }
-      if (near && levels(qs, allowed, true)) return true;
+      if (near) {
+        const bool pass = levels(qs, allowed, true, started);
+        started = true;
+        if (pass) return true;
+      }
       if (measured) return false;
       int worst = 0;
       for (uint32_t t : replaced) worst = std::max(worst, levelOf(t));
