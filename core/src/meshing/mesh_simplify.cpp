@@ -668,11 +668,10 @@ class Simplifier {
     bool started = false;  // levels() ran: the second round resumes it
     for (bool measured = false;; measured = true) {
       const double e = std::ldexp(tol_, allowed);
-      bool near = true;
+      bool near = true;  // every removed vertex within e of some new triangle
       for (size_t i = 0; i < gone.size() && near; ++i) {
-        double d = INFINITY;
-        for (const LevelQuery& q : qs) d = std::min(d, pointTriangleDistance(gone[i], q.a, q.b, q.c));
-        near = d <= e;
+        near = false;
+        for (size_t k = 0; k < qs.size() && !near; ++k) near = pointTriangleDistance(gone[i], qs[k].a, qs[k].b, qs[k].c) <= e;
       }
       if (near) {
         const bool pass = levels(qs, allowed, true, started);
