@@ -34,8 +34,8 @@ std::string simplifyLine(int stage, uint64_t done, uint64_t total) {
   std::string bar(size_t(width), '.');
   for (int i = 0; i < fill; ++i) bar[size_t(i)] = '#';
   char line[160];
-  std::snprintf(line, sizeof line, "[%s] simplifying: pass %d of 4, %llu/%llu %s", bar.c_str(), stage + 1,
-                (unsigned long long)done, (unsigned long long)total, stage < 3 ? "blocks" : "candidates");
+  std::snprintf(line, sizeof line, "[%s] simplifying: pass %d of 5, %llu/%llu %s", bar.c_str(), stage + 1,
+                (unsigned long long)done, (unsigned long long)total, stage < 4 ? "blocks" : "candidates");
   return line;
 }
 
@@ -59,7 +59,7 @@ std::function<void(int, uint64_t, uint64_t)> simplifyProgress(bool bar, bool jso
     }
     if (bar) {
       StatusLine::instance().show(simplifyLine(stage, done, total));
-      if (stage == 3 && end) StatusLine::instance().finish();
+      if (stage == 4 && end) StatusLine::instance().finish();
     }
   };
 }

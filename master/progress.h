@@ -16,8 +16,8 @@ std::string progressLine(uint64_t done, uint64_t total, double evalsPerSec, doub
 // The estimate from the elapsed time and the share done; < 0 (unknown) before any is done.
 double etaSeconds(uint64_t done, uint64_t total, double elapsedSeconds);
 
-// The bar's text during mesh simplification (SimplifyOptions::progress's stages 0, 1, 2):
-// "[###.....] simplifying: pass 2 of 3, 120/400 blocks".
+// The bar's text during mesh simplification (SimplifyOptions::progress's stages 0 to 4):
+// "[###.....] simplifying: pass 2 of 5, 120/400 blocks".
 std::string simplifyLine(int stage, uint64_t done, uint64_t total);
 
 // A SimplifyOptions::progress for the bar and/or JSON events ({"event":"progress","phase":

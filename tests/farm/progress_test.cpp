@@ -21,8 +21,8 @@ TEST(Progress, NoEtaBeforeTheFirstBrick) {
   EXPECT_EQ(start.find("ETA 0 s"), std::string::npos) << start;
   EXPECT_EQ(progressLine(2, 8, 1.5e6, 9.0, 2),
             "[#######.......................] 2/8 bricks  1.50 M evals/s  ETA 9 s  workers 2");
-  EXPECT_EQ(simplifyLine(3, 50, 100), "[###############...............] simplifying: pass 4 of 4, 50/100 candidates");
-  EXPECT_EQ(simplifyLine(0, 1, 4), "[#######.......................] simplifying: pass 1 of 4, 1/4 blocks");
+  EXPECT_EQ(simplifyLine(4, 50, 100), "[###############...............] simplifying: pass 5 of 5, 50/100 candidates");
+  EXPECT_EQ(simplifyLine(0, 1, 4), "[#######.......................] simplifying: pass 1 of 5, 1/4 blocks");
 }
 
 namespace {

@@ -115,7 +115,7 @@ double quality(const V3& a, const V3& b, const V3& c) {
 
 constexpr int kMaxSamplesPerSide = 64;  // the error check's subdivision: m <= 64
 constexpr size_t kProbes = 4;           // error samples tried first on every new triangle
-constexpr int kGlobalStage = 3;         // SimplifyOptions::progress: the global pass
+constexpr int kGlobalStage = 4;         // SimplifyOptions::progress: the global pass
 constexpr int kClusterLevels = 2;       // cell contractions: cells of 1, 2 and 4 voxels
 
 }  // namespace
@@ -167,6 +167,11 @@ struct Work {
   std::vector<char> made;     // per triangle: made by a collapse
   bool confined = false;      // placements stay inside [regionLo, regionHi]
   V3 regionLo{}, regionHi{};
+  // Per vertex, or empty: owned by a block of the fourth pass, whose collapses ran out, so
+  // every edge between two such vertices was tried there (after that block's changes around
+  // it) and failed. The global pass starts from the other edges only; a collapse still re-tries
+  // the edges around it.
+  std::vector<char> settled;
 };
 
 // The state of a mesh (vertices in key order, triangles canonical) with what earlier passes
@@ -395,6 +400,8 @@ class Simplifier {
     }
   }
 
+  bool settledEdge(uint32_t a, uint32_t b) const { return !w_.settled.empty() && w_.settled[a] && w_.settled[b]; }
+
   // Every edge of the mesh as a collapse candidate.
   void pushAllCandidates() {
     for (uint32_t t = 0; t < w_.tris.size(); ++t) {
@@ -402,6 +409,7 @@ class Simplifier {
       for (int c = 0; c < 3; ++c) {
         uint32_t a = w_.tris[t][c], b = w_.tris[t][(c + 1) % 3];
         // Each undirected edge once (in a closed mesh; a block's open rim is locked anyway).
+        if (settledEdge(a, b)) continue;
         if (a < b || !std::count(vtris_[b].begin(), vtris_[b].end(), t)) pushCandidate(a, b);
       }
     }
@@ -852,7 +860,9 @@ class Simplifier {
     for (size_t i = 0; i < byCell.size();) {
       size_t j = i;
       while (j < byCell.size() && byCell[j].first == byCell[i].first) ++j;
-      if (j - i >= 2) {
+      bool allSettled = !w_.settled.empty();
+      for (size_t k = i; k < j && allSettled; ++k) allSettled = w_.settled[byCell[k].second];
+      if (j - i >= 2 && !allSettled) {
         group.clear();
         const uint32_t inGroup = nextMark();
         for (size_t k = i; k < j; ++k) group.push_back(byCell[k].second), markA_[byCell[k].second] = inGroup;
@@ -1252,18 +1262,22 @@ std::unique_ptr<Simplifier> simplifyChecked(const std::function<Work()>& input, 
   return s;
 }
 
-constexpr int kBlockVoxels = 32;  // the block passes' blocks (fixed in index space)
-constexpr int kShift[2] = {0, kBlockVoxels / 2};  // the second pass's blocks straddle the first's faces
-// A third pass, in the master only (simplifyMesh), of larger blocks aligned with the first
-// pass's: what the second pass leaves along its block faces lies inside them, so the serial
-// global pass gets less to do, and it works with more of the mesh at once.
-constexpr int kThirdBlockVoxels = 2 * kBlockVoxels;
+// The block passes' blocks (fixed in index space): edge and shift along each axis. The second
+// pass's blocks are centred on the first's faces, where it left the rims. A third and a fourth
+// pass, in the master only (simplifyMesh), of larger blocks: the third aligned with the first
+// pass's (what the second leaves along its faces lies inside them), the fourth centred on the
+// third's faces. The fourth also sweeps its blocks once more (every edge tried again, after
+// the changes around it), which the serial global pass did for the whole mesh: now it only
+// finishes along the fourth pass's faces (Work::settled), on one core, with the rest done on all.
+constexpr int kBlockVoxels[4] = {32, 32, 64, 64};
+constexpr int kBlockShift[4] = {0, 16, 0, 32};
+constexpr int kWorkerPasses = 2;  // the passes simplifyRegion does in the bricks
 using BlockKey = std::array<int32_t, 3>;
 
 // The cells of block b of pass `pass` along one axis, clipped to the grid's cells.
 std::pair<int64_t, int64_t> blockCells(int32_t b, int pass, int64_t cells) {
-  const int64_t lo = int64_t(b) * kBlockVoxels - kShift[pass];
-  return {std::max<int64_t>(0, lo), std::min(cells, lo + kBlockVoxels)};
+  const int64_t lo = int64_t(b) * kBlockVoxels[pass] - kBlockShift[pass];
+  return {std::max<int64_t>(0, lo), std::min(cells, lo + kBlockVoxels[pass])};
 }
 
 // Does the simplification of the region [lo, hi) of cells (simplifyRegion) do block b of
@@ -1277,7 +1291,7 @@ bool regionDoes(const BlockKey& b, int pass, const std::array<int64_t, 3>& lo, c
     if (c0 >= c1 || c0 < lo[k] || c1 > hi[k]) return false;
     if (pass == 1)
       for (int64_t cell : {c0, c1 - 1}) {
-        auto [f0, f1] = blockCells(int32_t(cell / kBlockVoxels), 0, cells[k]);
+        auto [f0, f1] = blockCells(int32_t(cell / kBlockVoxels[0]), 0, cells[k]);
         if (f0 < lo[k] || f1 > hi[k]) return false;
       }
   }
@@ -1301,8 +1315,8 @@ bool bricksDid(const BlockKey& b, int pass, int brick, const std::array<int64_t,
   return regionDoes(b, pass, lo, hi, cells);
 }
 
-// A block pass, in parallel: the grid's index space, shifted by kShift[pass], is cut into
-// fixed blocks of kBlockVoxels (so the cut does not depend on the farm's bricks). A vertex
+// A block pass, in parallel: the grid's index space, shifted by kBlockShift[pass], is cut into
+// fixed blocks of kBlockVoxels[pass] (so the cut does not depend on the farm's bricks). A vertex
 // belongs to its block if it and every neighbour lie inside the block shrunk by a voxel; each
 // block simplifies the triangles around its own vertices, with the other vertices locked,
 // placements confined to the shrunk block, and every other triangle meeting it as a fixed
@@ -1312,10 +1326,11 @@ bool bricksDid(const BlockKey& b, int pass, int brick, const std::array<int64_t,
 // Only the blocks `mine` accepts are done.
 void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt, int pass,
                const std::function<bool(const BlockKey&)>& mine, SimplifyStats& stats) {
+  g.settled.clear();  // only the fourth pass settles vertices (for the global pass)
   const size_t nv = g.pos.size(), nt = g.tris.size();
-  const double side = (pass < 2 ? kBlockVoxels : kThirdBlockVoxels) * grid.voxel, margin = grid.voxel;
+  const double side = kBlockVoxels[pass] * grid.voxel, margin = grid.voxel;
   V3 origin;
-  for (int k = 0; k < 3; ++k) origin[k] = grid.origin[k] - (pass < 2 ? kShift[pass] : 0) * grid.voxel;
+  for (int k = 0; k < 3; ++k) origin[k] = grid.origin[k] - kBlockShift[pass] * grid.voxel;
   auto blockOf = [&](const V3& p) {
     BlockKey b;
     for (int k = 0; k < 3; ++k) b[k] = int32_t(std::floor((p[k] - origin[k]) / side));
@@ -1393,7 +1408,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     SimplifyStats stats;
   };
   std::vector<Result> results(blocks.size());
-  std::vector<char> vAlive(nv, 1), tAlive(nt, 1);
+  std::vector<char> vAlive(nv, 1), tAlive(nt, 1), vSettled(nv, 0);
   // activeIn[t]: the block one of whose own vertices t has (a triangle with an owned vertex lies
   // in that block's shrunk box, so it is one block's only: each entry has one writer).
   std::vector<uint32_t> activeIn(nt, UINT32_MAX);
@@ -1470,6 +1485,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
       g.quad[v] = out.quad[i];
       g.moved[v] = out.moved[i];
     }
+    for (uint32_t v : own) vSettled[v] = 1;
     for (uint32_t t : active) tAlive[t] = 0;
     for (uint32_t t = 0; t < active.size(); ++t) {  // the active triangles come first
       if (!s.triangleAlive(t)) continue;
@@ -1512,6 +1528,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     c.quad.push_back(g.quad[v]);
     c.moved.push_back(g.moved[v]);
     c.locked.push_back(0);
+    if (pass == 3) c.settled.push_back(vSettled[v]);  // the last block pass's, for the global one
   }
   std::vector<std::pair<Tri, uint32_t>> order;  // canonical triangle, old index
   for (uint32_t t = 0; t < g.tris.size(); ++t) {
@@ -1538,14 +1555,14 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
   Work w = workOf(mesh);
   stats += mesh.carry.counters;  // the regions' share (simplifyRegion in the workers)
   mesh.carry = SimplifyCarry();
-  // Two block passes, the second's blocks shifted by half a block: what the first leaves along
-  // its block faces lies inside the second's blocks; the global pass finishes the rest. Blocks
-  // the bricks' own simplification did are skipped (the result is the same).
+  // Four block passes (kBlockVoxels), each centred on what the one before left along its block
+  // faces; the global pass finishes the rest. Blocks the bricks' own simplification did are
+  // skipped (the result is the same).
   const std::array<int64_t, 3> cells = gridCells(grid);
-  for (int pass = 0; pass < 2; ++pass)
+  for (int pass = 0; pass < kWorkerPasses; ++pass)
     blockPass(w, tape, grid, options, pass,
               [&](const BlockKey& b) { return !bricksDid(b, pass, options.bricksSimplified, cells); }, stats);
-  blockPass(w, tape, grid, options, 2, [](const BlockKey&) { return true; }, stats);
+  for (int pass = kWorkerPasses; pass < 4; ++pass) blockPass(w, tape, grid, options, pass, [](const BlockKey&) { return true; }, stats);
   SimplifyStats s2;
   std::unique_ptr<Simplifier> second = simplifyChecked([&w] { return w; }, tape, grid, options, s2);
   stats += s2;
@@ -1569,7 +1586,7 @@ void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid,
   Work w = workOf(m);
   SimplifyStats stats;
   const std::array<int64_t, 3> cells = gridCells(grid), rlo{lo[0], lo[1], lo[2]}, rhi{hi[0], hi[1], hi[2]};
-  for (int pass = 0; pass < 2; ++pass)
+  for (int pass = 0; pass < kWorkerPasses; ++pass)
     blockPass(w, tape, grid, options, pass, [&](const BlockKey& b) { return regionDoes(b, pass, rlo, rhi, cells); }, stats);
   piece.vertices.clear();
   for (size_t v = 0; v < w.pos.size(); ++v) piece.vertices.push_back({w.key[v], w.pos[v], w.normal[v]});

@@ -22,7 +22,7 @@
 //    across a crease), so the result is never further from the surface than the tolerance or
 //    the input mesh. The removed vertices must also stay within e of the new triangles.
 // Passes: two of independent 32^3 blocks (fixed in index space; in parallel, and in the workers
-// for the blocks inside their bricks: simplifyRegion), one of 64^3 blocks, then one over the
+// for the blocks inside their bricks: simplifyRegion), two of 64^3 blocks, then one over the
 // whole mesh. Each is deterministic (ties broken by vertex index) and starts from the canonical
 // mesh, so the output depends only on the input mesh: the farm's split-invariance carries over.
 #pragma once
@@ -48,7 +48,7 @@ struct SimplifyOptions {
   // their blocks are not done again. 0: none.
   int bricksSimplified = 0;
   // Called as simplifyMesh advances (from the block passes' threads too: it must be thread-safe):
-  // stages 0, 1 and 2 are the block passes (blocks done of total), stage 3 the global pass
+  // stages 0 to 3 are the block passes (blocks done of total), stage 4 the global pass
   // (collapse candidates examined of examined + queued, so its total grows). Never changes the
   // result.
   std::function<void(int stage, uint64_t done, uint64_t total)> progress;
