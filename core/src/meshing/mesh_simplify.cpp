@@ -322,13 +322,27 @@ class Simplifier {
   // After a deferred run: does no triangle a collapse made meet a triangle near it improperly
   // (the same exact predicates as the per-collapse check, once per final triangle)?
   bool embedded() {
-    // The triangles filed once, in one array sorted by cell (no hash map of lists to build).
-    std::vector<std::pair<uint64_t, Entry>>& filed = scratch_.filed;
+    // Every alive triangle's box and cells computed once; (cell, triangle) pairs in one array
+    // sorted by cell (no hash map of lists to build).
+    std::vector<Entry>& box = scratch_.boxes;
+    std::vector<uint32_t>& cellsFrom = scratch_.cellsFrom;
+    std::vector<uint64_t>& cellsOf = scratch_.cells;
+    std::vector<std::pair<uint64_t, uint32_t>>& filed = scratch_.filed;
+    box.resize(w_.tris.size());
+    cellsFrom.assign(w_.tris.size() + 1, 0);
+    cellsOf.clear();
     filed.clear();
-    for (uint32_t t = 0; t < w_.tris.size(); ++t)
-      if (tAlive_[t]) fileTriangle(t, [&](uint64_t k, const Entry& e) { filed.push_back({k, e}); });
-    std::sort(filed.begin(), filed.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-    std::vector<uint64_t>& cellKeys = scratch_.cells;
+    for (uint32_t t = 0; t < w_.tris.size(); ++t) {
+      cellsFrom[t] = uint32_t(cellsOf.size());
+      if (!tAlive_[t]) continue;
+      const size_t first = cellsOf.size();
+      fileTriangle(t, [&](uint64_t k, const Entry& e) { box[t] = e, cellsOf.push_back(k); });
+      std::sort(cellsOf.begin() + std::ptrdiff_t(first), cellsOf.end());
+      cellsOf.erase(std::unique(cellsOf.begin() + std::ptrdiff_t(first), cellsOf.end()), cellsOf.end());
+      for (size_t i = first; i < cellsOf.size(); ++i) filed.push_back({cellsOf[i], t});
+    }
+    cellsFrom[w_.tris.size()] = uint32_t(cellsOf.size());
+    std::sort(filed.begin(), filed.end());
     for (uint32_t t = 0; t < w_.tris.size(); ++t) {
       if (!tAlive_[t] || !madeNow_[t]) continue;
       const Tri& tr = w_.tris[t];
@@ -338,26 +352,24 @@ class Simplifier {
         for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], w_.pos[v][k]), hi[k] = std::max(hi[k], w_.pos[v][k]);
       float flo[3], fhi[3];
       roundOut(lo, hi, flo, fhi);
-      cellKeys.clear();
-      forTriangleCells(w_.pos[tr[0]], w_.pos[tr[1]], w_.pos[tr[2]], [&](uint64_t k) { cellKeys.push_back(k); });
-      std::sort(cellKeys.begin(), cellKeys.end());
-      cellKeys.erase(std::unique(cellKeys.begin(), cellKeys.end()), cellKeys.end());
       ++probeNow_;
       probe_[t].seen = probeNow_;
-      for (uint64_t key : cellKeys) {
-        auto at = std::lower_bound(filed.begin(), filed.end(), key, [](const auto& x, uint64_t k) { return x.first < k; });
+      for (uint32_t c = cellsFrom[t]; c < cellsFrom[t + 1]; ++c) {
+        const uint64_t key = cellsOf[c];
+        auto at = std::lower_bound(filed.begin(), filed.end(), std::pair<uint64_t, uint32_t>{key, 0});
         for (; at != filed.end() && at->first == key; ++at) {
-          const Entry& e = at->second;
+          const uint32_t u = at->second;
+          const Entry& e = box[u];
           if (e.hi[0] < flo[0] || e.lo[0] > fhi[0] || e.hi[1] < flo[1] || e.lo[1] > fhi[1] || e.hi[2] < flo[2] ||
               e.lo[2] > fhi[2])
             continue;
-          Probe& pr = probe_[e.tri];
+          Probe& pr = probe_[u];
           if (pr.seen == probeNow_) continue;
           pr.seen = probeNow_;
           // Two triangles that meet share a point, so both are filed under its cell: a pair of
           // made triangles is tested from the first of them.
-          if (madeNow_[e.tri] && e.tri < t) continue;
-          const Tri& tu = w_.tris[e.tri];
+          if (madeNow_[u] && u < t) continue;
+          const Tri& tu = w_.tris[u];
           if (improperPair(tr, qt, tu, {qpos_[tu[0]], qpos_[tu[1]], qpos_[tu[2]]})) return false;
         }
       }
@@ -1203,7 +1215,9 @@ class Simplifier {
     std::vector<int8_t> newLevel;
     std::vector<LevelQuery> queries, ownLevel;
     std::vector<uint64_t> cells;  // hash cells of the self-intersection check
-    std::vector<std::pair<uint64_t, Entry>> filed;  // embedded()
+    std::vector<std::pair<uint64_t, uint32_t>> filed;  // embedded(): (cell, triangle)
+    std::vector<Entry> boxes;                          // embedded(): per triangle
+    std::vector<uint32_t> cellsFrom;                   // embedded(): triangle t's cells in cells
     std::vector<std::pair<uint64_t, uint32_t>> byCell;  // cell contractions
     std::vector<uint32_t> group, component, next, replaced;
     std::vector<V3> gonePoints;
