@@ -190,7 +190,12 @@ class Master {
       else runFarm();
     }
     progress_->finish(done_, report_.pointEvals, int(peers_.size()));
-    if (journal_) journal_->flush();
+    // To the disk when a resume will read it (stopped, or bricks poisoned). A finished job's
+    // journal is removed once the output is written (frep sample/mesh), usually before the
+    // kernel writes it back at all: syncing it took 0.18 s of a 1.2 s job (4096 bricks,
+    // 600 MB). It stays in the page cache meanwhile, so only a crash of the machine itself
+    // while the output is written can lose records, which a resume recomputes.
+    if (journal_ && done_ < bricks_.size()) journal_->flush();
     return finish();
   }
 
