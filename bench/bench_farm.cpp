@@ -67,7 +67,7 @@ double seconds(std::chrono::steady_clock::time_point t0) {
 std::string fakePayload(const std::array<int32_t, 3>& lo, int leaves) {
   BrickOutput b;
   for (int i = 0; i < leaves; ++i) {
-    LeafBlock l{};
+    LeafBlock l = LeafBlock::cleared();
     l.origin = {lo[0] + 8 * (i % 8), lo[1] + 8 * ((i / 8) % 8), lo[2] + 8 * (i / 64)};
     for (int v = 0; v < kLeafVoxels; ++v) {
       bool active = (v / 8) % 2 == 0;

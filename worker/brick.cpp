@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "frep/extremum/extremum.h"
+#include "leaf_expand.h"
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/minkowski_algebra/registry.h"
 #include "frep/lang/field.h"
@@ -291,13 +292,6 @@ struct Reader {
     return true;
   }
 };
-// For each byte of sign bits, the float sign bit of each of its 8 voxels (set where the bit is 0: -m).
-constexpr auto kNegativeSigns = [] {
-  std::array<std::array<uint32_t, 8>, 256> t{};
-  for (size_t b = 0; b < 256; ++b)
-    for (size_t i = 0; i < 8; ++i) t[b][i] = ((b >> i) & 1u) ? 0u : 0x80000000u;
-  return t;
-}();
 constexpr uint32_t kCompact = 1;  // leaf flag: inactive voxels are +-magnitude, only active values sent
 
 // A leaf's inactive voxels all hold +m or -m (the sampler's band value): then only the signs of
@@ -403,30 +397,9 @@ bool walkBrick(const void* data, size_t size, Sink& sink, std::string* error) {
       r.p += activeCount * sizeof(float);
       continue;
     }
-    // A byte (8 voxels) at a time: every voxel +-m from its sign bit (xor of a sign mask, which
-    // the compiler vectorises), then the active ones, in voxel order, from the stream (a whole
-    // active row of 8 in one copy).
     uint32_t m = 0;
     std::memcpy(&m, &magnitude, sizeof m);
-    const char* src = r.p;
-    for (int k = 0; k < kLeafVoxels / 8; ++k) {
-      const uint8_t signs = uint8_t(positive[size_t(k >> 3)] >> (8 * (k & 7)));
-      const uint8_t act = uint8_t(active[size_t(k >> 3)] >> (8 * (k & 7)));
-      float* v = l->values.data() + 8 * k;
-      uint32_t bits[8];
-      for (int b = 0; b < 8; ++b) bits[b] = m ^ kNegativeSigns[signs][b];
-      std::memcpy(v, bits, sizeof bits);
-      if (act == 0xFF) {
-        std::memcpy(v, src, 8 * sizeof(float));
-        src += 8 * sizeof(float);
-        continue;
-      }
-      for (unsigned rest = act; rest; rest &= rest - 1) {
-        std::memcpy(v + __builtin_ctz(rest), src, sizeof(float));
-        src += sizeof(float);
-      }
-    }
-    r.p = src;
+    r.p = expandCompactLeaf(l->values.data(), active.data(), positive.data(), m, r.p);
   }
   if (r.p != r.end) return fail("payload: trailing bytes");
   return true;

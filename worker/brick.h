@@ -11,6 +11,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "crc32.h"
 #include "farm.pb.h"
 #include "frep/meshing/mesh.h"
 #include "frep/render/raycast.h"
@@ -135,6 +136,5 @@ bool decodeRenderTile(const void* data, size_t size, BrickOutput& out, std::stri
 std::string encodePayload(Operation op, const BrickOutput& out);
 bool decodePayload(Operation op, const void* data, size_t size, BrickOutput& out, std::string* error);
 
-uint32_t crc32Of(const void* data, size_t size);
 
 }  // namespace frep::farm

@@ -80,7 +80,7 @@ struct ScriptedPeer {
   // A well-formed result for `brick` (right CRC, inside the brick) whose leaf is a lie.
   void forgeResult(uint64_t jobId, const Task& t, bool corruptCrc = false) {
     BrickOutput out;
-    LeafBlock l{};
+    LeafBlock l = LeafBlock::cleared();
     l.origin = {t.lo(0), t.lo(1), t.lo(2)};
     l.values.fill(42.0f);
     l.active.fill(~0ull);

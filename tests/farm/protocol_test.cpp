@@ -236,7 +236,7 @@ TEST(Protocol, CurveMasterRefusesWorkersWithoutTheKeys) {
 
 TEST(Protocol, PayloadCodecRejectsMalformedInput) {
   BrickOutput b;
-  LeafBlock l{};
+  LeafBlock l = LeafBlock::cleared();
   l.origin = {8, 16, 24};
   l.values.fill(1.5f);
   l.active.fill(~0ull);
@@ -253,7 +253,7 @@ TEST(Protocol, PayloadCodecRejectsMalformedInput) {
   bad[12 + 20] = 3;  // leaf origin x = 3: not a multiple of 8
   EXPECT_FALSE(decodeBrick(bad.data(), bad.size(), back, &err));
   // A surface leaf: half active; inactive voxels +-0.25 travel as signs only.
-  LeafBlock half{};
+  LeafBlock half = LeafBlock::cleared();
   half.origin = {0, 0, 0};
   for (int i = 0; i < kLeafVoxels; ++i) {
     bool active = (i % 2) == 0;
@@ -283,7 +283,7 @@ TEST(Protocol, PayloadCodecRejectsMalformedInput) {
 TEST(Protocol, ScanAndDecodeInPlaceAcceptExactlyWhatDecodeAccepts) {
   BrickOutput b;
   for (int k = 0; k < 3; ++k) {
-    LeafBlock l{};
+    LeafBlock l = LeafBlock::cleared();
     l.origin = {8 * k, 16, 24};
     for (int i = 0; i < kLeafVoxels; ++i) {
       const bool active = k == 0 || (i + k) % 3 == 0;
@@ -388,6 +388,54 @@ struct FakeMaster {
 
 // Protocol 2: the job travels once per connection, in the welcome; tasks carry its id only, so
 // a job with megabytes of model (here a 1 MiB comment) costs its bytes once per worker, not per brick.
+// LeafBlock is not zeroed when made (the master's merge decodes into a resized vector): the
+// decoders must write all of every leaf. Decoded over all-zero and over all-one bytes, every
+// leaf comes out the same, bit for bit, for each leaf form (all active, compact, in full).
+TEST(Protocol, DecodingWritesEveryByteOfALeafWhateverWasThereBefore) {
+  BrickOutput b;
+  for (int k = 0; k < 3; ++k) {
+    LeafBlock l = LeafBlock::cleared();
+    l.origin = {8 * k, 8, 16};
+    for (int i = 0; i < kLeafVoxels; ++i) {
+      const bool active = k == 0 || (i < 256 && (i * 7 + k) % 5 < 2);  // rows of 8 all, some or none active
+      if (active) l.active[size_t(i >> 6)] |= uint64_t(1) << (i & 63);
+      l.values[size_t(i)] = active ? 0.02f * float(i - 300) : (k == 2 ? float(i % 3) : (i % 3 ? 0.75f : -0.75f));
+    }
+    b.leaves.push_back(l);
+  }
+  const std::string s = encodeBrick(b);
+  auto decodedOver = [&](unsigned char fill, bool inPlace) {
+    std::vector<LeafBlock> leaves(b.leaves.size());
+    std::memset(static_cast<void*>(leaves.data()), fill, leaves.size() * sizeof(LeafBlock));
+    std::string err;
+    if (inPlace) {
+      EXPECT_TRUE(decodeBrickLeaves(s.data(), s.size(), leaves.size(), [&](size_t l) { return &leaves[l]; }, &err)) << err;
+    } else {
+      BrickOutput out;
+      out.leaves = leaves;
+      out.leaves.clear();  // the filled memory stays its capacity: decodeBrick's resize reuses it
+      EXPECT_TRUE(decodeBrick(s.data(), s.size(), out, &err)) << err;
+      return out.leaves;
+    }
+    return leaves;
+  };
+  for (bool inPlace : {false, true}) {
+    const std::vector<LeafBlock> zeros = decodedOver(0x00, inPlace), ones = decodedOver(0xFF, inPlace);
+    ASSERT_EQ(zeros.size(), b.leaves.size());
+    for (size_t l = 0; l < b.leaves.size(); ++l) {
+      for (const std::vector<LeafBlock>* d : {&zeros, &ones}) {
+        EXPECT_EQ((*d)[l].origin, b.leaves[l].origin) << l;
+        EXPECT_EQ((*d)[l].active, b.leaves[l].active) << l;
+        EXPECT_EQ(std::memcmp((*d)[l].values.data(), b.leaves[l].values.data(), sizeof b.leaves[l].values), 0) << l;
+      }
+    }
+  }
+  const LeafBlock c = LeafBlock::cleared();
+  for (float v : c.values) EXPECT_EQ(v, 0.0f);
+  for (uint64_t w : c.active) EXPECT_EQ(w, 0u);
+  EXPECT_EQ(c.origin, (std::array<int32_t, 3>{0, 0, 0}));
+}
+
 TEST(Protocol, TheWelcomeCarriesTheJobAndTasksOnlyItsId) {
   JobSpec j = sphereJob();
   std::string comment;

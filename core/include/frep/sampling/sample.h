@@ -32,6 +32,17 @@ constexpr int kLeafVoxels = kLeafDim * kLeafDim * kLeafDim;
 inline int leafOffset(int x, int y, int z) { return (x << 6) | (y << 3) | z; }
 
 struct LeafBlock {
+  // Not zeroed, even as LeafBlock{} or by a vector's resize(): every maker writes all of it
+  // (the farm's merge decodes 1 GB of leaves straight into a resized vector; zeroing them first
+  // was a third pass over that memory). cleared(): origin 0, every value 0, no voxel active.
+  LeafBlock() noexcept {}
+  static LeafBlock cleared() {
+    LeafBlock l;
+    l.origin.fill(0);
+    l.values.fill(0.0f);
+    l.active.fill(0);
+    return l;
+  }
   std::array<int32_t, 3> origin;  // multiple of 8 (index space)
   // f at each voxel (F-rep sign: >= 0 inside). Voxels outside the band, or outside the grid,
   // are inactive and hold +band (inside) or -band (outside), in world units: band * voxel.
