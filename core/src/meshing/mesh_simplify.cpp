@@ -706,6 +706,21 @@ class Simplifier {
     }
   }
 
+  // Shape of a changed triangle: tr (vertex ids, as it is) becoming c0, c1, c2 must keep facing
+  // the same way — its own normal, or for a sliver (whose normal is noise: the mesher's
+  // triangles where the surface grazes a grid point) the model's normals at its corners — within
+  // ~78 degrees, and not degenerate. Tracks the worst quality before and after.
+  bool keepsFacing(const Tri& tr, const V3& c0, const V3& c1, const V3& c2, double& worstBefore, double& worstAfter) const {
+    const V3 &o0 = w_.pos[tr[0]], &o1 = w_.pos[tr[1]], &o2 = w_.pos[tr[2]];
+    const double q0 = quality(o0, o1, o2);
+    worstBefore = std::min(worstBefore, q0);
+    const V3 n0 = q0 < opt_.minQuality ? add(w_.normal[tr[0]], add(w_.normal[tr[1]], w_.normal[tr[2]])) : cross(sub(o1, o0), sub(o2, o0));
+    const V3 n1 = cross(sub(c1, c0), sub(c2, c0));
+    const double l1 = norm(n1);
+    worstAfter = std::min(worstAfter, quality(c0, c1, c2));
+    return l1 > 1e-12 * grid_.voxel * grid_.voxel && dot(n0, n1) > 0.2 * norm(n0) * l1;
+  }
+
   // ---- one collapse ---------------------------------------------------------------------------
   void tryCollapse(uint32_t a, uint32_t b) {
     // Link condition: exactly two triangles hold the edge, and a and b have no other common
@@ -756,18 +771,7 @@ class Simplifier {
     for (uint32_t t : removed) worstBefore = std::min(worstBefore, quality(w_.pos[w_.tris[t][0]], w_.pos[w_.tris[t][1]], w_.pos[w_.tris[t][2]]));
     for (uint32_t t : changed) {
       const Tri& tr = w_.tris[t];
-      V3 o0 = w_.pos[tr[0]], o1 = w_.pos[tr[1]], o2 = w_.pos[tr[2]];
-      double q0 = quality(o0, o1, o2);
-      worstBefore = std::min(worstBefore, q0);
-      // The direction the triangle must keep facing: its own normal, or for a sliver (whose
-      // normal is noise: the mesher's triangles where the surface grazes a grid point) the
-      // model's normals at its corners.
-      V3 n0 = q0 < opt_.minQuality ? add(w_.normal[tr[0]], add(w_.normal[tr[1]], w_.normal[tr[2]])) : cross(sub(o1, o0), sub(o2, o0));
-      V3 c0 = corner(tr[0]), c1 = corner(tr[1]), c2 = corner(tr[2]);
-      V3 n1 = cross(sub(c1, c0), sub(c2, c0));
-      double l1 = norm(n1);
-      worstAfter = std::min(worstAfter, quality(c0, c1, c2));
-      if (!(l1 > 1e-12 * grid_.voxel * grid_.voxel) || dot(n0, n1) <= 0.2 * norm(n0) * l1) {
+      if (!keepsFacing(tr, corner(tr[0]), corner(tr[1]), corner(tr[2]), worstBefore, worstAfter)) {
         ++stats_.rejectedShape;
         return;
       }
@@ -1000,19 +1004,11 @@ class Simplifier {
     // quality bound the worst of the star does not get more than 10% worse.
     double worstBefore = 1, worstAfter = 1;
     for (uint32_t t : gone) worstBefore = std::min(worstBefore, quality(w_.pos[w_.tris[t][0]], w_.pos[w_.tris[t][1]], w_.pos[w_.tris[t][2]]));
-    for (const Fan& f : fan) {
-      const V3 &o0 = w_.pos[f.c], &o1 = w_.pos[f.u], &o2 = w_.pos[f.w];
-      const double q0 = quality(o0, o1, o2);
-      worstBefore = std::min(worstBefore, q0);
-      const V3 n0 = q0 < opt_.minQuality ? add(w_.normal[f.c], add(w_.normal[f.u], w_.normal[f.w])) : cross(sub(o1, o0), sub(o2, o0));
-      const V3 n1 = cross(sub(o1, p), sub(o2, p));
-      const double l1 = norm(n1);
-      worstAfter = std::min(worstAfter, quality(p, o1, o2));
-      if (!(l1 > 1e-12 * grid_.voxel * grid_.voxel) || dot(n0, n1) <= 0.2 * norm(n0) * l1) {
+    for (const Fan& f : fan)
+      if (!keepsFacing({f.c, f.u, f.w}, p, w_.pos[f.u], w_.pos[f.w], worstBefore, worstAfter)) {
         ++stats_.rejectedShape;
         return;
       }
-    }
     if (worstAfter < opt_.minQuality && worstAfter < 0.9 * worstBefore) {
       ++stats_.rejectedShape;
       return;
