@@ -323,7 +323,7 @@ class Simplifier {
   // (the same exact predicates as the per-collapse check, once per final triangle)?
   bool embedded() {
     // Every alive triangle's box and cells computed once; (cell, triangle) pairs in one array
-    // sorted by cell (no hash map of lists to build).
+    // grouped by cell (no hash map of lists to build).
     std::vector<Entry>& box = scratch_.boxes;
     std::vector<uint32_t>& cellsFrom = scratch_.cellsFrom;
     std::vector<uint64_t>& cellsOf = scratch_.cells;
@@ -342,7 +342,23 @@ class Simplifier {
       for (size_t i = first; i < cellsOf.size(); ++i) filed.push_back({cellsOf[i], t});
     }
     cellsFrom[w_.tris.size()] = uint32_t(cellsOf.size());
-    std::sort(filed.begin(), filed.end());
+    // Grouped by a hash of the cell (a counting sort: linear, unlike sorting by cell); a
+    // bucket's entries of other cells are skipped by their key.
+    size_t buckets = 1;
+    while (buckets < filed.size()) buckets <<= 1;
+    const uint64_t mask = buckets - 1;
+    auto bucketOf = [&](uint64_t key) { return (key * 0x9E3779B97F4A7C15ull >> 20) & mask; };
+    std::vector<uint32_t>& bucketFrom = scratch_.bucketFrom;
+    std::vector<std::pair<uint64_t, uint32_t>>& byBucket = scratch_.byBucket;
+    bucketFrom.assign(buckets + 1, 0);
+    for (const auto& f : filed) ++bucketFrom[bucketOf(f.first) + 1];
+    for (size_t b = 0; b < buckets; ++b) bucketFrom[b + 1] += bucketFrom[b];
+    byBucket.resize(filed.size());
+    {
+      std::vector<uint32_t>& at = scratch_.next;  // fill positions
+      at.assign(bucketFrom.begin(), bucketFrom.end() - 1);
+      for (const auto& f : filed) byBucket[at[bucketOf(f.first)]++] = f;
+    }
     for (uint32_t t = 0; t < w_.tris.size(); ++t) {
       if (!tAlive_[t] || !madeNow_[t]) continue;
       const Tri& tr = w_.tris[t];
@@ -356,9 +372,10 @@ class Simplifier {
       probe_[t].seen = probeNow_;
       for (uint32_t c = cellsFrom[t]; c < cellsFrom[t + 1]; ++c) {
         const uint64_t key = cellsOf[c];
-        auto at = std::lower_bound(filed.begin(), filed.end(), std::pair<uint64_t, uint32_t>{key, 0});
-        for (; at != filed.end() && at->first == key; ++at) {
-          const uint32_t u = at->second;
+        const uint64_t b = bucketOf(key);
+        for (uint32_t i = bucketFrom[b]; i < bucketFrom[b + 1]; ++i) {
+          if (byBucket[i].first != key) continue;
+          const uint32_t u = byBucket[i].second;
           const Entry& e = box[u];
           if (e.hi[0] < flo[0] || e.lo[0] > fhi[0] || e.hi[1] < flo[1] || e.lo[1] > fhi[1] || e.hi[2] < flo[2] ||
               e.lo[2] > fhi[2])
@@ -1214,6 +1231,8 @@ class Simplifier {
     std::vector<std::pair<uint64_t, uint32_t>> filed;  // embedded(): (cell, triangle)
     std::vector<Entry> boxes;                          // embedded(): per triangle
     std::vector<uint32_t> cellsFrom;                   // embedded(): triangle t's cells in cells
+    std::vector<uint32_t> bucketFrom;                  // embedded(): hash buckets of filed
+    std::vector<std::pair<uint64_t, uint32_t>> byBucket;
     std::vector<std::pair<uint64_t, uint32_t>> byCell;  // cell contractions
     std::vector<uint32_t> group, component, next, replaced;
     std::vector<V3> gonePoints;
