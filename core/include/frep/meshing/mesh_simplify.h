@@ -7,6 +7,11 @@
 // vertices holds the planes of the faces that meet there, so the merged vertex lands on the
 // edge or the corner (the estimate of dual contouring's QEF), and flat regions merge freely.
 //
+// Each pass first contracts cells: the connected vertices of a grid cell of 1, 2, then 4 voxels
+// merged into one at their quadric's least-squares point where the star stays a disk (dual
+// contouring's vertex per cell, reached from the marching tetrahedra's mesh), with the same
+// shape and error checks as an edge collapse on the fan; the greedy collapses do the rest.
+//
 // Every collapse is checked before it is made:
 //  - topology: the link condition (the surface stays a closed 2-manifold, same genus);
 //  - no fold, no degenerate triangle: no changed triangle turns by more than ~80 degrees or
