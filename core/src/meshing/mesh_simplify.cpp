@@ -924,9 +924,9 @@ class Simplifier {
   // Merges the connected vertices C into one if the surface stays a closed 2-manifold of the
   // same genus and the checks of an edge collapse pass (shape, error against the model).
   void tryContract(const std::vector<uint32_t>& C) {
-    std::vector<uint32_t>&star = scratch_.changed, &gone = scratch_.removed, &ring = scratch_.ring;
-    star.clear(), gone.clear(), ring.clear();
-    std::vector<Fan>& fan = scratch_.fan;
+    std::vector<uint32_t>& gone = scratch_.removed;  // the star's triangles with 2 or 3 corners in C
+    gone.clear();
+    std::vector<Fan>& fan = scratch_.fan;  // and those with one
     fan.clear();
     const uint32_t inC = nextMark();
     for (uint32_t c : C) markA_[c] = inC;
