@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 #include <sstream>
+#include <stdexcept>
 
 #include "frep/io/error.h"
 #include "vdb_checksum.h"
@@ -305,11 +306,12 @@ LevelSetBuilder::LevelSetBuilder(const GridSpec& grid, int bandVoxels)
 LevelSetBuilder::~LevelSetBuilder() = default;
 
 void LevelSetBuilder::addTiles(const std::vector<Tile>& tiles) {
-  if (leaves_) throw std::logic_error("LevelSetBuilder: tiles after leaves");
+  if (!tree_ || leaves_) throw std::logic_error("LevelSetBuilder: tiles after leaves or after write");
   tree_->addTiles(tiles);
 }
 
 void LevelSetBuilder::addLeaves(const std::vector<LeafBlock>& leaves) {
+  if (!tree_) throw std::logic_error("LevelSetBuilder: leaves after write");
   tree_->addLeaves(leaves);
   leaves_ += leaves.size();
 }
