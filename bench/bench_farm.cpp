@@ -4,13 +4,15 @@
 //     (protocol 2: the job goes once per worker, in the welcome);
 //  3. the master's own throughput against fake workers that replay pre-encoded results (bricks
 //     merged per second, the master's CPU per brick), decoding on the scheduling loop alone
-//     against decoding on all cores, and from it how many real workers one master keeps busy at
-//     the brick time measured in 1.
+//     against decoding on all cores, and streaming the merge into a sink that only counts the
+//     leaves (FarmOptions::sampleSink: what a consumer that writes as it goes costs the master),
+//     and from it how many real workers one master keeps busy at the brick time measured in 1.
 // `bench_farm --master-only` runs 2 and 3.
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstdio>
+#include <fstream>
 #include <thread>
 #include <vector>
 #include <zmq.hpp>
@@ -200,13 +202,32 @@ double processCpuSeconds() {
   return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
 }
 
+// The process's peak resident set restarts from its current one (clear_refs 5, Linux >= 4.0), so
+// that each run's peak is its own, not the largest of the runs before it. False if refused.
+bool resetPeakRss() {
+  std::ofstream f("/proc/self/clear_refs");
+  f << "5";
+  f.close();
+  return bool(f);
+}
+
+// VmHWM of /proc/self/status: the peak resident set since resetPeakRss, bytes (0 if unreadable).
+uint64_t peakRssSinceReset() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) * 1024;
+  return 0;
+}
+
 struct MasterRun {
   double wall = 0, loopCpu = 0, processCpu = 0, peakRssMb = 0;
   uint64_t bricks = 0, leaves = 0;
 };
 
-// One job of the master against `fakes` replaying workers, with a journal as frep keeps one.
-MasterRun masterRun(int fakes, int res, int brickVoxels, int leaves, int decodeThreads) {
+// One job of the master against `fakes` replaying workers, with a journal as frep keeps one;
+// `streaming`: the merge goes to a sink that counts the leaves (result.leaves stays empty).
+MasterRun masterRun(int fakes, int res, int brickVoxels, int leaves, int decodeThreads, bool streaming) {
   FakeFarm farm(fakes, res, brickVoxels, leaves);
   JobSpec big = job("my_model(x[3], a[1]) { my_model = 1; }", res);
   FarmOptions o;
@@ -219,7 +240,10 @@ MasterRun masterRun(int fakes, int res, int brickVoxels, int leaves, int decodeT
   int fd = mkstemp(journal);
   if (fd >= 0) close(fd);
   o.journalPath = journal;
+  uint64_t streamed = 0;
+  if (streaming) o.sampleSink.leaves = [&](const std::vector<LeafBlock>& slab) { streamed += slab.size(); };
   MasterRun m;
+  const bool peakReset = resetPeakRss();
   std::thread master([&] {
     const double cpu0 = processCpuSeconds(), loop0 = threadCpuSeconds();
     FarmOutcome out = runJob(big, o);
@@ -228,7 +252,13 @@ MasterRun masterRun(int fakes, int res, int brickVoxels, int leaves, int decodeT
     m.wall = out.report.wallSeconds;
     m.bricks = out.report.bricks;
     m.leaves = out.report.leaves;
-    m.peakRssMb = double(out.report.peakRssBytes) / (1 << 20);
+    m.peakRssMb = double(peakReset ? peakRssSinceReset() : out.report.peakRssBytes) / (1 << 20);
+    if (streaming ? streamed != out.report.leaves || !out.result.leaves.empty()
+                  : out.result.leaves.size() != out.report.leaves) {
+      std::fprintf(stderr, "bench_farm: the merge lost leaves (%llu merged, %llu streamed, %zu in the result)\n",
+                   (unsigned long long)out.report.leaves, (unsigned long long)streamed, out.result.leaves.size());
+      std::exit(1);
+    }
   });
   master.join();
   std::remove(journal);
@@ -329,19 +359,20 @@ int main(int argc, char** argv) {
               "1024^3 in 64^3 bricks, %d leaves (150 kB) a brick, journal on; master CPU = the master's process\n"
               "(loop, decoders, ZeroMQ I/O thread), loop = its scheduling thread alone\n", leavesPerBrick);
   // Decoding on the scheduling loop alone (decodeThreads 1) against the decode threads (0: all
-  // cores), alternated, 3 runs each; medians.
+  // cores), building the output (result.leaves) or streaming it into a counting sink,
+  // alternated, 3 runs each; medians. Peak RSS: each run's own (resetPeakRss).
   const int fakes = 8;
-  std::vector<double> rate[2], cpuPerBrick;
+  const char* label[3] = {"decoding on the loop ", "decoding on all cores", "streaming into a sink"};
+  std::vector<double> rate[3], cpuPerBrick[3];
   for (int round = 0; round < 3; ++round)
-    for (int mode = 0; mode < 2; ++mode) {
-      MasterRun m = masterRun(fakes, 1024, 64, leavesPerBrick, mode == 0 ? 1 : 0);
+    for (int mode = 0; mode < 3; ++mode) {
+      MasterRun m = masterRun(fakes, 1024, 64, leavesPerBrick, mode == 0 ? 1 : 0, mode == 2);
       rate[mode].push_back(double(m.bricks) / m.wall);
-      if (mode == 1) cpuPerBrick.push_back(m.processCpu / double(m.bricks));
+      cpuPerBrick[mode].push_back(m.processCpu / double(m.bricks));
       std::printf("  %d fake workers, %s: %llu bricks in %.2f s = %.0f bricks/s wall; master CPU %.0f us/brick, "
                   "loop %.0f us/brick; process peak RSS %.0f MiB\n",
-                  fakes, mode == 0 ? "decoding on the loop " : "decoding on all cores", (unsigned long long)m.bricks,
-                  m.wall, rate[mode].back(), 1e6 * m.processCpu / double(m.bricks), 1e6 * m.loopCpu / double(m.bricks),
-                  m.peakRssMb);
+                  fakes, label[mode], (unsigned long long)m.bricks, m.wall, rate[mode].back(),
+                  1e6 * m.processCpu / double(m.bricks), 1e6 * m.loopCpu / double(m.bricks), m.peakRssMb);
     }
   auto median = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
@@ -350,7 +381,11 @@ int main(int argc, char** argv) {
   std::printf("median: %.0f bricks/s decoding on the loop, %.0f on all cores: %.2fx\n", median(rate[0]),
               median(rate[1]), median(rate[1]) / median(rate[0]));
   std::printf("master CPU per brick (median, all cores): %.0f us: %.0f bricks per second of master CPU\n",
-              1e6 * median(cpuPerBrick), 1 / median(cpuPerBrick));
+              1e6 * median(cpuPerBrick[1]), 1 / median(cpuPerBrick[1]));
+  std::printf("streaming into a sink (median): %.0f bricks/s wall (%.2fx), %.0f us of master CPU per brick (%.2fx "
+              "fewer): %.0f bricks per second of master CPU\n",
+              median(rate[2]), median(rate[2]) / median(rate[1]), 1e6 * median(cpuPerBrick[2]),
+              median(cpuPerBrick[1]) / median(cpuPerBrick[2]), 1 / median(cpuPerBrick[2]));
   if (brickSeconds > 0)
     std::printf("  -> at %.4f s per brick one master keeps %.0f workers busy (goal >= 256)\n", brickSeconds,
                 median(rate[1]) * brickSeconds);

@@ -2,19 +2,21 @@
 # The master's throughput against a baseline build, alternated on the same machine in one run:
 # bench_farm --master-only of BASE and of NEW (their bin/ directories), ROUNDS times each in
 # turn (default 3), then the medians of the "decoding on all cores" runs (bricks/s wall, master
-# CPU per brick, peak RSS) and NEW/BASE ratios. The fake workers share the machine, so wall
-# rates follow the load; master CPU per brick is the steadier figure.
-#   bench/bench_farm_ab.sh /tmp/main-build/bin build/bin
+# CPU per brick, peak RSS) and NEW/BASE ratios. NEW_LINE (default the same) names the runs of
+# NEW to compare, e.g. "streaming into a sink" (the merge streamed to a consumer, not built).
+# The fake workers share the machine, so wall rates follow the load; master CPU per brick is
+# the steadier figure.
+#   bench/bench_farm_ab.sh /tmp/main-build/bin build/bin [ROUNDS] [NEW_LINE]
 set -eu
-BASE=$1 NEW=$2 ROUNDS=${3:-3}
+BASE=$1 NEW=$2 ROUNDS=${3:-3} NEW_LINE=${4:-decoding on all cores}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 i=0
 while [ "$i" -lt "$ROUNDS" ]; do
   for which in base new; do
-    if [ "$which" = base ]; then bin=$BASE; else bin=$NEW; fi
+    if [ "$which" = base ]; then bin=$BASE line="decoding on all cores"; else bin=$NEW line=$NEW_LINE; fi
     echo "round $((i + 1)) $which (load $(cut -d' ' -f1 /proc/loadavg))"
-    "$bin/bench_farm" --master-only 2>/dev/null | grep 'decoding on all cores:' | tee -a "$out/$which"
+    "$bin/bench_farm" --master-only 2>/dev/null | grep "$line:" | tee -a "$out/$which"
   done
   i=$((i + 1))
 done

@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "arg_parse.h"
+#include "brick.h"
 #include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "curve.h"
@@ -65,6 +66,11 @@ int runSample(const SampleRequest& request) {
   job.set_band(request.band);
   spdlog::info("sampling '{}' on {}x{}x{} voxels of {}", m.model.objectName, grid.dims[0], grid.dims[1],
                grid.dims[2], grid.voxel);
+  // The merge streams into the grid slab by slab (the master never holds the whole sample and
+  // the tree at once); a job that does not complete streams nothing and writes nothing.
+  io::LevelSetBuilder builder(farm::gridOf(job), request.band);  // the lattice the master merges on
+  options.sampleSink.tiles = [&](const std::vector<Tile>& tiles) { builder.addTiles(tiles); };
+  options.sampleSink.leaves = [&](const std::vector<LeafBlock>& slab) { builder.addLeaves(slab); };
   jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
   const farm::FarmReport& report = outcome.report;
@@ -79,7 +85,7 @@ int runSample(const SampleRequest& request) {
   meta.sourceHash = m.model.sourceHash;
   meta.iso = request.model.iso;
   jsonPhase("write");  // with the signed distance (levelSetRebuild) unless --store raw
-  io::writeLevelSet(out.tempPath(), outcome.result, meta);
+  builder.write(out.tempPath(), meta);
   out.commit();
   writeReport(reportOut, report);
   std::remove(options.journalPath.c_str());  // the output is complete: nothing to resume
@@ -89,7 +95,7 @@ int runSample(const SampleRequest& request) {
   std::ostream& text = request.farm.json ? std::cerr : std::cout;
   text << "wrote " << request.region.out << ": " << grid.dims[0] << "x" << grid.dims[1] << "x" << grid.dims[2]
        << " voxels of " << formatNumber(grid.voxel) << ", band " << request.band << " voxels\n"
-       << "  leaves " << outcome.result.leaves.size() << ", tiles " << outcome.result.tiles.size() << "\n"
+       << "  leaves " << builder.leaves() << ", tiles " << outcome.result.tiles.size() << "\n"
        << "  evaluations " << s.pointEvals << " (" << formatNumber(std::round(fraction * 1e4) / 100)
        << "% of dense " << s.denseEvals << "), interval " << s.intervalEvals << "\n"
        << "  NaN values " << s.nanValues << (s.nanValues ? " (domain errors, stored as outside)" : "") << "\n"

@@ -1001,8 +1001,12 @@ class Master {
   // bricks at a time: the bricks are planned x-slab by x-slab and the sort is by x first, so a
   // slab's leaves follow all the leaves of the slabs before it. Each brick's payload is decoded
   // (on the decode threads) straight into its leaves' sorted places; the slab's payloads are
-  // then released, so the master holds the payloads or the output, not both.
+  // then released, so the master holds the payloads or the output, not both. With a sample
+  // sink (complete jobs only) each slab is decoded into one buffer, sized once for the largest
+  // slab and refilled (no fresh pages per slab), and handed over; result.leaves stays empty.
   void mergeLeaves(SampleResult& result) {
+    const SampleSink& sink = opt_.sampleSink;
+    const bool streaming = sink.leaves && done_ == bricks_.size();
     size_t leaves = 0;
     for (const KeptBrick& k : kept_) {
       leaves += k.origins.size();
@@ -1010,12 +1014,25 @@ class Master {
     }
     std::vector<LeafBlock> noLeaves;
     sortByOrigin(noLeaves, result.tiles);
-    result.leaves.reserve(leaves);  // filled slab by slab: pages are touched as payloads are freed
+    if (streaming && sink.tiles) sink.tiles(result.tiles);
     const size_t perSlab = size_t((grid_.dims[1] + opt_.brickVoxels - 1) / opt_.brickVoxels) *
                            size_t((grid_.dims[2] + opt_.brickVoxels - 1) / opt_.brickVoxels);
+    std::vector<LeafBlock> slab;  // streaming: every slab's leaves, in turn
+    if (streaming) {
+      size_t largest = 0;
+      for (size_t first = 0; first < kept_.size(); first += perSlab) {
+        size_t n = 0;
+        for (size_t i = first; i < std::min(kept_.size(), first + perSlab); ++i) n += kept_[i].origins.size();
+        largest = std::max(largest, n);
+      }
+      slab.reserve(largest);
+    } else {
+      result.leaves.reserve(leaves);  // filled slab by slab: pages are touched as payloads are freed
+    }
+    std::vector<LeafBlock>& out = streaming ? slab : result.leaves;
     std::vector<std::array<int32_t, 3>> origins;  // the slab's, brick by brick
     std::vector<size_t> start, rank;  // rank[start[brick] + leaf]: the leaf's place in the slab
-    size_t at = 0;
+    size_t at = 0;  // where the slab starts in `out`
     for (size_t first = 0; first < kept_.size(); first += perSlab) {
       const size_t last = std::min(kept_.size(), first + perSlab);
       origins.clear();
@@ -1024,7 +1041,7 @@ class Master {
         origins.insert(origins.end(), kept_[i].origins.begin(), kept_[i].origins.end());
         start.push_back(origins.size());
       }
-      result.leaves.resize(at + origins.size());  // not zeroed (LeafBlock): decoded into below
+      out.resize(at + origins.size());  // not zeroed (LeafBlock): decoded into below
       decoders_.execute([&] {
         rankByOrigin(origins, bricks_[first].lo, bricks_[last - 1].hi, rank);
         tbb::parallel_for(first, last, [&](size_t i) {
@@ -1034,12 +1051,16 @@ class Master {
           const std::string_view bytes = keptPayload(k, i);
           std::string err;
           if (!decodeBrickLeaves(bytes.data(), bytes.size(), k.origins.size(),
-                                 [&](size_t l) { return &result.leaves[at + to[l]]; }, &err))
+                                 [&](size_t l) { return &out[at + to[l]]; }, &err))
             throw std::logic_error("brick " + std::to_string(i) + ": its verified payload no longer decodes: " + err);
         });
       });
-      at += origins.size();
       for (size_t i = first; i < last; ++i) kept_[i] = KeptBrick{};  // the arena unmaps emptied chunks
+      if (streaming) {
+        if (!slab.empty()) sink.leaves(slab);
+      } else {
+        at += origins.size();
+      }
     }
     kept_.clear();
   }

@@ -18,6 +18,21 @@
 
 namespace frep::farm {
 
+// "sample": the merged output handed to the caller as it is merged instead of built whole in
+// FarmOutcome::result.leaves (which then stays empty), so that a consumer that writes as it goes
+// (io::LevelSetBuilder) never holds the leaves and its own output at once (docs/farm.md,
+// "Throughput"). Streaming is on when `leaves` is set, and only for a complete job (nothing
+// poisoned, not interrupted: otherwise nothing is handed over and result.leaves is filled as
+// without a sink). Both are called on the thread that called runJob, in the order of result:
+// `tiles` once, every tile sorted (result.tiles still holds them), then `leaves` once per x-slab
+// of bricks that has any, with that slab's leaves sorted by origin (the slabs follow one another
+// in the sort). The slab is always the same buffer, refilled: read it during the call and keep
+// nothing that points into it.
+struct SampleSink {
+  std::function<void(const std::vector<Tile>& tiles)> tiles;  // optional
+  std::function<void(const std::vector<LeafBlock>& slabLeaves)> leaves;
+};
+
 struct FarmOptions {
   int workers = -1;              // local worker processes: -1 one per core, 0 compute in-process
   std::string listen;            // cluster mode: bind here (tcp://*:5555) and spawn nothing
@@ -39,6 +54,7 @@ struct FarmOptions {
   int threads = 0;               // in-process mode: threads per brick (0: all cores)
   int decodeThreads = 0;         // farm: threads verifying and decoding results (0: all cores, 1: the loop's own)
   std::string logLevel = "warn"; // local mode: workers' --log-level
+  SampleSink sampleSink;         // "sample": stream the merged output (see SampleSink)
   // Called once the master is bound, with the actual endpoint (tcp://127.0.0.1:* picks a free
   // port): tests and embedders start their workers from it.
   std::function<void(const std::string& endpoint)> onListening;

@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 #include <sstream>
+#include <stdexcept>
 
 #include "frep/io/error.h"
 #include "vdb_checksum.h"
@@ -146,24 +147,50 @@ std::string hex(uint64_t v) {
   return buf;
 }
 
+// The level set grid as the sampler's output comes in: tiles first, then leaves, then finished
+// (pruned to the canonical tree, transform and class set). levelSetGrid and LevelSetBuilder.
+struct GridAssembly {
+  GridSpec g;
+  int bandVoxels;
+  float background;
+  std::array<int32_t, 3> extent;
+  openvdb::Coord offset;
+  openvdb::FloatGrid::Ptr grid;
+  openvdb::FloatGrid::Accessor acc;
+  GridAssembly(const GridSpec& lattice, int band)
+      : g(lattice),
+        bandVoxels(band),
+        background(float(band * lattice.voxel)),
+        extent{(lattice.dims[0] + 7) & ~7, (lattice.dims[1] + 7) & ~7, (lattice.dims[2] + 7) & ~7},
+        offset(latticeOffset(lattice)),
+        grid((openvdb::initialize(), openvdb::FloatGrid::create(background))),
+        acc(grid->getAccessor()) {}
+  void addTiles(const std::vector<Tile>& tiles) {
+    for (const Tile& t : tiles) addTile(grid->tree(), t, t.inside ? -background : background, extent, offset);
+  }
+  void addLeaves(const std::vector<LeafBlock>& leaves) {
+    for (const LeafBlock& b : leaves) addLeaf(acc, b, offset);
+  }
+  openvdb::FloatGrid::Ptr finish() {
+    acc.clear();
+    openvdb::tools::pruneLevelSet(grid->tree());  // canonical tree: the same whatever the brick layout
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(g.voxel));
+    grid->setGridClass(openvdb::GRID_LEVEL_SET);
+    return std::move(grid);
+  }
+};
+
 }  // namespace
 
-openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result) {
-  openvdb::initialize();
-  const GridSpec& g = result.grid;
-  const float background = float(result.bandVoxels * g.voxel);
-  openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(background);
-  openvdb::FloatTree& tree = grid->tree();
-  const std::array<int32_t, 3> extent{(g.dims[0] + 7) & ~7, (g.dims[1] + 7) & ~7, (g.dims[2] + 7) & ~7};
-  const openvdb::Coord offset = latticeOffset(g);
-  for (const Tile& t : result.tiles) addTile(tree, t, t.inside ? -background : background, extent, offset);
-  openvdb::FloatGrid::Accessor acc = grid->getAccessor();
-  for (const LeafBlock& b : result.leaves) addLeaf(acc, b, offset);
-  openvdb::tools::pruneLevelSet(tree);  // canonical tree: the same whatever the brick layout
+struct LevelSetBuilder::Tree : GridAssembly {
+  using GridAssembly::GridAssembly;
+};
 
-  grid->setTransform(openvdb::math::Transform::createLinearTransform(g.voxel));
-  grid->setGridClass(openvdb::GRID_LEVEL_SET);
-  return grid;
+openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result) {
+  GridAssembly tree(result.grid, result.bandVoxels);
+  tree.addTiles(result.tiles);
+  tree.addLeaves(result.leaves);
+  return tree.finish();
 }
 
 openvdb::FloatGrid::Ptr signedDistanceGrid(const openvdb::FloatGrid& raw, int bandVoxels) {
@@ -211,12 +238,15 @@ const char* storeName(VdbStore store) {
   return "sdf";
 }
 
-void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta) {
-  openvdb::FloatGrid::Ptr grid = levelSetGrid(result);
-  if (meta.store != VdbStore::Raw) grid = signedDistanceGrid(*grid, result.bandVoxels);
+namespace {
+
+// A finished levelSetGrid of the lattice `g` to the file: the signed distance unless raw, the
+// metadata, the checksum, then every byte written and checked.
+void writeGrid(const std::string& path, openvdb::FloatGrid::Ptr grid, const GridSpec& g, int bandVoxels,
+               const VdbMetadata& meta) {
+  if (meta.store != VdbStore::Raw) grid = signedDistanceGrid(*grid, bandVoxels);
   if (meta.store == VdbStore::Fog) openvdb::tools::sdfToFogVolume(*grid);  // class fog volume
-  const GridSpec& g = result.grid;
-  const float background = float(result.bandVoxels * g.voxel);
+  const float background = float(bandVoxels * g.voxel);
   const openvdb::Coord offset = latticeOffset(g);
   const openvdb::Coord last = offset + openvdb::Coord(g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1);
   // Blender's volume import looks for a grid named "density".
@@ -234,7 +264,7 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
   grid->insertMeta("frep_box_index_max", openvdb::Vec3IMetadata(openvdb::Vec3i(last.asVec3i())));
   grid->insertMeta("frep_box_min", openvdb::Vec3DMetadata(grid->indexToWorld(offset)));
   grid->insertMeta("frep_box_max", openvdb::Vec3DMetadata(grid->indexToWorld(last)));
-  grid->insertMeta("frep_band_voxels", openvdb::Int32Metadata(result.bandVoxels));
+  grid->insertMeta("frep_band_voxels", openvdb::Int32Metadata(bandVoxels));
   grid->insertMeta("frep_band", openvdb::DoubleMetadata(double(background)));
   grid->insertMeta("frep_iso", openvdb::DoubleMetadata(meta.iso));
   grid->insertMeta("frep_params", openvdb::StringMetadata(meta.params));
@@ -262,6 +292,37 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
   } catch (const openvdb::Exception& e) {
     throw ioError("cannot write VDB '" + path + "': " + e.what());
   }
+}
+
+}  // namespace
+
+void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta) {
+  writeGrid(path, levelSetGrid(result), result.grid, result.bandVoxels, meta);
+}
+
+LevelSetBuilder::LevelSetBuilder(const GridSpec& grid, int bandVoxels)
+    : tree_(std::make_unique<Tree>(grid, bandVoxels)) {}
+
+LevelSetBuilder::~LevelSetBuilder() = default;
+
+void LevelSetBuilder::addTiles(const std::vector<Tile>& tiles) {
+  if (!tree_ || leaves_) throw std::logic_error("LevelSetBuilder: tiles after leaves or after write");
+  tree_->addTiles(tiles);
+}
+
+void LevelSetBuilder::addLeaves(const std::vector<LeafBlock>& leaves) {
+  if (!tree_) throw std::logic_error("LevelSetBuilder: leaves after write");
+  tree_->addLeaves(leaves);
+  leaves_ += leaves.size();
+}
+
+void LevelSetBuilder::write(const std::string& path, const VdbMetadata& meta) {
+  if (!tree_) throw std::logic_error("LevelSetBuilder: written twice");
+  const GridSpec g = tree_->g;
+  const int bandVoxels = tree_->bandVoxels;
+  openvdb::FloatGrid::Ptr grid = tree_->finish();
+  tree_.reset();
+  writeGrid(path, std::move(grid), g, bandVoxels, meta);
 }
 
 }  // namespace frep::io

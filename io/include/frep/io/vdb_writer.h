@@ -3,7 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "frep/sampling/sample.h"
 
@@ -32,5 +34,27 @@ struct VdbMetadata {
 // frep_box_index_min/max, frep_box_min/max (world), frep_band_voxels, frep_band, frep_iso,
 // frep_params, frep_version. Throws Error(kExitIoError).
 void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta);
+
+// The same file built from a sample as it streams in (farm::SampleSink): the tiles, then the
+// leaves in any number of calls, then write(): the bytes writeLevelSet writes for a SampleResult
+// holding those tiles and leaves. Each call copies its leaves into the tree, so the caller can
+// free or reuse them: the sampler's leaves and the tree are never held whole at once.
+class LevelSetBuilder {
+ public:
+  LevelSetBuilder(const GridSpec& grid, int bandVoxels);
+  ~LevelSetBuilder();
+  LevelSetBuilder(const LevelSetBuilder&) = delete;
+  LevelSetBuilder& operator=(const LevelSetBuilder&) = delete;
+  void addTiles(const std::vector<Tile>& tiles);  // before any leaf (a tile overwrites what it covers)
+  void addLeaves(const std::vector<LeafBlock>& leaves);
+  uint64_t leaves() const { return leaves_; }  // added so far
+  // Once, at the end; throws Error(kExitIoError) as writeLevelSet does.
+  void write(const std::string& path, const VdbMetadata& meta);
+
+ private:
+  struct Tree;  // the OpenVDB grid being built (vdb_writer.cpp)
+  std::unique_ptr<Tree> tree_;
+  uint64_t leaves_ = 0;
+};
 
 }  // namespace frep::io

@@ -1,0 +1,90 @@
+// io::LevelSetBuilder (what frep sample streams the farm's merge into) against writeLevelSet of
+// the whole SampleResult: the same file, byte for byte, whatever the slabs.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "frep/io/vdb_writer.h"
+#include "frep/io/world_lattice.h"
+#include "frep/expressions/expr.h"
+#include "frep/sampling/sample.h"
+
+using namespace frep;
+
+namespace {
+
+std::string readAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// An empty file at a fresh path (the writers fill an existing file, as AtomicOutput's).
+std::string emptyFile(const std::string& name) {
+  const std::string path = "/tmp/frep_level_set_builder." + std::to_string(getpid()) + "." + name;
+  std::ofstream(path).close();
+  return path;
+}
+
+// A block with a ball cut out, on the world lattice: leaves on flat faces, edges and a curved
+// pocket, and tiles inside and outside.
+SampleResult bittenBlock() {
+  Expr X = Expr::x(0), Y = Expr::x(1), Z = Expr::x(2);
+  Expr block = min(min(0.7 - abs(X), 0.6 - abs(Y)), 0.5 - abs(Z));
+  Expr ball = 0.45 - sqrt(square(X - 0.3) + square(Y - 0.2) + square(Z - 0.4));
+  GridSpec g = io::worldLatticeGrid("test", {-1, -1, -1}, {1, 1, 1}, 2.0 / 95);
+  return sample(Tape::compile(min(block, -ball), 3), g);
+}
+
+}  // namespace
+
+TEST(VdbLevelSetBuilder, SlabsOfAnySizeWriteTheBytesOfTheWholeResult) {
+  SampleResult s = bittenBlock();
+  ASSERT_GT(s.leaves.size(), 500u);
+  ASSERT_GT(s.tiles.size(), 10u);
+  for (io::VdbStore store : {io::VdbStore::Sdf, io::VdbStore::Raw, io::VdbStore::Fog}) {
+    SCOPED_TRACE(io::storeName(store));
+    io::VdbMetadata meta;
+    meta.gridName = "bitten";
+    meta.job = "test";
+    meta.store = store;
+    const std::string whole = emptyFile("whole.vdb");
+    io::writeLevelSet(whole, s, meta);
+    for (size_t slab : {size_t(1), size_t(97), s.leaves.size()}) {
+      SCOPED_TRACE("slabs of " + std::to_string(slab) + " leaves");
+      io::LevelSetBuilder b(s.grid, s.bandVoxels);
+      b.addTiles(s.tiles);
+      std::vector<LeafBlock> buffer;  // one buffer, refilled, as the farm's merge hands them over
+      for (size_t at = 0; at < s.leaves.size(); at += slab) {
+        buffer.assign(s.leaves.begin() + long(at), s.leaves.begin() + long(std::min(s.leaves.size(), at + slab)));
+        b.addLeaves(buffer);
+        for (LeafBlock& l : buffer) l = LeafBlock::cleared();  // the builder kept copies, not references
+      }
+      EXPECT_EQ(b.leaves(), s.leaves.size());
+      const std::string streamed = emptyFile("streamed.vdb");
+      b.write(streamed, meta);
+      const std::string want = readAll(whole), got = readAll(streamed);
+      EXPECT_GT(want.size(), 10000u);
+      EXPECT_TRUE(want == got) << "the streamed file differs (" << got.size() << " bytes against " << want.size() << ")";
+      std::remove(streamed.c_str());
+    }
+    std::remove(whole.c_str());
+  }
+}
+
+TEST(VdbLevelSetBuilder, TilesAfterLeavesAndASecondWriteAreRefused) {
+  SampleResult s = bittenBlock();
+  io::LevelSetBuilder b(s.grid, s.bandVoxels);
+  b.addTiles(s.tiles);
+  b.addLeaves(s.leaves);
+  EXPECT_THROW(b.addTiles(s.tiles), std::logic_error);  // a tile would overwrite the leaves it covers
+  const std::string path = emptyFile("twice.vdb");
+  b.write(path, io::VdbMetadata{});
+  EXPECT_THROW(b.write(path, io::VdbMetadata{}), std::logic_error);
+  std::remove(path.c_str());
+}
