@@ -355,7 +355,7 @@ class Simplifier {
     for (size_t b = 0; b < buckets; ++b) bucketFrom[b + 1] += bucketFrom[b];
     byBucket.resize(filed.size());
     {
-      std::vector<uint32_t>& at = scratch_.next;  // fill positions
+      std::vector<uint32_t>& at = scratch_.bucketFill;
       at.assign(bucketFrom.begin(), bucketFrom.end() - 1);
       for (const auto& f : filed) byBucket[at[bucketOf(f.first)]++] = f;
     }
@@ -606,20 +606,20 @@ class Simplifier {
           q.done = false;
     }
     for (LevelQuery& q : qs) q.limit = maxK;
-    for (LevelQuery& q : qs) {
-      if (resume) break;
-      auto unit = [](V3 d) {
-        double l = norm(d);
-        return l > 0 && std::isfinite(l) ? scale(d, 1 / l) : V3{0, 0, 0};
-      };
-      q.d = q.primary != V3{0, 0, 0} ? unit(q.primary) : unit(cross(sub(q.b, q.a), sub(q.c, q.a)));
-      const double longest = std::max({norm(sub(q.b, q.a)), norm(sub(q.c, q.b)), norm(sub(q.a, q.c))});
-      q.m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
-      q.level = 0;
-      q.probed = false;
-      q.done = q.d == V3{0, 0, 0};  // no direction: no level passes
-      if (q.done) q.level = maxK + 1;
-    }
+    if (!resume)
+      for (LevelQuery& q : qs) {  // a fresh call: every query from level 0
+        auto unit = [](V3 d) {
+          double l = norm(d);
+          return l > 0 && std::isfinite(l) ? scale(d, 1 / l) : V3{0, 0, 0};
+        };
+        q.d = q.primary != V3{0, 0, 0} ? unit(q.primary) : unit(cross(sub(q.b, q.a), sub(q.c, q.a)));
+        const double longest = std::max({norm(sub(q.b, q.a)), norm(sub(q.c, q.b)), norm(sub(q.a, q.c))});
+        q.m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
+        q.level = 0;
+        q.probed = false;
+        q.done = q.d == V3{0, 0, 0};  // no direction: no level passes
+        if (q.done) q.level = maxK + 1;
+      }
     const uint32_t nvars = tape_->numVars();
     batch_.reserve(*tape_);
     inputs_.resize(nvars);
@@ -727,6 +727,16 @@ class Simplifier {
   // the same way — its own normal, or for a sliver (whose normal is noise: the mesher's
   // triangles where the surface grazes a grid point) the model's normals at its corners — within
   // ~78 degrees, and not degenerate. Tracks the worst quality before and after.
+  // The worst quality of the triangles ts as they are (1 for none).
+  double worstQuality(const std::vector<uint32_t>& ts) const {
+    double worst = 1;
+    for (uint32_t t : ts) worst = std::min(worst, quality(w_.pos[w_.tris[t][0]], w_.pos[w_.tris[t][1]], w_.pos[w_.tris[t][2]]));
+    return worst;
+  }
+  // Below the quality bound the worst triangle may not get more than 10% worse (the mesher
+  // leaves slivers where the surface grazes grid points; they go first).
+  bool worstGotWorse(double before, double after) const { return after < opt_.minQuality && after < 0.9 * before; }
+
   bool keepsFacing(const Tri& tr, const V3& c0, const V3& c1, const V3& c2, double& worstBefore, double& worstAfter) const {
     const V3 &o0 = w_.pos[tr[0]], &o1 = w_.pos[tr[1]], &o2 = w_.pos[tr[2]];
     const double q0 = quality(o0, o1, o2);
@@ -782,10 +792,8 @@ class Simplifier {
       }
     auto corner = [&](uint32_t v) { return v == a || v == b ? p : w_.pos[v]; };
 
-    // Shape: no flip or fold; below the quality bound, the worst triangle may not get more than
-    // 10% worse (the mesher leaves slivers where the surface grazes grid points; they go first).
-    double worstBefore = 1, worstAfter = 1;
-    for (uint32_t t : removed) worstBefore = std::min(worstBefore, quality(w_.pos[w_.tris[t][0]], w_.pos[w_.tris[t][1]], w_.pos[w_.tris[t][2]]));
+    // Shape: no flip or fold, no sliver made worse (keepsFacing, worstGotWorse).
+    double worstBefore = worstQuality(removed), worstAfter = 1;
     for (uint32_t t : changed) {
       const Tri& tr = w_.tris[t];
       if (!keepsFacing(tr, corner(tr[0]), corner(tr[1]), corner(tr[2]), worstBefore, worstAfter)) {
@@ -793,7 +801,7 @@ class Simplifier {
         return;
       }
     }
-    if (worstAfter < opt_.minQuality && worstAfter < 0.9 * worstBefore) {
+    if (worstGotWorse(worstBefore, worstAfter)) {
       ++stats_.rejectedShape;
       return;
     }
@@ -1019,14 +1027,13 @@ class Simplifier {
 
     // Shape, as for an edge collapse: no fan triangle turns over or degenerates, and below the
     // quality bound the worst of the star does not get more than 10% worse.
-    double worstBefore = 1, worstAfter = 1;
-    for (uint32_t t : gone) worstBefore = std::min(worstBefore, quality(w_.pos[w_.tris[t][0]], w_.pos[w_.tris[t][1]], w_.pos[w_.tris[t][2]]));
+    double worstBefore = worstQuality(gone), worstAfter = 1;
     for (const Fan& f : fan)
       if (!keepsFacing({f.c, f.u, f.w}, p, w_.pos[f.u], w_.pos[f.w], worstBefore, worstAfter)) {
         ++stats_.rejectedShape;
         return;
       }
-    if (worstAfter < opt_.minQuality && worstAfter < 0.9 * worstBefore) {
+    if (worstGotWorse(worstBefore, worstAfter)) {
       ++stats_.rejectedShape;
       return;
     }
@@ -1231,7 +1238,7 @@ class Simplifier {
     std::vector<std::pair<uint64_t, uint32_t>> filed;  // embedded(): (cell, triangle)
     std::vector<Entry> boxes;                          // embedded(): per triangle
     std::vector<uint32_t> cellsFrom;                   // embedded(): triangle t's cells in cells
-    std::vector<uint32_t> bucketFrom;                  // embedded(): hash buckets of filed
+    std::vector<uint32_t> bucketFrom, bucketFill;      // embedded(): hash buckets of filed
     std::vector<std::pair<uint64_t, uint32_t>> byBucket;
     std::vector<std::pair<uint64_t, uint32_t>> byCell;  // cell contractions
     std::vector<uint32_t> group, component, next, replaced;
