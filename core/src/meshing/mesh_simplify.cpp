@@ -641,11 +641,11 @@ class Simplifier {
           const V3 p = add(q.a, add(scale(u, cells[k][0] + 1.0 / 3), scale(v, cells[k][1] + 1.0 / 3)));
           for (uint32_t c = 0; c < spatial; ++c) inputs_[c][2 * lanes_] = p[c] - de[c], inputs_[c][2 * lanes_ + 1] = p[c] + de[c];
           laneQuery_[lanes_] = i;
-          if (++lanes_ == kPairsPerCall) crossed();
+          if (++lanes_ == kPairsPerCall && crossed() && stopAbove && endsAbove(qs, maxK)) return false;
         }
       }
       if (!any) return true;
-      crossed();
+      if (crossed() && stopAbove && endsAbove(qs, maxK)) return false;
       for (uint32_t i = 0; i < qs.size(); ++i) {
         LevelQuery& q = qs[i];
         if (q.done) continue;
@@ -666,17 +666,31 @@ class Simplifier {
     }
   }
 
+  // With stopAbove: some query failed its last level maxK, so the call's answer (false) is known
+  // without the rest of the round. That query is answered (above maxK); the others keep the
+  // state they began the round with, and a resume redoes the round for them (the same answers).
+  bool endsAbove(std::vector<LevelQuery>& qs, int maxK) {
+    for (uint32_t i = 0; i < qs.size(); ++i)
+      if (failed_[i] && !qs[i].done && qs[i].level == maxK) {
+        qs[i].level = maxK + 1, qs[i].probed = false, qs[i].done = true;
+        return true;
+      }
+    return false;
+  }
+
   // Evaluates the pending lanes (pairs: f(p - e d) must be inside, f(p + e d) outside) and marks
-  // failed_[query] where a pair is not.
-  void crossed() {
-    if (lanes_ == 0) return;
+  // failed_[query] where a pair is not. True if some pair failed.
+  bool crossed() {
+    if (lanes_ == 0) return false;
     const uint32_t nvars = tape_->numVars();
     for (uint32_t k = 3; k < nvars; ++k) std::fill_n(inputs_[k], 2 * lanes_, opt_.fixedCoords[k - 3]);
     const double* f = batch_.eval(*tape_, 2 * lanes_);
     stats_.modelEvals += 2 * lanes_;
+    bool any = false;
     for (size_t i = 0; i < lanes_; ++i)
-      if (std::signbit(f[2 * i]) || !std::signbit(f[2 * i + 1])) failed_[laneQuery_[i]] = 1;
+      if (std::signbit(f[2 * i]) || !std::signbit(f[2 * i + 1])) failed_[laneQuery_[i]] = 1, any = true;
     lanes_ = 0;
+    return any;
   }
 
   int levelOf(uint32_t t) {
