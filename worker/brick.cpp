@@ -482,7 +482,7 @@ constexpr size_t kMinTriangleBytes = 3;
 std::string encodeMeshPiece(const MeshPiece& piece) {
   std::string s;
   s.reserve(kMeshHeader + piece.vertices.size() * 51 + piece.triangles.size() * 5);
-  s.append("FRM3", 4);
+  s.append("FRM4", 4);
   for (int a = 0; a < 3; ++a) put(s, piece.regionLo[a]);
   const MeshStats& st = piece.stats;
   for (uint64_t v : {st.cellsVisited, st.cellsCrossed, st.rootEvals, st.gradientEvals, st.samplePointEvals,
@@ -517,6 +517,7 @@ std::string encodeMeshPiece(const MeshPiece& piece) {
     prevIndex = v.index;
     for (double q : v.quadric) put(s, q);
     s.push_back(char(v.moved));
+    put(s, v.settled);
   }
   s.push_back(char(c.triangles.empty() ? 0 : 1));
   s.append(reinterpret_cast<const char*>(c.triangles.data()), c.triangles.size());
@@ -528,7 +529,7 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
     if (error) *error = why;
     return false;
   };
-  if (size < kMeshHeader || std::memcmp(data, "FRM3", 4) != 0) return fail("mesh payload: bad magic or header");
+  if (size < kMeshHeader || std::memcmp(data, "FRM4", 4) != 0) return fail("mesh payload: bad magic or header");
   Reader r{static_cast<const char*>(data) + 4, static_cast<const char*>(data) + size};
   for (int a = 0; a < 3; ++a) r.get(out.regionLo[a]);
   if (((out.regionLo[0] | out.regionLo[1] | out.regionLo[2]) & 7) != 0 || out.regionLo[0] < 0 || out.regionLo[1] < 0 ||
@@ -588,7 +589,7 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
     if (!r.get(*v)) return fail("mesh payload: truncated simplifier counters");
   uint32_t ncv = 0;
   if (!r.get(ncv)) return fail("mesh payload: truncated simplifier state");
-  if (uint64_t(ncv) * (1 + 88 + 1) > size_t(r.end - r.p)) return fail("mesh payload: carried vertices exceed its size");
+  if (uint64_t(ncv) * (1 + 88 + 1 + 4) > size_t(r.end - r.p)) return fail("mesh payload: carried vertices exceed its size");
   c.vertices.resize(ncv);
   for (uint32_t i = 0; i < ncv; ++i) {
     SimplifyCarry::Vertex& v = c.vertices[i];
@@ -603,6 +604,7 @@ bool decodeMeshPiece(const void* data, size_t size, MeshPiece& out, std::string*
     uint8_t moved = 0;
     if (!r.get(moved) || moved > 1) return fail("mesh payload: bad carried vertex flag");
     v.moved = moved;
+    if (!r.get(v.settled)) return fail("mesh payload: truncated carried vertex");
   }
   uint8_t hasStates = 0;
   if (!r.get(hasStates) || hasStates > 1) return fail("mesh payload: bad triangle-state flag");

@@ -105,7 +105,7 @@ bool scanBrick(const void* data, size_t size, std::vector<std::array<int32_t, 3>
 bool decodeBrickLeaves(const void* data, size_t size, size_t leaves, const std::function<LeafBlock*(size_t)>& slot,
                        std::string* error);
 
-// Mesh piece codec (little-endian, version in the magic): "FRM3", regionLo (3 x i32), the
+// Mesh piece codec (little-endian, version in the magic): "FRM4", regionLo (3 x i32), the
 // piece's MeshStats (6 x u64: cells visited, crossed, root evals, gradient evals, sample point
 // evals, fallback edges), u32 vertices, u32 triangles; per vertex: its key as a
 // varint (the first absolute, then the increase over the previous key: keys strictly increase),
@@ -114,7 +114,7 @@ bool decodeBrickLeaves(const void* data, size_t size, size_t leaves, const std::
 // the first. Then the simplifier's carry (SimplifyCarry, mesh.h; empty for raw pieces): 6 x u64
 // counters (collapses, rejected for topology, shape, error, intersection, model evaluations),
 // u32 carried vertices, each a varint index (the first absolute, then the increase), 11 x f64
-// quadric and a u8 moved flag; a u8 flag, and when 1 one state byte per triangle. Varints are
+// quadric, a u8 moved flag and a u32 settled tag; a u8 flag, and when 1 one state byte per triangle. Varints are
 // LEB128 (7 bits a byte, at most 10 bytes).
 std::string encodeMeshPiece(const MeshPiece& piece);
 // Returns false (with a reason) on a malformed payload: bad magic, truncation, counts beyond

@@ -2,6 +2,7 @@
 // mesh is the in-process meshGrid's, vertex for vertex and triangle for triangle, for any worker
 // count and brick size, through a worker killed mid-job and a resume from a torn journal; the
 // mesh payload codec rejects malformed input without reading out of bounds.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -137,7 +138,7 @@ TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
   EXPECT_TRUE(back.vertices.empty() && back.triangles.empty());
 
   EXPECT_FALSE(decodeMeshPiece(s.data(), s.size() - 1, back, &err));  // truncated
-  EXPECT_FALSE(decodeMeshPiece("FRM3", 4, back, &err));
+  EXPECT_FALSE(decodeMeshPiece("FRM4", 4, back, &err));
   EXPECT_FALSE(decodeMeshPiece("FRM2", 4, back, &err));
   EXPECT_FALSE(decodeMeshPiece((s + "x").data(), s.size() + 1, back, &err));  // trailing
   std::string bad = s;
@@ -190,7 +191,11 @@ TEST(MeshFarm, MeshPayloadCodecRejectsMalformedInput) {
     EXPECT_EQ(back.carry.vertices[i].index, simplified.carry.vertices[i].index);
     EXPECT_EQ(back.carry.vertices[i].quadric, simplified.carry.vertices[i].quadric);
     EXPECT_EQ(back.carry.vertices[i].moved, simplified.carry.vertices[i].moved);
+    EXPECT_EQ(back.carry.vertices[i].settled, simplified.carry.vertices[i].settled);
   }
+  // The blocks' runs settled vertices (their collapses ran out): the tags travel too.
+  EXPECT_TRUE(std::any_of(simplified.carry.vertices.begin(), simplified.carry.vertices.end(),
+                          [](const SimplifyCarry::Vertex& v) { return v.settled != 0; }));
   // A carried vertex past the piece, a bad flag, an error level out of range: refused.
   {
     MeshPiece p = simplified;

@@ -1,5 +1,5 @@
 // Fuzz target: what the farm decodes from the network. The first byte picks the decoder, the rest
-// is its input: 0 a brick result's FRB2 payload (decodeBrick), 1 a mesh piece's FRM3 payload
+// is its input: 0 a brick result's FRB2 payload (decodeBrick), 1 a mesh piece's FRM4 payload
 // (decodeMeshPiece, then the master's merge of it), 2 an Envelope frame (wire.cpp's parse) and,
 // when it holds a welcome, the job a worker would compute (fuzz_target.h). Oracles: a payload
 // that decodes re-encodes to bytes that decode and re-encode to the same bytes (the codec has

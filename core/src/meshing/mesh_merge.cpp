@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <functional>
 #include <stdexcept>
+#include <tuple>
 
 namespace frep {
 
@@ -118,7 +119,7 @@ Mesh mergeKeyed(const std::vector<MeshPiece>& pieces, const std::function<void(s
   // should two pieces carry it, the smaller record wins, whatever the order of the pieces.
   auto& cv = mesh.carry.vertices;
   std::sort(cv.begin(), cv.end(), [](const SimplifyCarry::Vertex& x, const SimplifyCarry::Vertex& y) {
-    return x.index != y.index ? x.index < y.index : (x.quadric != y.quadric ? x.quadric < y.quadric : x.moved < y.moved);
+    return std::tie(x.index, x.quadric, x.moved, x.settled) < std::tie(y.index, y.quadric, y.moved, y.settled);
   });
   cv.erase(std::unique(cv.begin(), cv.end(), [](const SimplifyCarry::Vertex& x, const SimplifyCarry::Vertex& y) {
              return x.index == y.index;

@@ -167,11 +167,12 @@ struct Work {
   std::vector<char> made;     // per triangle: made by a collapse
   bool confined = false;      // placements stay inside [regionLo, regionHi]
   V3 regionLo{}, regionHi{};
-  // Per vertex, or empty: owned by a block of the fourth pass, whose collapses ran out, so
-  // every edge between two such vertices was tried there (after that block's changes around
-  // it) and failed. The global pass starts from the other edges only; a collapse still re-tries
-  // the edges around it.
-  std::vector<char> settled;
+  // Per vertex, or empty (none): the tag of the block run that owned it and whose collapses ran
+  // out, 0 for none. Every edge between two vertices of one tag was tried there, after the last
+  // change to either end's star, and failed for reasons the next block's borders cannot change
+  // (a placement cut off by the block's border unsettles its vertices): a later pass starts
+  // from the other edges only, and a change to a settled vertex's star re-tries its edges.
+  std::vector<uint32_t> settled;
 };
 
 // The state of a mesh (vertices in key order, triangles canonical) with what earlier passes
@@ -185,10 +186,12 @@ Work workOf(const Mesh& mesh) {
   for (size_t v = 0; v < w.pos.size(); ++v) w.quad[v].addPlane(w.normal[v], w.pos[v]);
   w.moved.assign(w.pos.size(), 0);
   w.locked.assign(w.pos.size(), 0);
+  w.settled.assign(w.pos.size(), 0);
   for (const SimplifyCarry::Vertex& c : mesh.carry.vertices) {
     if (c.index >= w.pos.size()) throw std::invalid_argument("simplifyMesh: a carried vertex past the mesh's vertices");
     w.quad[c.index] = Quadric::unpacked(c.quadric);
     w.moved[c.index] = c.moved;
+    w.settled[c.index] = c.settled;
   }
   w.tris = mesh.triangles;
   w.level.assign(w.tris.size(), -1);
@@ -209,8 +212,9 @@ void carryOf(const Work& w, SimplifyCarry& carry) {
   carry.vertices.clear();
   for (uint32_t v = 0; v < w.pos.size(); ++v) {
     const Quadric& q = w.quad[v];
-    if (q.weight == 1 && !w.moved[v]) continue;  // its own tangent plane: workOf rebuilds it
-    carry.vertices.push_back({v, q.packed(), uint8_t(w.moved[v] ? 1 : 0)});
+    const uint32_t settled = w.settled.empty() ? 0 : w.settled[v];
+    if (q.weight == 1 && !w.moved[v] && settled == 0) continue;  // as workOf rebuilds it
+    carry.vertices.push_back({v, q.packed(), uint8_t(w.moved[v] ? 1 : 0), settled});
   }
   carry.triangles.resize(w.tris.size());
   for (size_t t = 0; t < w.tris.size(); ++t) carry.triangles[t] = uint8_t((w.level[t] + 1) | (w.made[t] ? 0x80 : 0));
@@ -394,6 +398,9 @@ class Simplifier {
     return true;
   }
   bool vertexAlive(uint32_t v) const { return alive_[v] && !vtris_[v].empty(); }
+  bool settles() const { return deferred_; }
+  // A placement cut off by the block's border: v's edges may pass in another block.
+  bool borderBound(uint32_t v) const { return borderBound_[v] != 0; }
   bool triangleAlive(uint32_t t) const { return tAlive_[t]; }
 
  private:
@@ -415,6 +422,8 @@ class Simplifier {
       if (onBoxFace(w_.pos[v])) w_.locked[v] = 1;
     alive_.assign(nv, 1);
     version_.assign(nv, 0);
+    if (w_.settled.size() != nv) w_.settled.assign(nv, 0);
+    borderBound_.assign(nv, 0);
     markA_.assign(nv, 0);
     markB_.assign(nv, 0);
     vtris_.assign(nv, {});
@@ -429,7 +438,24 @@ class Simplifier {
     }
   }
 
-  bool settledEdge(uint32_t a, uint32_t b) const { return !w_.settled.empty() && w_.settled[a] && w_.settled[b]; }
+  bool settledEdge(uint32_t a, uint32_t b) const { return w_.settled[a] != 0 && w_.settled[a] == w_.settled[b]; }
+  // v's star changes: its edges are tried again (now, if the greedy phase has begun; at its
+  // start otherwise), and it is no longer settled.
+  // Only the edges pushAllCandidates skipped (to vertices of v's tag): the others are queued.
+  void unsettle(uint32_t v, bool push) {
+    const uint32_t tag = w_.settled[v];
+    if (tag == 0) return;
+    w_.settled[v] = 0;
+    if (!push) return;
+    const uint32_t seen = nextMark();
+    markA_[v] = seen;
+    for (uint32_t t : vtris_[v])
+      for (uint32_t x : w_.tris[t])
+        if (markA_[x] != seen) {
+          markA_[x] = seen;
+          if (w_.settled[x] == tag) pushCandidate(v, x);
+        }
+  }
 
   // Every edge of the mesh as a collapse candidate.
   void pushAllCandidates() {
@@ -460,7 +486,7 @@ class Simplifier {
     return q;
   }
 
-  V3 placement(uint32_t a, uint32_t b, double* cost) const {
+  V3 placement(uint32_t a, uint32_t b, double* cost, bool* clipped = nullptr) const {
     Quadric q = w_.quad[a];
     q += w_.quad[b];
     const V3 &pa = w_.pos[a], &pb = w_.pos[b];
@@ -474,9 +500,13 @@ class Simplifier {
       double cp = q(p);
       bool inside = true;
       for (int k = 0; k < 3 && w_.confined; ++k) inside = inside && p[k] >= w_.regionLo[k] && p[k] <= w_.regionHi[k];
-      if (inside && norm(sub(p, mid)) <= reach && std::isfinite(cp) && cp <= *cost) {
-        *cost = cp;
-        best = p;
+      if (norm(sub(p, mid)) <= reach && std::isfinite(cp) && cp <= *cost) {
+        if (inside) {
+          *cost = cp;
+          best = p;
+        } else if (clipped) {
+          *clipped = true;
+        }
       }
     }
     return best;
@@ -792,7 +822,9 @@ class Simplifier {
     }
 
     double cost;
-    V3 p = placement(a, b, &cost);
+    bool clipped = false;
+    V3 p = placement(a, b, &cost, &clipped);
+    if (clipped) borderBound_[a] = borderBound_[b] = 1;
     // changed: triangles kept with a new corner; removed: the two dropped
     for (uint32_t v : {a, b})
       for (uint32_t t : vtris_[v]) {
@@ -891,6 +923,8 @@ class Simplifier {
         if (markA_[v] != seen) markA_[v] = seen, ring.push_back(v);
     for (uint32_t v : ring) pushCandidate(a, v);  // the order of pushes does not matter: the
                                                    // candidates' order is total
+    w_.settled[a] = 0;
+    for (uint32_t v : ring) unsettle(v, true);
   }
 
   // ---- cell contractions --------------------------------------------------------------------
@@ -915,8 +949,9 @@ class Simplifier {
     for (size_t i = 0; i < byCell.size();) {
       size_t j = i;
       while (j < byCell.size() && byCell[j].first == byCell[i].first) ++j;
-      bool allSettled = !w_.settled.empty();
-      for (size_t k = i; k < j && allSettled; ++k) allSettled = w_.settled[byCell[k].second];
+      // tried in the block run that settled them all (the same tag)
+      bool allSettled = w_.settled[byCell[i].second] != 0;
+      for (size_t k = i; k < j && allSettled; ++k) allSettled = w_.settled[byCell[k].second] == w_.settled[byCell[i].second];
       if (j - i >= 2 && !allSettled) {
         group.clear();
         const uint32_t inGroup = nextMark();
@@ -1032,7 +1067,12 @@ class Simplifier {
       const double cx = q(x);
       bool inside = true;
       for (int k = 0; k < 3 && w_.confined; ++k) inside = inside && x[k] >= w_.regionLo[k] && x[k] <= w_.regionHi[k];
-      if (inside && norm(sub(x, mid)) <= reach && std::isfinite(cx) && cx <= cost) cost = cx, p = x, atMember = false;
+      if (norm(sub(x, mid)) <= reach && std::isfinite(cx) && cx <= cost) {
+        if (inside)
+          cost = cx, p = x, atMember = false;
+        else
+          for (uint32_t c : C) borderBound_[c] = 1;
+      }
     }
     if (cost > tol_ * tol_ * weight) {
       ++stats_.rejectedError;
@@ -1095,6 +1135,8 @@ class Simplifier {
     w_.quad[survivor] = q;
     ++version_[survivor];
     stats_.collapses += nc - 1;
+    w_.settled[survivor] = 0;
+    for (const Fan& f : fan) unsettle(f.u, false);  // before the greedy phase: pushed at its start
   }
 
   // Self-intersection: the new triangles of collapsing a, b to p against each other, then
@@ -1273,6 +1315,7 @@ class Simplifier {
   std::vector<exact::P> qpos_;
   std::vector<char> alive_;
   std::vector<uint32_t> version_;
+  std::vector<char> borderBound_;  // per vertex: an attempt's placement was cut off by the border
   std::vector<std::vector<uint32_t>> vtris_;
   std::vector<char> tAlive_;
   // Per-triangle marks of the self-intersection queries.
@@ -1316,9 +1359,8 @@ std::unique_ptr<Simplifier> simplifyChecked(const std::function<Work()>& input, 
 // pass's blocks are centred on the first's faces, where it left the rims. A third and a fourth
 // pass, in the master only (simplifyMesh), of larger blocks: the third aligned with the first
 // pass's (what the second leaves along its faces lies inside them), the fourth centred on the
-// third's faces. The fourth also sweeps its blocks once more (every edge tried again, after
-// the changes around it), which the serial global pass did for the whole mesh: now it only
-// finishes along the fourth pass's faces (Work::settled), on one core, with the rest done on all.
+// third's faces. Each pass (and the global one) skips the edges the run before it settled
+// (Work::settled): the serial global pass mostly finishes along the fourth pass's faces.
 constexpr int kBlockVoxels[4] = {32, 32, 64, 64};
 constexpr int kBlockShift[4] = {0, 16, 0, 32};
 constexpr int kWorkerPasses = 2;  // the passes simplifyRegion does in the bricks
@@ -1376,8 +1418,8 @@ bool bricksDid(const BlockKey& b, int pass, int brick, const std::array<int64_t,
 // Only the blocks `mine` accepts are done.
 void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& opt, int pass,
                const std::function<bool(const BlockKey&)>& mine, SimplifyStats& stats) {
-  g.settled.clear();  // only the fourth pass settles vertices (for the global pass)
   const size_t nv = g.pos.size(), nt = g.tris.size();
+  if (g.settled.size() != nv) g.settled.assign(nv, 0);
   const double side = kBlockVoxels[pass] * grid.voxel, margin = grid.voxel;
   V3 origin;
   for (int k = 0; k < 3; ++k) origin[k] = grid.origin[k] - kBlockShift[pass] * grid.voxel;
@@ -1458,12 +1500,14 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     SimplifyStats stats;
   };
   std::vector<Result> results(blocks.size());
-  std::vector<char> vAlive(nv, 1), tAlive(nt, 1), vSettled(nv, 0);
+  std::vector<char> vAlive(nv, 1), tAlive(nt, 1);
   // activeIn[t]: the block one of whose own vertices t has (a triangle with an owned vertex lies
   // in that block's shrunk box, so it is one block's only: each entry has one writer).
   std::vector<uint32_t> activeIn(nt, UINT32_MAX);
   auto solve = [&](size_t i) {
     const BlockKey& b = blocks[i];
+    // This block run's tag (Work::settled): neighbouring blocks' differ.
+    const uint32_t tag = 1 + uint32_t(pass) + 4 * (uint32_t(b[0] & 511) | uint32_t(b[1] & 511) << 9 | uint32_t(b[2] & 511) << 18);
     Result& r = results[i];
     const std::vector<uint32_t>& own = owned[i];
     if (own.empty()) return;
@@ -1499,6 +1543,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
       Work w;
       const size_t n = globalOf.size(), m = active.size() + obstacles.size();
       w.pos.reserve(n), w.normal.reserve(n), w.key.reserve(n), w.quad.reserve(n), w.moved.reserve(n), w.locked.reserve(n);
+      w.settled.reserve(n);
       w.tris.reserve(m), w.level.reserve(m), w.made.reserve(m);
       size_t at = 0;  // own is sorted: a merge walk marks the locked vertices
       for (uint32_t v : globalOf) {
@@ -1507,6 +1552,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
         w.key.push_back(g.key[v]);
         w.quad.push_back(g.quad[v]);
         w.moved.push_back(g.moved[v]);
+        w.settled.push_back(g.settled[v]);
         while (at < own.size() && own[at] < v) ++at;
         w.locked.push_back(!(at < own.size() && own[at] == v));
       }
@@ -1534,8 +1580,10 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
       g.key[v] = out.key[i];
       g.quad[v] = out.quad[i];
       g.moved[v] = out.moved[i];
+      // The block's collapses ran out around its own vertices (a rerun with the per-collapse
+      // intersection check settles none: its rejections depend on more than the star).
+      g.settled[v] = s.settles() && !s.borderBound(i) ? tag : 0;
     }
-    for (uint32_t v : own) vSettled[v] = 1;
     for (uint32_t t : active) tAlive[t] = 0;
     for (uint32_t t = 0; t < active.size(); ++t) {  // the active triangles come first
       if (!s.triangleAlive(t)) continue;
@@ -1578,7 +1626,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     c.quad.push_back(g.quad[v]);
     c.moved.push_back(g.moved[v]);
     c.locked.push_back(0);
-    if (pass == 3) c.settled.push_back(vSettled[v]);  // the last block pass's, for the global one
+    c.settled.push_back(g.settled[v]);
   }
   std::vector<std::pair<Tri, uint32_t>> order;  // canonical triangle, old index
   for (uint32_t t = 0; t < g.tris.size(); ++t) {

@@ -1,5 +1,5 @@
 // Writes the fuzz targets' seed corpora from the code that makes the real inputs, so the seeds
-// follow the formats: a worker's brick payloads (FRB2, raw and simplified FRM3) and a task envelope
+// follow the formats: a worker's brick payloads (FRB2, raw and simplified FRM4) and a task envelope
 // for `payload`, a journal of them for `journal`, frep sample's sealed .vdb for `vdb`. The .hf seeds are examples/ itself. Run by
 // run_fuzz.sh: fuzz_seeds DIR writes DIR/<target>/.
 #include <sys/stat.h>
@@ -45,10 +45,10 @@ int main(int argc, char** argv) {
   farm::JobSpec meshJob = job;
   meshJob.set_operation("mesh");
   const std::string raw = farm::encodeMeshPiece(farm::computeBrick(tape, meshJob, lo, {8, 8, 8}, 1).piece);
-  put(payloads, "frm3_raw", 1, raw);
+  put(payloads, "frm4_raw", 1, raw);
   meshJob.mutable_mesh()->set_tolerance(0.5);
   const std::string simplified = farm::encodeMeshPiece(farm::computeBrick(tape, meshJob, lo, {8, 8, 8}, 1).piece);
-  put(payloads, "frm3_simplified", 1, simplified);
+  put(payloads, "frm4_simplified", 1, simplified);
   farm::Envelope welcome;  // protocol 2: the job once per connection, tasks name it by id
   welcome.set_job_id(farm::jobIdOf(job));
   welcome.mutable_welcome()->set_heartbeat_ms(500);

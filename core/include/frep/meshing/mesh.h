@@ -84,12 +84,15 @@ struct SimplifyCounters {
 // What a region's simplification (simplifyRegion, mesh_simplify.h) leaves for the passes after
 // it; empty for a mesh as the mesher made it. Indices are into the owner's vertices/triangles.
 struct SimplifyCarry {
-  // A vertex's quadric (A: xx xy xz yy yz zz, b: 3, c, weight) and whether it left the mesher's
-  // root; listed (by increasing index) only where that is more than its own tangent plane.
+  // A vertex's quadric (A: xx xy xz yy yz zz, b: 3, c, weight), whether it left the mesher's
+  // root, and the tag of the block run that settled it (0: none; mesh_simplify.cpp's
+  // Work::settled); listed (by increasing index) only where that is more than its own tangent
+  // plane, unmoved and unsettled.
   struct Vertex {
     uint32_t index;
     std::array<double, 11> quadric;
     uint8_t moved;
+    uint32_t settled = 0;
   };
   std::vector<Vertex> vertices;
   // Per triangle (all of them, or none): error level + 1 (0: not measured), | 0x80 when a
