@@ -1364,6 +1364,10 @@ std::unique_ptr<Simplifier> simplifyChecked(const std::function<Work()>& input, 
 constexpr int kBlockVoxels[4] = {32, 32, 64, 64};
 constexpr int kBlockShift[4] = {0, 16, 0, 32};
 constexpr int kWorkerPasses = 2;  // the passes simplifyRegion does in the bricks
+// The shrunk block's margin: any gap between two blocks' boxes keeps their triangles apart (each
+// block's stay inside its own box); a narrow one leaves narrow rims for the next pass (a quarter
+// voxel: 44% fewer triangles reach the master's first pass than a whole voxel at 256^3).
+constexpr double kBlockMarginVoxels = 0.25;
 using BlockKey = std::array<int32_t, 3>;
 
 // The cells of block b of pass `pass` along one axis, clipped to the grid's cells.
@@ -1409,7 +1413,7 @@ bool bricksDid(const BlockKey& b, int pass, int brick, const std::array<int64_t,
 
 // A block pass, in parallel: the grid's index space, shifted by kBlockShift[pass], is cut into
 // fixed blocks of kBlockVoxels[pass] (so the cut does not depend on the farm's bricks). A vertex
-// belongs to its block if it and every neighbour lie inside the block shrunk by a voxel; each
+// belongs to its block if it and every neighbour lie inside the block shrunk by kBlockMarginVoxels; each
 // block simplifies the triangles around its own vertices, with the other vertices locked,
 // placements confined to the shrunk block, and every other triangle meeting it as a fixed
 // obstacle. Those triangles are never changed by another block (each block's triangles stay
@@ -1420,7 +1424,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
                const std::function<bool(const BlockKey&)>& mine, SimplifyStats& stats) {
   const size_t nv = g.pos.size(), nt = g.tris.size();
   if (g.settled.size() != nv) g.settled.assign(nv, 0);
-  const double side = kBlockVoxels[pass] * grid.voxel, margin = grid.voxel;
+  const double side = kBlockVoxels[pass] * grid.voxel, margin = kBlockMarginVoxels * grid.voxel;
   V3 origin;
   for (int k = 0; k < 3; ++k) origin[k] = grid.origin[k] - kBlockShift[pass] * grid.voxel;
   auto blockOf = [&](const V3& p) {
@@ -1441,7 +1445,10 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
   // to set up (e.g. the master's first pass when the bricks did every block).
   std::vector<BlockKey> vblock(nv);
   std::vector<BlockKey> blocks;
-  for (uint32_t v = 0; v < nv; ++v) blocks.push_back(vblock[v] = blockOf(g.pos[v]));
+  for (uint32_t v = 0; v < nv; ++v) {
+    vblock[v] = blockOf(g.pos[v]);
+    if (blocks.empty() || blocks.back() != vblock[v]) blocks.push_back(vblock[v]);  // runs: key order is local
+  }
   std::sort(blocks.begin(), blocks.end());
   blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
   blocks.erase(std::remove_if(blocks.begin(), blocks.end(), [&](const BlockKey& b) { return !mine(b); }), blocks.end());
@@ -1465,9 +1472,12 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
   }
   // Owned vertices by block, in increasing order (the write-back order is fixed).
   std::vector<std::vector<uint32_t>> owned(blocks.size());
+  BlockKey lastKey = vblock.empty() ? BlockKey{} : vblock[0];
+  int64_t last = vblock.empty() ? -1 : blockIndex(lastKey);
   for (uint32_t v = 0; v < nv; ++v) {
     if (vtStart[v] == vtStart[v + 1]) continue;
-    const int64_t b = blockIndex(vblock[v]);
+    if (vblock[v] != lastKey) lastKey = vblock[v], last = blockIndex(lastKey);  // runs, as above
+    const int64_t b = last;
     if (b < 0) continue;
     V3 lo, hi;
     shrunk(blocks[size_t(b)], lo, hi);
