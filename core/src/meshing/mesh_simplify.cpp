@@ -2,6 +2,7 @@
 #include "frep/meshing/mesh_simplify.h"
 
 #include <Eigen/Eigenvalues>
+#include <boost/container/small_vector.hpp>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -1116,7 +1117,7 @@ class Simplifier {
         l.erase(std::find(l.begin(), l.end(), t));
       }
     }
-    std::vector<uint32_t>& around = vtris_[survivor];
+    auto& around = vtris_[survivor];
     around.clear();
     for (size_t i = 0; i < nf; ++i) {
       const Fan& f = fan[i];
@@ -1316,7 +1317,9 @@ class Simplifier {
   std::vector<char> alive_;
   std::vector<uint32_t> version_;
   std::vector<char> borderBound_;  // per vertex: an attempt's placement was cut off by the border
-  std::vector<std::vector<uint32_t>> vtris_;
+  // The triangles around each vertex: most have a dozen or fewer, held inline (no allocation
+  // per vertex and per block).
+  std::vector<boost::container::small_vector<uint32_t, 10>> vtris_;
   std::vector<char> tAlive_;
   // Per-triangle marks of the self-intersection queries.
   struct Probe {
