@@ -58,6 +58,7 @@ struct FarmOptions {
   int workerThreads = 1;         // local mode: threads per worker
   int threads = 0;               // in-process mode: threads per brick (0: all cores)
   int decodeThreads = 0;         // farm: threads verifying and decoding results (0: all cores, 1: the loop's own)
+                                 // (streaming a sample: as many again merge its slabs, on their own thread)
   std::string logLevel = "warn"; // local mode: workers' --log-level
   SampleSink sampleSink;         // "sample": stream the merged output (see SampleSink)
   // Called once the master is bound, with the actual endpoint (tcp://127.0.0.1:* picks a free
