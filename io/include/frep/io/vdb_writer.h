@@ -46,7 +46,9 @@ class LevelSetBuilder {
   ~LevelSetBuilder();
   LevelSetBuilder(const LevelSetBuilder&) = delete;
   LevelSetBuilder& operator=(const LevelSetBuilder&) = delete;
-  void addTiles(const std::vector<Tile>& tiles);  // before the leaves they cover (a tile overwrites what it covers)
+  // Before the leaves they cover (a tile overwrites what it covers): a tile below the end in x
+  // of the leaves added so far is std::logic_error.
+  void addTiles(const std::vector<Tile>& tiles);
   void addLeaves(const std::vector<LeafBlock>& leaves);
   uint64_t leaves() const { return leaves_; }  // added so far
   // Once, at the end; throws Error(kExitIoError) as writeLevelSet does.
@@ -56,6 +58,7 @@ class LevelSetBuilder {
   struct Tree;  // the OpenVDB grid being built (vdb_writer.cpp)
   std::unique_ptr<Tree> tree_;
   uint64_t leaves_ = 0;
+  int64_t leavesEndX_ = 0;  // past the largest x of the leaves added (addTiles' check)
 };
 
 }  // namespace frep::io
