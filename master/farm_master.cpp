@@ -101,12 +101,12 @@ struct Brick {
   size_t maxLeaves = 0;  // upper bound on leaves in the region (payload sanity check)
 };
 
-// "sample": what the master keeps of a merged brick until the job's end: where its verified
+// "sample": what the master keeps of a merged brick until its slab is merged: where its verified
 // FRB2 payload is (compact leaves take about half the bytes of decoded ones): in the journal,
 // which holds it anyway (page cache, not the master's memory), or without a journal in the
 // payload arena; its leaves' origins (where they go in the sorted output) and its tiles.
-// Verifying a payload only scans it (scanBrick); finish() decodes it once, straight into the
-// output (Master::mergeLeaves).
+// Verifying a payload only scans it (scanBrick); its slab's merge decodes it once, straight into
+// the output (Master::decodeSlab: streaming, once the slab's bricks are all in; else in finish()).
 struct KeptBrick {
   PayloadArena::Piece payload;  // without a journal
   bool inJournal = false;       // with one: the payload's offset, size and CRC-32 there
