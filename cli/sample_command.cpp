@@ -66,8 +66,9 @@ int runSample(const SampleRequest& request) {
   job.set_band(request.band);
   spdlog::info("sampling '{}' on {}x{}x{} voxels of {}", m.model.objectName, grid.dims[0], grid.dims[1],
                grid.dims[2], grid.voxel);
-  // The merge streams into the grid slab by slab (the master never holds the whole sample and
-  // the tree at once); a job that does not complete streams nothing and writes nothing.
+  // The merge streams into the grid slab by slab as the slabs complete (the master never holds
+  // the whole sample and the tree at once); a job that does not complete writes nothing (what it
+  // streamed is dropped with the builder).
   io::LevelSetBuilder builder(farm::gridOf(job), request.band);  // the lattice the master merges on
   options.sampleSink.tiles = [&](const std::vector<Tile>& tiles) { builder.addTiles(tiles); };
   options.sampleSink.leaves = [&](const std::vector<LeafBlock>& slab) { builder.addLeaves(slab); };

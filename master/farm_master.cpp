@@ -7,9 +7,12 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <csignal>
 #include <deque>
+#include <exception>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
@@ -98,12 +101,12 @@ struct Brick {
   size_t maxLeaves = 0;  // upper bound on leaves in the region (payload sanity check)
 };
 
-// "sample": what the master keeps of a merged brick until the job's end: where its verified
+// "sample": what the master keeps of a merged brick until its slab is merged: where its verified
 // FRB2 payload is (compact leaves take about half the bytes of decoded ones): in the journal,
 // which holds it anyway (page cache, not the master's memory), or without a journal in the
 // payload arena; its leaves' origins (where they go in the sorted output) and its tiles.
-// Verifying a payload only scans it (scanBrick); finish() decodes it once, straight into the
-// output (Master::mergeLeaves).
+// Verifying a payload only scans it (scanBrick); its slab's merge decodes it once, straight into
+// the output (Master::decodeSlab: streaming, once the slab's bricks are all in; else in finish()).
 struct KeptBrick {
   PayloadArena::Piece payload;  // without a journal
   bool inJournal = false;       // with one: the payload's offset, size and CRC-32 there
@@ -154,7 +157,9 @@ class Master {
         jobId_(jobIdOf(job)),
         grid_(gridOf(job)),
         op_(operationOf(job)),
-        decoders_(opt.decodeThreads > 0 ? opt.decodeThreads : tbb::task_arena::automatic) {
+        decoders_(opt.decodeThreads > 0 ? opt.decodeThreads : tbb::task_arena::automatic),
+        mergers_(opt.decodeThreads > 0 ? opt.decodeThreads : tbb::task_arena::automatic),
+        streaming_(op_ == Operation::Sample && opt.sampleSink.leaves) {
     if (opt.brickVoxels < 8 || opt.brickVoxels % 8 != 0)
       throw std::invalid_argument("--brick must be a positive multiple of 8 voxels");
     if (op_ == Operation::Render && opt.brickVoxels % kRenderTile != 0)  // castRegion's regions
@@ -167,9 +172,12 @@ class Master {
     plan();
   }
 
+  ~Master() { stopMerger(); }
+
   FarmOutcome run() {
     SignalScope signals;
     start_ = Clock::now();
+    if (streaming_) merger_ = std::thread([this] { mergeSlabs(); });
     if (!opt_.journalPath.empty()) {
       journal_ = std::make_unique<Journal>(opt_.journalPath, jobId_, opt_.resume, [&](uint64_t id, const std::string& payload) {
         if (id >= bricks_.size() || bricks_[id].phase == BrickPhase::Done) return;
@@ -220,6 +228,9 @@ class Master {
         }
     if (op_ == Operation::Sample) kept_.resize(bricks_.size());
     else outputs_.resize(bricks_.size());
+    perSlab_ = size_t(n[1]) * size_t(n[2]);
+    for (size_t first = 0; first < bricks_.size(); first += perSlab_)
+      slabLeft_.push_back(std::min(perSlab_, bricks_.size() - first));
     report_.bricks = bricks_.size();
     size_t leaves = 0;
     for (auto& br : bricks_) leaves = std::max(leaves, br.maxLeaves);
@@ -250,6 +261,7 @@ class Master {
       report_.leaves += kept.origins.size();
       report_.tiles += kept.tiles.size();
       kept_[id] = std::move(kept);
+      if (streaming_ && --slabLeft_[id / perSlab_] == 0) queueCompleteSlabs();
     }
     if (computed) {
       ++report_.bricksComputed;
@@ -278,6 +290,7 @@ class Master {
         report_.interrupted = true;
         return;
       }
+      rethrowMergeError();
       auto t0 = Clock::now();
       BrickOutput out = computeBrick(tape, job_, b.lo, b.hi, opt_.threads);
       report_.perWorker["in-process"].computeSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -372,6 +385,7 @@ class Master {
         handle(router, in, err);
       }
       verifyArrivals(router);
+      rethrowMergeError();
       auto now = Clock::now();
       // The master's own stall (SIGSTOP, swapping, a slow disk): a turn is at most a poll
       // (a quarter beat) and a bounded drain, so a gap longer than the liveness window means
@@ -703,7 +717,9 @@ class Master {
 
   // A verified payload: appended to the journal if there is one, and for "sample" kept until
   // the merge: where the journal has it, or (no journal) a copy in the arena. Safe on the decode
-  // threads at once.
+  // threads at once. (Keeping the received message itself until its slab's merge instead, while
+  // streaming, cost more than reading it back: 141-167 against 136-143 us of master CPU a brick
+  // in bench_farm, the held buffers cold and the heap growing and shrinking.)
   void journalAndKeep(uint64_t brick, const void* data, size_t size, uint32_t crc, KeptBrick& kept) {
     if (journal_) {
       const uint64_t at = journal_->add(brick, data, size, crc);
@@ -997,71 +1013,133 @@ class Master {
     return buffer;
   }
 
+  // ---- the merge of a sample ----------------------------------------------------------------
   // The bricks' leaves sorted by origin (as sample() sorts them) and their tiles, one slab of
   // bricks at a time: the bricks are planned x-slab by x-slab and the sort is by x first, so a
   // slab's leaves follow all the leaves of the slabs before it. Each brick's payload is decoded
-  // (on the decode threads) straight into its leaves' sorted places; the slab's payloads are
-  // then released, so the master holds the payloads or the output, not both. With a sample
-  // sink (complete jobs only) each slab is decoded into one buffer, sized once for the largest
-  // slab and refilled (no fresh pages per slab), and handed over; result.leaves stays empty.
-  void mergeLeaves(SampleResult& result) {
-    const SampleSink& sink = opt_.sampleSink;
-    const bool streaming = sink.leaves && done_ == bricks_.size();
-    size_t leaves = 0;
-    for (const KeptBrick& k : kept_) {
-      leaves += k.origins.size();
-      result.tiles.insert(result.tiles.end(), k.tiles.begin(), k.tiles.end());
-    }
-    std::vector<LeafBlock> noLeaves;
-    sortByOrigin(noLeaves, result.tiles);
-    if (streaming && sink.tiles) sink.tiles(result.tiles);
-    const size_t perSlab = size_t((grid_.dims[1] + opt_.brickVoxels - 1) / opt_.brickVoxels) *
-                           size_t((grid_.dims[2] + opt_.brickVoxels - 1) / opt_.brickVoxels);
-    std::vector<LeafBlock> slab;  // streaming: every slab's leaves, in turn
-    if (streaming) {
-      size_t largest = 0;
-      for (size_t first = 0; first < kept_.size(); first += perSlab) {
-        size_t n = 0;
-        for (size_t i = first; i < std::min(kept_.size(), first + perSlab); ++i) n += kept_[i].origins.size();
-        largest = std::max(largest, n);
-      }
-      slab.reserve(largest);
-    } else {
-      result.leaves.reserve(leaves);  // filled slab by slab: pages are touched as payloads are freed
-    }
-    std::vector<LeafBlock>& out = streaming ? slab : result.leaves;
+  // (in parallel) straight into its leaves' sorted places; the slab's payloads are then
+  // released, so the master holds the payloads or the output, not both.
+
+  // Decodes the slab of bricks [first, last) into out[at, ...) (resized to fit) in `threads`,
+  // releases their payloads and appends their tiles to `tiles`. Returns the slab's leaves.
+  size_t decodeSlab(size_t first, size_t last, std::vector<LeafBlock>& out, size_t at, tbb::task_arena& threads,
+                    std::vector<Tile>& tiles) {
     std::vector<std::array<int32_t, 3>> origins;  // the slab's, brick by brick
-    std::vector<size_t> start, rank;  // rank[start[brick] + leaf]: the leaf's place in the slab
-    size_t at = 0;  // where the slab starts in `out`
-    for (size_t first = 0; first < kept_.size(); first += perSlab) {
-      const size_t last = std::min(kept_.size(), first + perSlab);
-      origins.clear();
-      start.assign(1, 0);
-      for (size_t i = first; i < last; ++i) {
-        origins.insert(origins.end(), kept_[i].origins.begin(), kept_[i].origins.end());
-        start.push_back(origins.size());
-      }
-      out.resize(at + origins.size());  // not zeroed (LeafBlock): decoded into below
-      decoders_.execute([&] {
-        rankByOrigin(origins, bricks_[first].lo, bricks_[last - 1].hi, rank);
-        tbb::parallel_for(first, last, [&](size_t i) {
-          const KeptBrick& k = kept_[i];
-          if (k.origins.empty()) return;
-          const size_t* to = rank.data() + start[i - first];
-          const std::string_view bytes = keptPayload(k, i);
-          std::string err;
-          if (!decodeBrickLeaves(bytes.data(), bytes.size(), k.origins.size(),
-                                 [&](size_t l) { return &out[at + to[l]]; }, &err))
-            throw std::logic_error("brick " + std::to_string(i) + ": its verified payload no longer decodes: " + err);
-        });
-      });
-      for (size_t i = first; i < last; ++i) kept_[i] = KeptBrick{};  // the arena unmaps emptied chunks
-      if (streaming) {
-        if (!slab.empty()) sink.leaves(slab);
-      } else {
-        at += origins.size();
-      }
+    std::vector<size_t> start(1, 0), rank;         // rank[start[brick] + leaf]: the leaf's place in the slab
+    for (size_t i = first; i < last; ++i) {
+      origins.insert(origins.end(), kept_[i].origins.begin(), kept_[i].origins.end());
+      start.push_back(origins.size());
+      tiles.insert(tiles.end(), kept_[i].tiles.begin(), kept_[i].tiles.end());
     }
+    out.resize(at + origins.size());  // not zeroed (LeafBlock): decoded into below
+    threads.execute([&] {
+      rankByOrigin(origins, bricks_[first].lo, bricks_[last - 1].hi, rank);
+      tbb::parallel_for(first, last, [&](size_t i) {
+        const KeptBrick& k = kept_[i];
+        if (k.origins.empty()) return;
+        const size_t* to = rank.data() + start[i - first];
+        const std::string_view bytes = keptPayload(k, i);
+        std::string err;
+        if (!decodeBrickLeaves(bytes.data(), bytes.size(), k.origins.size(),
+                               [&](size_t l) { return &out[at + to[l]]; }, &err))
+          throw std::logic_error("brick " + std::to_string(i) + ": its verified payload no longer decodes: " + err);
+      });
+    });
+    for (size_t i = first; i < last; ++i) kept_[i] = KeptBrick{};  // the arena unmaps emptied chunks
+    return origins.size();
+  }
+
+  // Streaming (FarmOptions::sampleSink): the loop hands the merge thread every slab whose bricks
+  // are all merged, in slab order, as soon as they are (commit), so that the merge overlaps the
+  // receiving of the next slabs instead of following the last brick.
+  void queueCompleteSlabs() {
+    size_t queued = slabsQueued_;
+    while (queued < slabLeft_.size() && slabLeft_[queued] == 0) ++queued;
+    if (queued == slabsQueued_) return;
+    slabsQueued_ = queued;
+    {
+      std::lock_guard<std::mutex> lock(mergeMutex_);
+      slabsReady_ = queued;
+    }
+    mergeWake_.notify_one();
+  }
+
+  // The merge thread: each slab handed over, in order, decoded into one buffer (refilled; it
+  // grows only for a slab larger than all before it) on its own threads, and given to the sink
+  // (its tiles sorted, then its leaves). Stops when told to, once the slabs handed over are done.
+  void mergeSlabs() {
+    const SampleSink& sink = opt_.sampleSink;
+    std::vector<LeafBlock> slab;
+    std::vector<Tile> tiles;
+    try {
+      for (size_t next = 0;; ++next) {
+        {
+          std::unique_lock<std::mutex> lock(mergeMutex_);
+          mergeWake_.wait(lock, [&] { return slabsReady_ > next || mergeStop_; });
+          if (slabsReady_ <= next) return;  // stopped, nothing more handed over
+        }
+        const size_t first = next * perSlab_, last = std::min(bricks_.size(), first + perSlab_);
+        size_t leaves = 0;
+        for (size_t i = first; i < last; ++i) leaves += kept_[i].origins.size();
+        if (leaves > slab.capacity()) {
+          slab = std::vector<LeafBlock>();  // not copied over: refilled below
+          slab.reserve(leaves);
+        }
+        slab.clear();
+        tiles.clear();
+        decodeSlab(first, last, slab, 0, mergers_, tiles);
+        std::vector<LeafBlock> noLeaves;
+        sortByOrigin(noLeaves, tiles);
+        if (!tiles.empty() && sink.tiles) sink.tiles(tiles);
+        if (!slab.empty()) sink.leaves(slab);
+        streamedTiles_.insert(streamedTiles_.end(), tiles.begin(), tiles.end());
+        std::lock_guard<std::mutex> lock(mergeMutex_);
+        slabsStreamed_ = next + 1;
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mergeMutex_);
+      mergeError_ = std::current_exception();
+      mergeFailed_ = true;
+    }
+  }
+
+  // Waits for the merge thread to finish the slabs handed over, and ends it.
+  void stopMerger() {
+    if (!merger_.joinable()) return;
+    {
+      std::lock_guard<std::mutex> lock(mergeMutex_);
+      mergeStop_ = true;
+    }
+    mergeWake_.notify_one();
+    merger_.join();
+  }
+
+  // A failure of the merge thread (its sink threw, the journal could not be read) ends the job.
+  void rethrowMergeError() {
+    if (!mergeFailed_) return;
+    std::lock_guard<std::mutex> lock(mergeMutex_);
+    std::rethrow_exception(mergeError_);
+  }
+
+  // The merged sample in `result`. Streaming, the merge thread has handed every slab of a
+  // complete job to the sink; of an incomplete one (a brick poisoned, or stopped) the slabs it
+  // handed over (those before the first one not complete) and result.leaves holds the merged
+  // leaves of the others. result.tiles holds every tile, sorted. Without a sink, the slabs are
+  // decoded here into result.leaves, sized once.
+  void mergeLeaves(SampleResult& result) {
+    stopMerger();
+    rethrowMergeError();
+    result.tiles = std::move(streamedTiles_);
+    size_t leaves = 0;
+    const size_t firstKept = slabsStreamed_ * perSlab_;
+    for (size_t i = firstKept; i < kept_.size(); ++i) leaves += kept_[i].origins.size();
+    result.leaves.reserve(leaves);  // filled slab by slab: pages are touched as payloads are freed
+    std::vector<Tile> tiles;
+    for (size_t first = firstKept, at = 0; first < kept_.size(); first += perSlab_)
+      at += decodeSlab(first, std::min(kept_.size(), first + perSlab_), result.leaves, at, decoders_, tiles);
+    std::vector<LeafBlock> noLeaves;
+    sortByOrigin(noLeaves, tiles);
+    result.tiles.insert(result.tiles.end(), tiles.begin(), tiles.end());  // after the streamed slabs' tiles
     kept_.clear();
   }
 
@@ -1130,6 +1208,22 @@ class Master {
   std::vector<Arrival> arrivals_;  // results received, not yet verified (verifyArrivals)
   size_t arrivalBytes_ = 0;
   tbb::task_arena decoders_;       // the decode threads (FarmOptions::decodeThreads)
+  tbb::task_arena mergers_;        // streaming: the merge thread's decoders (as many)
+  // Streaming (mergeSlabs): slabs of perSlab_ bricks, the bricks of each not merged yet, the
+  // slabs handed to the merge thread (loop's count, and under mergeMutex_ the merge thread's),
+  // the slabs it gave the sink and their tiles (read after it ends).
+  bool streaming_ = false;
+  size_t perSlab_ = 1;
+  std::vector<size_t> slabLeft_;
+  size_t slabsQueued_ = 0;
+  std::thread merger_;
+  std::mutex mergeMutex_;
+  std::condition_variable mergeWake_;
+  size_t slabsReady_ = 0, slabsStreamed_ = 0;
+  bool mergeStop_ = false;
+  std::exception_ptr mergeError_;
+  std::atomic<bool> mergeFailed_{false};
+  std::vector<Tile> streamedTiles_;
   std::map<std::string, Peer> peers_;
   std::vector<double> brickSeconds_;
   double median_ = 0;    // medianBrickSeconds() of the first medianOf_ entries

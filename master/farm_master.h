@@ -18,16 +18,21 @@
 
 namespace frep::farm {
 
-// "sample": the merged output handed to the caller as it is merged instead of built whole in
-// FarmOutcome::result.leaves (which then stays empty), so that a consumer that writes as it goes
-// (io::LevelSetBuilder) never holds the leaves and its own output at once (docs/farm.md,
-// "Throughput"). Streaming is on when `leaves` is set, and only for a complete job (nothing
-// poisoned, not interrupted: otherwise nothing is handed over and result.leaves is filled as
-// without a sink). Both are called on the thread that called runJob, in the order of result:
-// `tiles` once, every tile sorted (result.tiles still holds them), then `leaves` once per x-slab
-// of bricks that has any, with that slab's leaves sorted by origin (the slabs follow one another
-// in the sort). The slab is always the same buffer, refilled: read it during the call and keep
-// nothing that points into it.
+// "sample": the merged output handed to the caller slab by slab as it is merged instead of built
+// whole in FarmOutcome::result.leaves (then empty for a complete job), so that a consumer that
+// writes as it goes (io::LevelSetBuilder) never holds the leaves and its own output at once
+// (docs/farm.md, "Throughput"). Streaming is on when `leaves` is set. The bricks are planned in
+// x-slabs; as soon as every brick of the next slab is merged (not after the job's last brick),
+// the master's merge thread calls, for that slab, `tiles` with its tiles sorted (if it has any),
+// then `leaves` with its leaves sorted by origin (if it has any). The slabs follow one another
+// in the sort, so the calls in turn hand over result's tiles and leaves in result's order, and a
+// slab's tiles never cover an earlier slab's leaves. The calls come from the merge thread, one at
+// a time, all before runJob returns; an exception from either ends the job (runJob throws it).
+// A job that does not complete (a brick poisoned, or interrupted) hands over only the slabs
+// before the first one it did not complete: result.leaves holds the merged leaves of the others
+// (result.tiles always holds every tile, sorted). The slab is one buffer, refilled (it grows
+// only for a slab larger than all before it): read it during the call and keep nothing that
+// points into it.
 struct SampleSink {
   std::function<void(const std::vector<Tile>& tiles)> tiles;  // optional
   std::function<void(const std::vector<LeafBlock>& slabLeaves)> leaves;
@@ -53,6 +58,7 @@ struct FarmOptions {
   int workerThreads = 1;         // local mode: threads per worker
   int threads = 0;               // in-process mode: threads per brick (0: all cores)
   int decodeThreads = 0;         // farm: threads verifying and decoding results (0: all cores, 1: the loop's own)
+                                 // (streaming a sample: as many again merge its slabs, on their own thread)
   std::string logLevel = "warn"; // local mode: workers' --log-level
   SampleSink sampleSink;         // "sample": stream the merged output (see SampleSink)
   // Called once the master is bound, with the actual endpoint (tcp://127.0.0.1:* picks a free

@@ -2,8 +2,10 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -18,6 +20,7 @@ constexpr char kMagic[4] = {'F', 'R', 'J', '1'};
 // A record is one brick's payload: never more than a frame the master accepts from a worker.
 constexpr uint64_t kMaxRecord = kMaxJournalRecord;
 constexpr long kRecordHeader = 8 + 4 + 8;  // brick, crc, size
+constexpr uint64_t kReserveStep = uint64_t(64) << 20;  // blocks allocated ahead (Journal::reserve)
 
 // Opens the journal as -O's policy does (io/src/atomic_output.cpp): only a regular file, never
 // through a symbolic link (a planted `out.vdb.journal -> ~/.bashrc` would be truncated), never
@@ -103,6 +106,7 @@ Journal::Journal(const std::string& path, uint64_t jobId, bool resume,
   if (std::fflush(file_) != 0 || std::ferror(file_))
     throw JournalIoError("cannot write journal " + path + ": " + std::strerror(errno));
   end_ = goodEnd > 0 ? uint64_t(goodEnd) : uint64_t(sizeof kMagic + sizeof jobId);
+  reserved_ = end_;
   flush();
 }
 
@@ -116,19 +120,41 @@ uint64_t Journal::add(uint64_t brick, const void* payload, size_t size, uint32_t
   std::memcpy(head, &brick, 8);
   std::memcpy(head + 8, &crc, 4);
   std::memcpy(head + 12, &size64, 8);
-  // Each record gets its own stretch of the file, so threads write theirs at once.
+  // Each record gets its own stretch of the file; the header and the payload go in one call,
+  // one writer at a time: the file system serializes writers to a file anyway (ext4's inode
+  // lock), and a writer waiting on our mutex sleeps where one waiting on that lock spins.
   const uint64_t at = end_.fetch_add(uint64_t(kRecordHeader) + size);
-  auto writeAt = [&](const char* p, size_t n, uint64_t off) {
-    while (n > 0) {
-      const ssize_t w = ::pwrite(fileno(file_), p, n, off_t(off));
-      if (w < 0 && errno == EINTR) continue;
-      if (w <= 0) throw JournalIoError("cannot write journal " + path_ + ": " + std::strerror(w < 0 ? errno : ENOSPC));
-      p += w, n -= size_t(w), off += uint64_t(w);
-    }
-  };
-  writeAt(head, sizeof head, at);
-  writeAt(static_cast<const char*>(payload), size, at + kRecordHeader);
+  std::lock_guard<std::mutex> writing(writeMutex_);
+  const size_t total = sizeof head + size;
+  reserve(at + total);
+  for (size_t done = 0; done < total;) {  // from where a short write stopped
+    struct iovec parts[2];
+    int n = 0;
+    if (done < sizeof head) parts[n++] = {head + done, sizeof head - done};
+    const size_t from = done > sizeof head ? done - sizeof head : 0;
+    if (size > from) parts[n++] = {const_cast<char*>(static_cast<const char*>(payload)) + from, size - from};
+    const ssize_t w = ::pwritev(fileno(file_), parts, n, off_t(at + done));
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) throw JournalIoError("cannot write journal " + path_ + ": " + std::strerror(w < 0 ? errno : ENOSPC));
+    done += size_t(w);
+  }
   return at + kRecordHeader;
+}
+
+void Journal::reserve(uint64_t end) {
+  // Writing into blocks the file system has already allocated costs a third less CPU than
+  // allocating them page by page as the writes come (ext4's delayed allocation, measured: 26
+  // against 37 us per 151 kB record), so the file's blocks are allocated ahead in large steps.
+  // KEEP_SIZE: the file's size is still what was written, so a resume reads only records. A
+  // file system that cannot (EOPNOTSUPP) or a full disk just leaves the writes to allocate (and
+  // to report ENOSPC themselves).
+  if (end <= reserved_ || reserveFailed_) return;
+  const uint64_t step = std::max<uint64_t>(kReserveStep, end - reserved_);
+  if (::fallocate(fileno(file_), FALLOC_FL_KEEP_SIZE, off_t(reserved_), off_t(step)) != 0) {
+    reserveFailed_ = true;
+    return;
+  }
+  reserved_ += step;
 }
 
 uint64_t Journal::append(uint64_t brick, const std::string& payload) {

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdio>
 #include <functional>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -35,7 +36,7 @@ class Journal {
 
   // Appends a record (its payload's CRC-32 already known) straight to the kernel (pwrite), so
   // a killed master loses none of it. Safe to call from several threads at once: each record
-  // takes its own stretch of the file (their order in it does not matter).
+  // takes its own stretch of the file (their order in it does not matter); they write in turn.
   // Returns where the payload starts in the file (for read).
   uint64_t add(uint64_t brick, const void* payload, size_t size, uint32_t crc);
   uint64_t append(uint64_t brick, const std::string& payload);  // add, computing the CRC
@@ -51,6 +52,11 @@ class Journal {
   std::string path_;
   FILE* file_ = nullptr;
   std::atomic<uint64_t> end_{0};  // where the next record goes
+  std::mutex writeMutex_;         // one writer at a time (add)
+  // The file's blocks allocated ahead of the records up to here (reserve; under writeMutex_).
+  void reserve(uint64_t end);
+  uint64_t reserved_ = 0;
+  bool reserveFailed_ = false;
 };
 
 }  // namespace frep::farm

@@ -390,8 +390,7 @@ bool walkBrick(const void* data, size_t size, Sink& sink, std::string* error) {
     std::array<uint64_t, kLeafVoxels / 64> positive{};
     float magnitude = 0;
     if (!r.bytes(positive.data(), sizeof positive) || !r.get(magnitude)) return fail("payload: truncated leaf");
-    size_t activeCount = 0;
-    for (uint64_t word : active) activeCount += size_t(__builtin_popcountll(word));
+    const size_t activeCount = countVoxels(active.data());
     if (size_t(r.end - r.p) < activeCount * sizeof(float)) return fail("payload: truncated leaf values");
     if (!l) {
       r.p += activeCount * sizeof(float);

@@ -61,6 +61,17 @@ __attribute__((target("avx512f,popcnt"))) const char* expandAvx512(float* values
   return src;
 }
 
+__attribute__((target("popcnt"))) size_t countWithPopcnt(const uint64_t mask[8]) {
+  size_t n = 0;
+  for (int w = 0; w < 8; ++w) n += size_t(_mm_popcnt_u64(mask[w]));
+  return n;
+}
+
+bool hasPopcnt() {
+  static const bool has = __builtin_cpu_supports("popcnt");
+  return has;
+}
+
 bool hasAvx512() {
   static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("popcnt");
   return has;
@@ -68,6 +79,15 @@ bool hasAvx512() {
 #endif
 
 }  // namespace
+
+size_t countVoxels(const uint64_t mask[8]) {
+#ifdef FREP_LEAF_EXPAND_AVX512
+  if (hasPopcnt()) return countWithPopcnt(mask);
+#endif
+  size_t n = 0;
+  for (int w = 0; w < 8; ++w) n += size_t(__builtin_popcountll(mask[w]));
+  return n;
+}
 
 std::vector<LeafExpansion> leafExpansions() {
   std::vector<LeafExpansion> ways{LeafExpansion::Bytewise};

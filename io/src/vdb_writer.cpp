@@ -306,13 +306,21 @@ LevelSetBuilder::LevelSetBuilder(const GridSpec& grid, int bandVoxels)
 LevelSetBuilder::~LevelSetBuilder() = default;
 
 void LevelSetBuilder::addTiles(const std::vector<Tile>& tiles) {
-  if (!tree_ || leaves_) throw std::logic_error("LevelSetBuilder: tiles after leaves or after write");
+  if (!tree_) throw std::logic_error("LevelSetBuilder: tiles after write");
+  // A tile reaches only towards +x from its origin: one at or past the end in x of every leaf
+  // added so far covers none of them (the farm hands over x-slab by x-slab), and the tree is
+  // then the one all the tiles first would give.
+  for (const Tile& t : tiles)
+    if (leaves_ && t.origin[0] < leavesEndX_)
+      throw std::logic_error("LevelSetBuilder: a tile at x " + std::to_string(t.origin[0]) +
+                             " after leaves up to x " + std::to_string(leavesEndX_) + " it may cover");
   tree_->addTiles(tiles);
 }
 
 void LevelSetBuilder::addLeaves(const std::vector<LeafBlock>& leaves) {
   if (!tree_) throw std::logic_error("LevelSetBuilder: leaves after write");
   tree_->addLeaves(leaves);
+  for (const LeafBlock& l : leaves) leavesEndX_ = std::max(leavesEndX_, int64_t(l.origin[0]) + kLeafDim);
   leaves_ += leaves.size();
 }
 

@@ -178,3 +178,36 @@ TEST(Journal, ReadGivesBackEachPayloadWhereAddPutIt) {
   EXPECT_THROW(j.read(at.back() + 4, past.data(), past.size()), frep::farm::JournalIoError);
   std::remove(path.c_str());
 }
+
+// The journal allocates the file's blocks ahead of its records in 64 MiB steps (Journal::add):
+// records across steps and one larger than a step replay whole, and the file's size is what
+// was written, not what was allocated (so a resume never reads the blocks past the records).
+TEST(Journal, RecordsAcrossTheBlocksAllocatedAheadReplayAndTheSizeIsWhatWasWritten) {
+  const std::string path = ::testing::TempDir() + "allocated_ahead.journal";
+  std::remove(path.c_str());
+  std::vector<std::string> payloads{std::string(40 << 20, 'a'), std::string(70 << 20, 'b'), std::string(1000, 'c')};
+  payloads[1][(70 << 20) - 1] = 'z';
+  size_t written = 12;
+  {
+    Journal j(path, 42, false, nullptr);
+    for (size_t i = 0; i < payloads.size(); ++i) {
+      j.append(i, payloads[i]);
+      written += 20 + payloads[i].size();
+      struct stat st {};
+      ASSERT_EQ(stat(path.c_str(), &st), 0);
+      EXPECT_EQ(uint64_t(st.st_size), written) << "after record " << i;
+    }
+  }
+  size_t n = 0;
+  Journal j(path, 42, true, [&](uint64_t brick, const std::string& payload) {
+    ASSERT_LT(brick, payloads.size());
+    EXPECT_TRUE(payload == payloads[brick]) << "record " << brick;
+    ++n;
+  });
+  EXPECT_EQ(n, payloads.size());
+  j.append(3, "after the resume");
+  struct stat st {};
+  ASSERT_EQ(stat(path.c_str(), &st), 0);
+  EXPECT_EQ(uint64_t(st.st_size), written + 20 + 16);
+  std::remove(path.c_str());
+}

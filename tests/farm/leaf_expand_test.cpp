@@ -60,3 +60,26 @@ TEST(LeafExpand, EveryWayGivesTheFormatsBitsAndReadsOnlyItsValues) {
   }
   munmap(pages, size_t(3 * page));
 }
+
+// countVoxels against a count bit by bit: empty, full, single bits at every place, random masks.
+TEST(LeafExpand, CountVoxelsCountsEveryBitOfTheMask) {
+  auto byBits = [](const uint64_t m[8]) {
+    size_t n = 0;
+    for (int i = 0; i < 512; ++i) n += (m[i >> 6] >> (i & 63)) & 1;
+    return n;
+  };
+  uint64_t mask[8] = {};
+  EXPECT_EQ(countVoxels(mask), 0u);
+  for (int i = 0; i < 512; ++i) {
+    std::memset(mask, 0, sizeof mask);
+    mask[i >> 6] = uint64_t(1) << (i & 63);
+    ASSERT_EQ(countVoxels(mask), 1u) << i;
+  }
+  std::memset(mask, 0xFF, sizeof mask);
+  EXPECT_EQ(countVoxels(mask), 512u);
+  std::mt19937_64 rng(17);
+  for (int r = 0; r < 1000; ++r) {
+    for (uint64_t& w : mask) w = rng() & rng();
+    ASSERT_EQ(countVoxels(mask), byBits(mask)) << r;
+  }
+}

@@ -1,10 +1,13 @@
-// FarmOptions::sampleSink: the merged sample streamed slab by slab hands over exactly the
-// leaves, in exactly the order, that FarmOutcome::result.leaves holds without it, the tiles
-// first, and every slab in one reused buffer.
+// FarmOptions::sampleSink: the merged sample streamed slab by slab (as each slab's bricks are all
+// merged) hands over exactly the tiles and leaves, in exactly the order, that FarmOutcome::result
+// holds without it, each slab's tiles before its leaves, in one reused buffer; whatever order
+// the bricks arrive in, and when the job does not complete or the sink fails.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cstdio>
+#include <optional>
+#include <stdexcept>
 #include <thread>
 #include <zmq.hpp>
 
@@ -14,20 +17,20 @@ using namespace farmtest;
 
 namespace {
 
-// What a sink saw: the tiles, each slab's leaves and where the buffer was.
+// What a sink saw: the tiles (and for each call, how many leaves had come before it), each
+// slab's leaves and where the buffer was.
 struct Streamed {
   std::vector<Tile> tiles;
-  int tileCalls = 0;
-  size_t leavesBeforeTiles = 0;
+  std::vector<size_t> tileCallSizes, leavesBeforeTileCall;
   std::vector<LeafBlock> leaves;
   std::vector<size_t> slabSizes;
   std::vector<const LeafBlock*> buffers;
   SampleSink sink() {
     SampleSink s;
     s.tiles = [this](const std::vector<Tile>& t) {
-      ++tileCalls;
-      leavesBeforeTiles = leaves.size();
-      tiles = t;
+      tileCallSizes.push_back(t.size());
+      leavesBeforeTileCall.push_back(leaves.size());
+      tiles.insert(tiles.end(), t.begin(), t.end());
     };
     s.leaves = [this](const std::vector<LeafBlock>& slab) {
       leaves.insert(leaves.end(), slab.begin(), slab.end());
@@ -56,13 +59,15 @@ void expectSameTiles(const std::vector<Tile>& want, const std::vector<Tile>& got
   }
 }
 
-// The stream against the result built without a sink: same tiles (handed over once, before any
-// leaf), same leaves in the same order, result.leaves empty, one slab per x-slab of bricks that
-// has leaves (each within its slab), all in one buffer.
+// The x-slab (of `brick` voxels) of a leaf or tile origin.
+int slabOf(const std::array<int32_t, 3>& origin, int brick) { return origin[0] / brick; }
+
+// The stream against the result built without a sink: the same tiles and leaves in the same
+// order, result.leaves empty; one leaves call per x-slab of bricks that has leaves (each within
+// its slab), one tiles call per x-slab that has tiles, before any leaf of that slab or a later
+// one; a new buffer only for a slab larger than every one before it.
 void expectStreamedAsMerged(const FarmOutcome& ref, const FarmOutcome& got, const Streamed& s, int brick) {
   EXPECT_TRUE(got.result.leaves.empty());
-  EXPECT_EQ(s.tileCalls, 1);
-  EXPECT_EQ(s.leavesBeforeTiles, 0u);
   expectSameTiles(ref.result.tiles, s.tiles);
   expectSameTiles(ref.result.tiles, got.result.tiles);
   expectSameLeaves(ref.result.leaves, s.leaves);
@@ -70,14 +75,31 @@ void expectStreamedAsMerged(const FarmOutcome& ref, const FarmOutcome& got, cons
   size_t at = 0;
   std::vector<int> slabsWithLeaves;
   for (const LeafBlock& l : ref.result.leaves)
-    if (slabsWithLeaves.empty() || slabsWithLeaves.back() != l.origin[0] / brick) slabsWithLeaves.push_back(l.origin[0] / brick);
+    if (slabsWithLeaves.empty() || slabsWithLeaves.back() != slabOf(l.origin, brick))
+      slabsWithLeaves.push_back(slabOf(l.origin, brick));
   ASSERT_EQ(s.slabSizes.size(), slabsWithLeaves.size());
+  size_t largest = 0;
   for (size_t k = 0; k < s.slabSizes.size(); ++k) {
     EXPECT_GT(s.slabSizes[k], 0u);
     for (size_t i = at; i < at + s.slabSizes[k]; ++i)
-      ASSERT_EQ(s.leaves[i].origin[0] / brick, slabsWithLeaves[k]) << "slab " << k << ", leaf " << i;
+      ASSERT_EQ(slabOf(s.leaves[i].origin, brick), slabsWithLeaves[k]) << "slab " << k << ", leaf " << i;
     at += s.slabSizes[k];
-    EXPECT_EQ(s.buffers[k], s.buffers[0]) << "slab " << k << " was handed over in another buffer";
+    if (k > 0 && s.slabSizes[k] <= largest)
+      EXPECT_EQ(s.buffers[k], s.buffers[k - 1]) << "slab " << k << " was handed over in another buffer";
+    largest = std::max(largest, s.slabSizes[k]);
+  }
+  std::vector<int> slabsWithTiles;
+  for (const Tile& t : ref.result.tiles)
+    if (slabsWithTiles.empty() || slabsWithTiles.back() != slabOf(t.origin, brick)) slabsWithTiles.push_back(slabOf(t.origin, brick));
+  ASSERT_EQ(s.tileCallSizes.size(), slabsWithTiles.size());
+  size_t tile = 0;
+  for (size_t c = 0; c < s.tileCallSizes.size(); ++c) {
+    const int slab = slabsWithTiles[c];
+    for (size_t i = tile; i < tile + s.tileCallSizes[c]; ++i)
+      ASSERT_EQ(slabOf(s.tiles[i].origin, brick), slab) << "tiles call " << c << ", tile " << i;
+    tile += s.tileCallSizes[c];
+    for (size_t i = 0; i < s.leavesBeforeTileCall[c]; ++i)  // only leaves of earlier slabs came first
+      ASSERT_LT(slabOf(s.leaves[i].origin, brick), slab) << "tiles call " << c << " came after leaf " << i;
   }
 }
 
@@ -130,8 +152,24 @@ BrickOutput scriptedBrick(uint64_t id, const std::array<int32_t, 3>& lo) {
   return b;
 }
 
-// A scripted worker: answers each task at once with scriptedBrick, until told bye.
-void scriptedWorker(const std::string& ep, const std::string& id, std::atomic<bool>& stop) {
+// Sends the scripted result of a task.
+void answer(zmq::socket_t& s, uint64_t jobId, const Task& t) {
+  BrickOutput b = scriptedBrick(t.brick_id(), {t.lo(0), t.lo(1), t.lo(2)});
+  std::string payload = encodePayload(Operation::Sample, b);
+  Envelope r;
+  r.set_job_id(jobId);
+  r.mutable_result()->set_brick_id(t.brick_id());
+  r.mutable_result()->set_attempt(t.attempt());
+  r.mutable_result()->set_leaves(uint32_t(b.leaves.size()));
+  r.mutable_result()->set_payload_crc32(crc32Of(payload.data(), payload.size()));
+  send(s, "", r, &payload);
+}
+
+// A scripted worker: answers each task at once with scriptedBrick, until told bye. With
+// `holdFirst` it keeps its first task and answers it last, once no task came for a while (the
+// bricks of the slab it is in arrive out of order, after those of later slabs); the result is
+// the same whenever it comes.
+void scriptedWorker(const std::string& ep, const std::string& id, std::atomic<bool>& stop, bool holdFirst = false) {
   zmq::context_t ctx(1);
   zmq::socket_t s(ctx, zmq::socket_type::dealer);
   s.set(zmq::sockopt::linger, 200);
@@ -139,28 +177,33 @@ void scriptedWorker(const std::string& ep, const std::string& id, std::atomic<bo
   Envelope hello;
   hello.mutable_hello()->set_worker_id(id);
   send(s, "", hello);
+  std::optional<Envelope> held;
+  bool answeredHeld = false;
+  int idleTurns = 0;
   while (!stop) {
     zmq::pollitem_t item{static_cast<void*>(s), 0, ZMQ_POLLIN, 0};
     zmq::poll(&item, 1, std::chrono::milliseconds(20));
     Incoming in;
+    bool tasks = false;
     while (receive(s, false, in, nullptr)) {
       if (in.envelope.body_case() == Envelope::kBye) return;
       if (in.envelope.body_case() != Envelope::kTask) continue;
-      const Task& t = in.envelope.task();
-      BrickOutput b = scriptedBrick(t.brick_id(), {t.lo(0), t.lo(1), t.lo(2)});
-      std::string payload = encodePayload(Operation::Sample, b);
-      Envelope r;
-      r.set_job_id(in.envelope.job_id());
-      r.mutable_result()->set_brick_id(t.brick_id());
-      r.mutable_result()->set_attempt(t.attempt());
-      r.mutable_result()->set_leaves(uint32_t(b.leaves.size()));
-      r.mutable_result()->set_payload_crc32(crc32Of(payload.data(), payload.size()));
-      send(s, "", r, &payload);
+      tasks = true;
+      if (holdFirst && !held) {
+        held = in.envelope;
+        continue;
+      }
+      answer(s, in.envelope.job_id(), in.envelope.task());
+    }
+    idleTurns = tasks ? 0 : idleTurns + 1;
+    if (held && !answeredHeld && idleTurns >= 5) {
+      answer(s, held->job_id(), held->task());
+      answeredHeld = true;
     }
   }
 }
 
-FarmOutcome scriptedJob(const std::string& journal, const SampleSink& sink) {
+FarmOutcome scriptedJob(const std::string& journal, const SampleSink& sink, bool outOfOrder = false) {
   JobSpec j = partJob("sample", 128);  // 4 x 4 x 4 bricks of 32
   FarmOptions o;
   o.brickVoxels = 32;
@@ -172,7 +215,8 @@ FarmOutcome scriptedJob(const std::string& journal, const SampleSink& sink) {
   MasterThread m(j, o);
   const std::string ep = m.endpoint();
   std::atomic<bool> stop{false};
-  std::thread a(scriptedWorker, ep, "scripted-a", std::ref(stop)), b(scriptedWorker, ep, "scripted-b", std::ref(stop));
+  std::thread a(scriptedWorker, ep, "scripted-a", std::ref(stop), outOfOrder),
+      b(scriptedWorker, ep, "scripted-b", std::ref(stop), false);
   m.join();
   stop = true;
   a.join();
@@ -186,7 +230,11 @@ FarmOutcome scriptedJob(const std::string& journal, const SampleSink& sink) {
 // Pre-encoded payloads as bench_farm --master-only replays them, slabs of different sizes (the
 // largest last, one empty), from the journal and from the payload arena; the merge without a
 // sink checked first against the scripted leaves sorted independently.
-TEST(SampleSink, StreamsScriptedPayloadsSlabBySlabInOneBuffer) {
+// Pre-encoded payloads as bench_farm --master-only replays them, slabs of different sizes (the
+// largest last, one empty), from the journal and from the payload arena, the bricks in the order
+// they were leased or one of the first slab's last of all; the merge without a sink checked
+// first against the scripted leaves sorted independently.
+TEST(SampleSink, StreamsScriptedPayloadsSlabBySlabWhateverTheirOrder) {
   std::vector<LeafBlock> want;
   std::vector<Tile> wantTiles;
   uint64_t id = 0;
@@ -198,37 +246,99 @@ TEST(SampleSink, StreamsScriptedPayloadsSlabBySlabInOneBuffer) {
         wantTiles.insert(wantTiles.end(), b.tiles.begin(), b.tiles.end());
       }
   sortByOrigin(want, wantTiles);
-  for (bool journal : {false, true}) {
-    SCOPED_TRACE(std::string("journal ") + (journal ? "on" : "off"));
-    const std::string path = journal ? "/tmp/frep_sample_sink_scripted." + std::to_string(getpid()) + ".journal" : "";
-    if (journal) std::remove(path.c_str());
-    FarmOutcome ref = scriptedJob(path, {});
-    if (journal) std::remove(path.c_str());
-    ASSERT_EQ(ref.report.bricks, 64u);
-    expectSameLeaves(want, ref.result.leaves);
-    expectSameTiles(wantTiles, ref.result.tiles);
+  for (bool journal : {false, true})
+    for (bool outOfOrder : {false, true}) {
+      SCOPED_TRACE(std::string("journal ") + (journal ? "on" : "off") + (outOfOrder ? ", out of order" : ""));
+      const std::string path = journal ? "/tmp/frep_sample_sink_scripted." + std::to_string(getpid()) + ".journal" : "";
+      if (journal) std::remove(path.c_str());
+      FarmOutcome ref = scriptedJob(path, {}, outOfOrder);
+      if (journal) std::remove(path.c_str());
+      ASSERT_EQ(ref.report.bricks, 64u);
+      expectSameLeaves(want, ref.result.leaves);
+      expectSameTiles(wantTiles, ref.result.tiles);
+      Streamed s;
+      FarmOutcome got = scriptedJob(path, s.sink(), outOfOrder);
+      if (journal) std::remove(path.c_str());
+      expectStreamedAsMerged(ref, got, s, 32);
+      ASSERT_EQ(s.slabSizes.size(), 3u);  // x-slab 1 is empty
+      EXPECT_LT(s.slabSizes[0], s.slabSizes[2]);
+    }
+}
+
+namespace {
+
+// The leaves of `from` in x-slabs [slabLo, slabHi) of 32 voxels, but not in the box [lo, hi).
+std::vector<LeafBlock> leavesOf(const std::vector<LeafBlock>& from, int slabLo, int slabHi,
+                                const std::array<int32_t, 3>& lo = {}, const std::array<int32_t, 3>& hi = {}) {
+  std::vector<LeafBlock> out;
+  for (const LeafBlock& l : from) {
+    const int slab = slabOf(l.origin, 32);
+    bool inBox = true;
+    for (int a = 0; a < 3; ++a) inBox = inBox && l.origin[a] >= lo[a] && l.origin[a] < hi[a];
+    if (slab >= slabLo && slab < slabHi && !inBox) out.push_back(l);
+  }
+  return out;
+}
+
+}  // namespace
+
+// A job that does not complete hands over the slabs before the first one it did not complete;
+// result.leaves holds the merged leaves of the others: with the first slab's brick 3 poisoned,
+// nothing is handed over; with brick 21 of the last slab (27 bricks of 32^3, 9 a slab), the
+// first two slabs are, and result.leaves is the last slab without that brick's leaves.
+TEST(SampleSink, AnIncompleteJobHandsOverTheSlabsBeforeItsFirstIncompleteOne) {
+  JobSpec j = partJob("sample", 96);
+  FarmOutcome ref = runJob(j, fast(0));
+  for (const char* crash : {"3", "21"}) {
+    SCOPED_TRACE(std::string("brick ") + crash + " poisoned");
+    FarmOptions o = fast(2);
     Streamed s;
-    FarmOutcome got = scriptedJob(path, s.sink());
-    if (journal) std::remove(path.c_str());
-    expectStreamedAsMerged(ref, got, s, 32);
-    ASSERT_EQ(s.slabSizes.size(), 3u);  // x-slab 1 is empty
-    EXPECT_LT(s.slabSizes[0], s.slabSizes[2]);
+    o.sampleSink = s.sink();
+    setenv("FREP_TEST_CRASH_BRICK", crash, 1);
+    FarmOutcome got = runJob(j, o);
+    unsetenv("FREP_TEST_CRASH_BRICK");
+    ASSERT_EQ(got.report.poisoned.size(), 1u);
+    const PoisonedBrick& p = got.report.poisoned[0];
+    EXPECT_EQ(s.leaves.size() + got.result.leaves.size(), got.report.leaves);
+    if (std::string(crash) == "3") {
+      EXPECT_TRUE(s.tileCallSizes.empty());
+      EXPECT_TRUE(s.slabSizes.empty());
+      expectSameLeaves(leavesOf(ref.result.leaves, 0, 3, p.lo, p.hi), got.result.leaves);
+    } else {
+      ASSERT_EQ(p.lo, (std::array<int32_t, 3>{64, 32, 0}));
+      expectSameLeaves(leavesOf(ref.result.leaves, 0, 2), s.leaves);
+      expectSameLeaves(leavesOf(ref.result.leaves, 2, 3, p.lo, p.hi), got.result.leaves);
+    }
   }
 }
 
-// A sink only streams a complete job: with a brick poisoned nothing is handed over, and the
-// merged leaves stay in the result, as without a sink.
-TEST(SampleSink, AnIncompleteJobHandsNothingOver) {
-  JobSpec j = partJob("sample", 64);
-  FarmOptions o = fast(2);
+// A sink that throws ends the job with its error, as if the master had died in the middle of
+// the merge; what was journaled by then is not computed again by a resume, which hands over the
+// same tiles and leaves as a job that never failed.
+TEST(SampleSink, AFailingSinkEndsTheJobAndAResumeStreamsTheSame) {
+  JobSpec j = partJob("sample", 96);  // 27 bricks of 32^3, 3 slabs
+  FarmOutcome ref = runJob(j, fast(0));
+  const std::string path = "/tmp/frep_sample_sink_fail." + std::to_string(getpid()) + ".journal";
+  std::remove(path.c_str());
+  FarmOptions o = fast(0);
+  o.journalPath = path;
+  int calls = 0;
+  o.sampleSink.leaves = [&](const std::vector<LeafBlock>&) {
+    if (++calls == 2) throw std::runtime_error("the consumer failed");
+  };
+  try {
+    runJob(j, o);
+    ADD_FAILURE() << "the sink's error did not end the job";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "the consumer failed");
+  }
+  EXPECT_EQ(calls, 2);
+  o.resume = true;
   Streamed s;
   o.sampleSink = s.sink();
-  setenv("FREP_TEST_CRASH_BRICK", "3", 1);
   FarmOutcome got = runJob(j, o);
-  unsetenv("FREP_TEST_CRASH_BRICK");
-  ASSERT_EQ(got.report.poisoned.size(), 1u);
-  EXPECT_EQ(s.tileCalls, 0);
-  EXPECT_TRUE(s.slabSizes.empty());
-  EXPECT_GT(got.result.leaves.size(), 0u);
-  EXPECT_EQ(got.result.leaves.size(), got.report.leaves);
+  std::remove(path.c_str());
+  EXPECT_GE(got.report.bricksFromJournal, 18u);  // the first two slabs' bricks were journaled before their merge
+  EXPECT_EQ(got.report.bricksFromJournal + got.report.bricksComputed, got.report.bricks);
+  expectStreamedAsMerged(ref, got, s, 32);
 }

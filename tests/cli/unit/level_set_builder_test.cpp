@@ -77,6 +77,43 @@ TEST(VdbLevelSetBuilder, SlabsOfAnySizeWriteTheBytesOfTheWholeResult) {
   }
 }
 
+// As the farm streams a sample: x-slab by x-slab, each slab's tiles (some reaching into later
+// slabs) before its leaves; the same bytes as all the tiles first.
+TEST(VdbLevelSetBuilder, EachXSlabsTilesBeforeItsLeavesWriteTheBytesOfTheWholeResult) {
+  SampleResult s = bittenBlock();
+  io::VdbMetadata meta;
+  meta.gridName = "bitten";
+  meta.job = "test";
+  meta.store = io::VdbStore::Raw;
+  const std::string whole = emptyFile("whole.vdb");
+  io::writeLevelSet(whole, s, meta);
+  bool tileReachesOn = false;
+  for (int width : {8, 32}) {
+    SCOPED_TRACE("x-slabs of " + std::to_string(width) + " voxels");
+    io::LevelSetBuilder b(s.grid, s.bandVoxels);
+    for (int x0 = 0; x0 < s.grid.dims[0]; x0 += width) {
+      std::vector<Tile> tiles;
+      std::vector<LeafBlock> leaves;
+      for (const Tile& t : s.tiles)
+        if (t.origin[0] >= x0 && t.origin[0] < x0 + width) {
+          tiles.push_back(t);
+          tileReachesOn = tileReachesOn || t.origin[0] + t.size > x0 + width;
+        }
+      for (const LeafBlock& l : s.leaves)
+        if (l.origin[0] >= x0 && l.origin[0] < x0 + width) leaves.push_back(l);
+      b.addTiles(tiles);
+      b.addLeaves(leaves);
+    }
+    EXPECT_EQ(b.leaves(), s.leaves.size());
+    const std::string streamed = emptyFile("xslabs.vdb");
+    b.write(streamed, meta);
+    EXPECT_TRUE(readAll(whole) == readAll(streamed)) << "the file built x-slab by x-slab differs";
+    std::remove(streamed.c_str());
+  }
+  EXPECT_TRUE(tileReachesOn);  // some tile covered later slabs before their leaves came
+  std::remove(whole.c_str());
+}
+
 TEST(VdbLevelSetBuilder, TilesAfterLeavesAndASecondWriteAreRefused) {
   SampleResult s = bittenBlock();
   io::LevelSetBuilder b(s.grid, s.bandVoxels);

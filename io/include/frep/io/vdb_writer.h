@@ -35,8 +35,9 @@ struct VdbMetadata {
 // frep_params, frep_version. Throws Error(kExitIoError).
 void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta);
 
-// The same file built from a sample as it streams in (farm::SampleSink): the tiles, then the
-// leaves in any number of calls, then write(): the bytes writeLevelSet writes for a SampleResult
+// The same file built from a sample as it streams in (farm::SampleSink): tiles and leaves in any
+// number of calls, each tile before the leaves it covers (farm::SampleSink hands each slab's
+// tiles before its leaves), then write(): the bytes writeLevelSet writes for a SampleResult
 // holding those tiles and leaves. Each call copies its leaves into the tree, so the caller can
 // free or reuse them: the sampler's leaves and the tree are never held whole at once.
 class LevelSetBuilder {
@@ -45,7 +46,9 @@ class LevelSetBuilder {
   ~LevelSetBuilder();
   LevelSetBuilder(const LevelSetBuilder&) = delete;
   LevelSetBuilder& operator=(const LevelSetBuilder&) = delete;
-  void addTiles(const std::vector<Tile>& tiles);  // before any leaf (a tile overwrites what it covers)
+  // Before the leaves they cover (a tile overwrites what it covers): a tile below the end in x
+  // of the leaves added so far is std::logic_error.
+  void addTiles(const std::vector<Tile>& tiles);
   void addLeaves(const std::vector<LeafBlock>& leaves);
   uint64_t leaves() const { return leaves_; }  // added so far
   // Once, at the end; throws Error(kExitIoError) as writeLevelSet does.
@@ -55,6 +58,7 @@ class LevelSetBuilder {
   struct Tree;  // the OpenVDB grid being built (vdb_writer.cpp)
   std::unique_ptr<Tree> tree_;
   uint64_t leaves_ = 0;
+  int64_t leavesEndX_ = 0;  // past the largest x of the leaves added (addTiles' check)
 };
 
 }  // namespace frep::io
