@@ -440,9 +440,9 @@ class Simplifier {
   }
 
   bool settledEdge(uint32_t a, uint32_t b) const { return w_.settled[a] != 0 && w_.settled[a] == w_.settled[b]; }
-  // v's star changes: its edges are tried again (now, if the greedy phase has begun; at its
-  // start otherwise), and it is no longer settled.
-  // Only the edges pushAllCandidates skipped (to vertices of v's tag): the others are queued.
+  // v's star changes: it is no longer settled, and the edges pushAllCandidates skipped for its
+  // tag (those to vertices of the same tag; the others are queued already) are queued now, or
+  // (push false: before the greedy phase) at its start.
   void unsettle(uint32_t v, bool push) {
     const uint32_t tag = w_.settled[v];
     if (tag == 0) return;
