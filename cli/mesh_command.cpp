@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "allocator_tuning.h"
 #include "arg_parse.h"
 #include "frep/io/atomic_output.h"
 #include "commands.h"
@@ -118,6 +119,9 @@ int runMesh(const MeshRequest& request) {
   Box box = request.region.bounds.empty() ? Box{} : parseBounds("-b/--bounds", request.region.bounds);
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);
   LoadedModel m = loadModel(request.model, true);
+  // The master merges and simplifies the whole mesh: its blocks' vectors come and go by the
+  // thousand (frep sample keeps glibc's default: its merge hands memory back to stay flat).
+  farm::keepFreedMemory();
   // A 1D or 2D object is meshed as frep sample samples it: the slab or prism it is in 3D
   // (constant along the missing axes), cut by the box.
   if (m.dims > 3)

@@ -5,10 +5,12 @@
 
 #include <cstdlib>
 
+#include "allocator_tuning.h"
 #include "frep/io/geometry_files.h"
 #include "worker.h"
 
 int main(int argc, char** argv) {
+  frep::farm::keepFreedMemory();
   frep::io::installGeometryLoader();  // frMesh / frVolume read files through frep_io
   CLI::App app{"frep-worker: computes bricks for a frepfarm master.\n"
                "Exit codes: 0 done or stopped by SIGTERM, 2 bad arguments, 75 no master reachable,\n"
