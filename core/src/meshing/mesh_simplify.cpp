@@ -154,7 +154,11 @@ const std::vector<std::array<int32_t, 2>>& errorSampleCells(int m) {
 namespace {
 
 constexpr double kQuantum = 65536;      // exact predicates: 2^16 steps per voxel
-constexpr double kBucketVoxels = 2;     // spatial hash cell
+// The spatial hash's cell for the self-intersection check. Only the speed depends on it (every
+// pair whose boxes meet is tested exactly either way): 8 voxels files a simplified triangle
+// under one to eight cells without the separating-axis test, and took 30% less time in
+// embedded() than 2 at 256^3.
+constexpr double kBucketVoxels = 8;
 
 // The state a simplification works on: the whole mesh, or one block of it (locked vertices and
 // the triangles around the block held fixed, placements confined to the block).
