@@ -288,6 +288,7 @@ class Simplifier {
     // triangle allows its new ones at most that much error, however far its own chord was (the
     // mesher's chords across a crease can be most of a voxel deep).
     while (std::ldexp(tol_, maxLevel_ + 1) <= std::max(tol_, grid_.voxel) * (1 + 1e-12)) ++maxLevel_;
+    for (int k = 0; k <= maxLevel_ + 1; ++k) levelTol_.push_back(std::ldexp(tol_, k));
     if (tape_->numVars() > 3 && opt_.fixedCoords.size() < tape_->numVars() - 3)
       throw std::invalid_argument("simplifyMesh: the model has " + std::to_string(tape_->numVars()) +
                                   " coordinates; give values for x[4..] (fixedCoords)");
@@ -621,6 +622,7 @@ class Simplifier {
     // internal: unit direction, samples per side, whether the probes of `level` passed
     V3 d{};
     int m = 1, limit = 0;  // limit: the maxK of the last call
+    const std::vector<std::array<int32_t, 2>>* cells = nullptr;  // errorSampleCells(m)
     bool probed = false, done = false;
   };
 
@@ -650,6 +652,7 @@ class Simplifier {
         q.d = q.primary != V3{0, 0, 0} ? unit(q.primary) : unit(cross(sub(q.b, q.a), sub(q.c, q.a)));
         const double longest = std::max({norm(sub(q.b, q.a)), norm(sub(q.c, q.b)), norm(sub(q.a, q.c))});
         q.m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
+        q.cells = &errorSampleCells(q.m);
         q.level = 0;
         q.probed = false;
         q.done = q.d == V3{0, 0, 0};  // no direction: no level passes
@@ -667,9 +670,9 @@ class Simplifier {
         LevelQuery& q = qs[i];
         if (q.done) continue;
         any = true;
-        const std::vector<std::array<int32_t, 2>>& cells = errorSampleCells(q.m);
+        const std::vector<std::array<int32_t, 2>>& cells = *q.cells;
         const size_t from = q.probed ? kProbes : 0, to = q.probed ? cells.size() : std::min(kProbes, cells.size());
-        const double e = 0.8 * std::ldexp(tol_, q.level);
+        const double e = 0.8 * levelTol_[size_t(q.level)];
         const V3 u = scale(sub(q.b, q.a), 1.0 / q.m), v = scale(sub(q.c, q.a), 1.0 / q.m), de = scale(q.d, e);
         // Straight into the evaluator's lanes; a query that already failed this round stops.
         for (size_t k = from; k < to && !failed_[i]; ++k) {
@@ -686,7 +689,7 @@ class Simplifier {
         if (q.done) continue;
         if (!failed_[i]) {
           // the probes passed: now the rest (none left: done); the rest passed: done
-          if (q.probed || errorSampleCells(q.m).size() <= kProbes)
+          if (q.probed || q.cells->size() <= kProbes)
             q.done = true;
           else
             q.probed = true;
@@ -753,7 +756,7 @@ class Simplifier {
     int allowed = 0;
     bool started = false;  // levels() ran: the second round resumes it
     for (bool measured = false;; measured = true) {
-      const double e = std::ldexp(tol_, allowed);
+      const double e = levelTol_[size_t(allowed)];
       bool near = true;  // every removed vertex within e of some new triangle
       for (size_t i = 0; i < gone.size() && near; ++i) {
         near = false;
@@ -1340,6 +1343,7 @@ class Simplifier {
   MinHeap<Candidate> queue_;
   BatchEvaluator<double> batch_;
   int maxLevel_ = 0;  // the last error level
+  std::vector<double> levelTol_;  // e_k = tol * 2^k, k = 0 .. maxLevel_ + 1
   bool deferred_;
   std::vector<char> madeNow_;  // per triangle: made by a collapse of this run
 };
