@@ -182,12 +182,13 @@ struct Work {
 
 // The state of a mesh (vertices in key order, triangles canonical) with what earlier passes
 // carried: quadrics beyond a vertex's own tangent plane, error levels, made triangles.
-Work workOf(const Mesh& mesh) {
+// The mesh's vertex and triangle arrays move into the work (the caller replaces the mesh after).
+Work workOf(Mesh&& mesh) {
   Work w;
-  w.pos = mesh.positions;
-  w.normal = mesh.normals;
-  w.key = mesh.keys;
-  w.quad.resize(mesh.positions.size());
+  w.pos = std::move(mesh.positions);
+  w.normal = std::move(mesh.normals);
+  w.key = std::move(mesh.keys);
+  w.quad.resize(w.pos.size());
   for (size_t v = 0; v < w.pos.size(); ++v) w.quad[v].addPlane(w.normal[v], w.pos[v]);
   w.moved.assign(w.pos.size(), 0);
   w.locked.assign(w.pos.size(), 0);
@@ -198,7 +199,7 @@ Work workOf(const Mesh& mesh) {
     w.moved[c.index] = c.moved;
     w.settled[c.index] = c.settled;
   }
-  w.tris = mesh.triangles;
+  w.tris = std::move(mesh.triangles);
   w.level.assign(w.tris.size(), -1);
   w.made.assign(w.tris.size(), 0);
   if (!mesh.carry.triangles.empty()) {
@@ -1639,6 +1640,8 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     if (vAlive[v]) alive.push_back(v);
   std::sort(alive.begin(), alive.end(), [&](uint32_t x, uint32_t y) { return g.key[x] < g.key[y]; });
   Work c;
+  c.pos.reserve(alive.size()), c.normal.reserve(alive.size()), c.key.reserve(alive.size()), c.quad.reserve(alive.size());
+  c.moved.reserve(alive.size()), c.locked.reserve(alive.size()), c.settled.reserve(alive.size());
   for (uint32_t v : alive) {
     index[v] = uint32_t(c.pos.size());
     c.pos.push_back(g.pos[v]);
@@ -1650,6 +1653,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     c.settled.push_back(g.settled[v]);
   }
   std::vector<std::pair<Tri, uint32_t>> order;  // canonical triangle, old index
+  order.reserve(g.tris.size());
   for (uint32_t t = 0; t < g.tris.size(); ++t) {
     if (!tAlive[t]) continue;
     Tri r{index[g.tris[t][0]], index[g.tris[t][1]], index[g.tris[t][2]]};
@@ -1657,6 +1661,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     order.push_back({r, t});
   }
   std::sort(order.begin(), order.end());
+  c.tris.reserve(order.size()), c.level.reserve(order.size()), c.made.reserve(order.size());
   for (const auto& [r, t] : order) {
     c.tris.push_back(r);
     c.level.push_back(g.level[t]);
@@ -1671,7 +1676,7 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
   SimplifyStats stats;
   stats.trianglesBefore = stats.trianglesAfter = mesh.triangles.size() + 2 * mesh.carry.counters.collapses;
   if (!(options.tolerance > 0) || mesh.triangles.empty()) return stats;
-  Work w = workOf(mesh);
+  Work w = workOf(std::move(mesh));
   stats += mesh.carry.counters;  // the regions' share (simplifyRegion in the workers)
   mesh.carry = SimplifyCarry();
   // Four block passes (kBlockVoxels), each centred on what the one before left along its block
@@ -1695,6 +1700,7 @@ void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid,
                     const std::array<int32_t, 3>& lo, const std::array<int32_t, 3>& hi) {
   if (!(options.tolerance > 0) || piece.triangles.empty()) return;
   Mesh m;  // the piece as a mesh: its vertices are in key order, its triangles canonical
+  m.positions.reserve(piece.vertices.size()), m.normals.reserve(piece.vertices.size()), m.keys.reserve(piece.vertices.size());
   for (const MeshVertex& v : piece.vertices) {
     m.positions.push_back(v.position);
     m.normals.push_back(v.normal);
@@ -1702,7 +1708,7 @@ void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid,
   }
   m.triangles = std::move(piece.triangles);
   m.carry = std::move(piece.carry);
-  Work w = workOf(m);
+  Work w = workOf(std::move(m));
   SimplifyStats stats;
   const std::array<int64_t, 3> cells = gridCells(grid), rlo{lo[0], lo[1], lo[2]}, rhi{hi[0], hi[1], hi[2]};
   for (int pass = 0; pass < kWorkerPasses; ++pass)
