@@ -1638,7 +1638,8 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
   std::vector<uint32_t> alive, index(nv, UINT32_MAX);
   for (uint32_t v = 0; v < nv; ++v)
     if (vAlive[v]) alive.push_back(v);
-  std::sort(alive.begin(), alive.end(), [&](uint32_t x, uint32_t y) { return g.key[x] < g.key[y]; });
+  parallelSort(alive.begin(), alive.end(), [&](uint32_t x, uint32_t y) { return g.key[x] != g.key[y] ? g.key[x] < g.key[y] : x < y; },
+               opt.threads);  // a total order: the same for any thread count
   Work c;
   c.pos.reserve(alive.size()), c.normal.reserve(alive.size()), c.key.reserve(alive.size()), c.quad.reserve(alive.size());
   c.moved.reserve(alive.size()), c.locked.reserve(alive.size()), c.settled.reserve(alive.size());
@@ -1660,7 +1661,7 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     canonicalRotate(r);
     order.push_back({r, t});
   }
-  std::sort(order.begin(), order.end());
+  parallelSort(order.begin(), order.end(), std::less<>(), opt.threads);  // triangles are distinct: a total order
   c.tris.reserve(order.size()), c.level.reserve(order.size()), c.made.reserve(order.size());
   for (const auto& [r, t] : order) {
     c.tris.push_back(r);
