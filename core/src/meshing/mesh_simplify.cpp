@@ -675,12 +675,22 @@ class Simplifier {
         const size_t from = q.probed ? kProbes : 0, to = q.probed ? cells.size() : std::min(kProbes, cells.size());
         const double e = 0.8 * levelTol_[size_t(q.level)];
         const V3 u = scale(sub(q.b, q.a), 1.0 / q.m), v = scale(sub(q.c, q.a), 1.0 / q.m), de = scale(q.d, e);
-        // Straight into the evaluator's lanes; a query that already failed this round stops.
-        for (size_t k = from; k < to && !failed_[i]; ++k) {
-          const V3 p = add(q.a, add(scale(u, cells[k][0] + 1.0 / 3), scale(v, cells[k][1] + 1.0 / 3)));
-          for (uint32_t c = 0; c < spatial; ++c) inputs_[c][2 * lanes_] = p[c] - de[c], inputs_[c][2 * lanes_ + 1] = p[c] + de[c];
-          laneQuery_[lanes_] = i;
-          if (++lanes_ == kPairsPerCall && crossed() && stopAbove && endsAbove(qs, maxK)) return false;
+        // Straight into the evaluator's lanes, as many as fit before the batch is evaluated; a
+        // query that already failed this round stops.
+        for (size_t k = from; k < to && !failed_[i];) {
+          const size_t n = std::min(to - k, kPairsPerCall - lanes_);
+          double* const* in = inputs_.data();
+          for (size_t j = 0; j < n; ++j, ++k) {
+            const double s = cells[k][0] + 1.0 / 3, t = cells[k][1] + 1.0 / 3;
+            const size_t lane = 2 * (lanes_ + j);
+            for (uint32_t c = 0; c < spatial; ++c) {
+              const double pc = q.a[c] + (u[c] * s + v[c] * t);  // a + s u + t v
+              in[c][lane] = pc - de[c], in[c][lane + 1] = pc + de[c];
+            }
+            laneQuery_[lanes_ + j] = i;
+          }
+          lanes_ += n;
+          if (lanes_ == kPairsPerCall && crossed() && stopAbove && endsAbove(qs, maxK)) return false;
         }
       }
       if (!any) return true;
