@@ -447,8 +447,11 @@ class Master {
       send(router, rid, e);
     }
     if (zap) report_.curveRejected = zap->rejected();
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    if (local) local->terminateAll();
+    // The byes leave while the context closes (it waits for them up to the linger) instead of
+    // after a fixed sleep; local workers exit on theirs while the master merges, and are reaped
+    // (and signalled, should one still run) when the master is done (retired_).
+    router.set(zmq::sockopt::linger, 100);
+    retired_ = std::move(local);
   }
 
   void handle(zmq::socket_t& router, Incoming& in, const std::string& err) {
@@ -1233,6 +1236,7 @@ class Master {
   size_t done_ = 0, poisoned_ = 0;
   FarmReport report_;
   std::unique_ptr<Journal> journal_;
+  std::unique_ptr<LocalWorkers> retired_;  // the job's local workers, sent their bye
   std::unique_ptr<Progress> progress_;
   std::optional<Clock::time_point> firstJoin_;
   Clock::time_point start_;
