@@ -20,7 +20,6 @@ namespace {
 char* mapChunk(size_t bytes) {
   void* p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
   if (p == MAP_FAILED) throw std::bad_alloc();
-  adviseHugePages(p, bytes);
   return static_cast<char*>(p);
 }
 }  // namespace
