@@ -347,10 +347,12 @@ void taskCost() {
 int main(int argc, char** argv) {
   if (argc == 6 && std::string(argv[1]) == "--fake-workers")
     return runFakeWorkers(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), std::atoi(argv[5]));
-  const bool masterOnly = argc == 2 && std::string(argv[1]) == "--master-only";
+  const bool masterOnly = argc >= 2 && std::string(argv[1]) == "--master-only";
+  // --master-only --streaming: only the streamed runs (profiling the merge into a sink).
+  const bool streamingOnly = masterOnly && argc == 3 && std::string(argv[2]) == "--streaming";
   double brickSeconds = 0;
   if (!masterOnly) brickSeconds = workerSpeedUp();
-  taskCost();
+  if (!streamingOnly) taskCost();
 
   // 3. The master's own ceiling: a 1024^3 grid in 64^3 bricks = 4096 bricks, each answered at
   //    once with 128 leaf blocks (a surface crossing a 64^3 brick, 150 kB), with a journal.
@@ -366,6 +368,7 @@ int main(int argc, char** argv) {
   std::vector<double> rate[3], cpuPerBrick[3];
   for (int round = 0; round < 3; ++round)
     for (int mode = 0; mode < 3; ++mode) {
+      if (streamingOnly && mode != 2) continue;
       MasterRun m = masterRun(fakes, 1024, 64, leavesPerBrick, mode == 0 ? 1 : 0, mode == 2);
       rate[mode].push_back(double(m.bricks) / m.wall);
       cpuPerBrick[mode].push_back(m.processCpu / double(m.bricks));
@@ -374,6 +377,7 @@ int main(int argc, char** argv) {
                   fakes, label[mode], (unsigned long long)m.bricks, m.wall, rate[mode].back(),
                   1e6 * m.processCpu / double(m.bricks), 1e6 * m.loopCpu / double(m.bricks), m.peakRssMb);
     }
+  if (streamingOnly) return 0;
   auto median = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];

@@ -5,16 +5,17 @@
 # CPU per brick, peak RSS) and NEW/BASE ratios. NEW_LINE (default the same) names the runs of
 # NEW to compare, e.g. "streaming into a sink" (the merge streamed to a consumer, not built).
 # The fake workers share the machine, so wall rates follow the load; master CPU per brick is
-# the steadier figure.
-#   bench/bench_farm_ab.sh /tmp/main-build/bin build/bin [ROUNDS] [NEW_LINE]
+# the steadier figure. BASE_LINE (default "decoding on all cores") names the runs of BASE, e.g.
+# "streaming into a sink" to compare the streamed runs of both.
+#   bench/bench_farm_ab.sh /tmp/main-build/bin build/bin [ROUNDS] [NEW_LINE] [BASE_LINE]
 set -eu
-BASE=$1 NEW=$2 ROUNDS=${3:-3} NEW_LINE=${4:-decoding on all cores}
+BASE=$1 NEW=$2 ROUNDS=${3:-3} NEW_LINE=${4:-decoding on all cores} BASE_LINE=${5:-decoding on all cores}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 i=0
 while [ "$i" -lt "$ROUNDS" ]; do
   for which in base new; do
-    if [ "$which" = base ]; then bin=$BASE line="decoding on all cores"; else bin=$NEW line=$NEW_LINE; fi
+    if [ "$which" = base ]; then bin=$BASE line=$BASE_LINE; else bin=$NEW line=$NEW_LINE; fi
     echo "round $((i + 1)) $which (load $(cut -d' ' -f1 /proc/loadavg))"
     "$bin/bench_farm" --master-only 2>/dev/null | grep "$line:" | tee -a "$out/$which"
   done
