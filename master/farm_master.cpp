@@ -27,6 +27,7 @@
 #include "brick.h"
 #include "curve.h"
 #include "frep/meshing/mesh_merge.h"
+#include "allocator_tuning.h"
 #include "journal.h"
 #include "leaf_order.h"
 #include "local_workers.h"

@@ -13,13 +13,6 @@
 
 namespace frep::farm {
 
-// Asks the kernel to back the whole 2 MiB pages inside [data, data + bytes) with huge pages
-// (madvise MADV_HUGEPAGE; a hint, ignored where unsupported). For a large buffer filled once, the
-// streamed merge's slab: under this paravirtualized hypervisor the first touch of fresh memory
-// costs 12 us per 4 KiB page (0.35 GB/s), in 2 MiB pages 0.5-0.9 GB/s, or ~10 GB/s when they were
-// freed shortly before (docs/farm.md, "Throughput"). Call it before the buffer is first written.
-void adviseHugePages(void* data, size_t bytes);
-
 class PayloadArena {
  public:
   // A payload held in the arena; releases it when destroyed (move-only).

@@ -19,6 +19,12 @@ constexpr size_t kHeapRoom = size_t(1) << 30;
 
 }  // namespace
 
+void adviseHugePages(void* data, size_t bytes) {
+  const uintptr_t begin = reinterpret_cast<uintptr_t>(data);
+  const uintptr_t from = (begin + kHugePage - 1) & ~(kHugePage - 1), to = (begin + bytes) & ~(kHugePage - 1);
+  if (to > from) madvise(reinterpret_cast<void*>(from), to - from, MADV_HUGEPAGE);
+}
+
 void keepFreedMemory() {
   constexpr int kBytes = 256 << 20;  // above any one vector of a brick at the job limits
   mallopt(M_MMAP_THRESHOLD, kBytes);
@@ -31,12 +37,11 @@ void keepFreedMemory() {
   // THP mode "never" the advice is ignored; a failure only means 4 KiB pages, as before.
   mallopt(M_ARENA_MAX, 1);
   mallopt(M_TOP_PAD, int(kHeapRoom));
-  const uintptr_t before = reinterpret_cast<uintptr_t>(sbrk(0));
+  char* const before = static_cast<char*>(sbrk(0));
   void* volatile block = std::malloc(kHugePage);  // extends the break by kHeapRoom (volatile: the
   std::free(block);                               // pair is not elided; freed, the room stays)
-  const uintptr_t after = reinterpret_cast<uintptr_t>(sbrk(0));
-  const uintptr_t from = (before + kHugePage - 1) & ~(kHugePage - 1), to = after & ~(kHugePage - 1);
-  if (to > from) madvise(reinterpret_cast<void*>(from), to - from, MADV_HUGEPAGE);
+  char* const after = static_cast<char*>(sbrk(0));
+  if (after > before) adviseHugePages(before, size_t(after - before));
 }
 
 }  // namespace frep::farm

@@ -7,6 +7,7 @@
 #include <thread>
 #include <vector>
 
+#include "allocator_tuning.h"
 #include "payload_arena.h"
 
 using frep::farm::adviseHugePages;
