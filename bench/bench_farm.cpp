@@ -21,6 +21,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "allocator_tuning.h"
 #include "brick.h"
 #include "farm_master.h"
 #include "wire.h"
@@ -345,8 +346,10 @@ void taskCost() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc == 6 && std::string(argv[1]) == "--fake-workers")
+  if (argc == 6 && std::string(argv[1]) == "--fake-workers") {
+    keepFreedMemory();  // the fake workers stand in for frep-worker processes: its allocator policy
     return runFakeWorkers(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), std::atoi(argv[5]));
+  }
   const bool masterOnly = argc >= 2 && std::string(argv[1]) == "--master-only";
   // --master-only --streaming: only the streamed runs (profiling the merge into a sink).
   const bool streamingOnly = masterOnly && argc == 3 && std::string(argv[2]) == "--streaming";
