@@ -347,7 +347,7 @@ void taskCost() {
 
 int main(int argc, char** argv) {
   if (argc == 6 && std::string(argv[1]) == "--fake-workers") {
-    keepFreedMemory();  // the fake workers stand in for frep-worker processes: its allocator policy
+    applyAllocatorPolicy();  // the fake workers stand in for frep-worker processes: its allocator policy
     return runFakeWorkers(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), std::atoi(argv[5]));
   }
   const bool masterOnly = argc >= 2 && std::string(argv[1]) == "--master-only";

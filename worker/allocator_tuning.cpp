@@ -25,7 +25,7 @@ void adviseHugePages(void* data, size_t bytes) {
   if (to > from) madvise(reinterpret_cast<void*>(from), to - from, MADV_HUGEPAGE);
 }
 
-void keepFreedMemory() {
+void applyAllocatorPolicy() {
   constexpr int kBytes = 256 << 20;  // above any one vector of a brick at the job limits
   mallopt(M_MMAP_THRESHOLD, kBytes);
   mallopt(M_TRIM_THRESHOLD, kBytes);

@@ -10,7 +10,7 @@
 #include "worker.h"
 
 int main(int argc, char** argv) {
-  frep::farm::keepFreedMemory();
+  frep::farm::applyAllocatorPolicy();
   frep::io::installGeometryLoader();  // frMesh / frVolume read files through frep_io
   CLI::App app{"frep-worker: computes bricks for a frepfarm master.\n"
                "Exit codes: 0 done or stopped by SIGTERM, 2 bad arguments, 75 no master reachable,\n"

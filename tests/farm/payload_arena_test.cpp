@@ -2,15 +2,12 @@
 // from several threads at once, and a chunk goes back to the system once its pieces are released.
 #include <gtest/gtest.h>
 
-#include <cstdint>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "allocator_tuning.h"
 #include "payload_arena.h"
 
-using frep::farm::adviseHugePages;
 using frep::farm::PayloadArena;
 
 TEST(PayloadArena, PiecesHoldTheirBytesAndChunksAreReturnedWhenEmptied) {
@@ -53,22 +50,4 @@ TEST(PayloadArena, ConcurrentAddsKeepEveryPayloadIntact) {
       const PayloadArena::Piece& p = pieces[size_t(t)][size_t(i)];
       ASSERT_EQ(std::string(p.data(), p.size()), std::string(size_t(100 + 37 * i % 3000), char(t * kEach + i)));
     }
-}
-
-// adviseHugePages is a hint on the whole 2 MiB pages inside a range: any range (empty, short,
-// unaligned, heap or mapped) is accepted and its bytes are left as they are.
-TEST(PayloadArena, AdviseHugePagesKeepsAnyBufferIntact) {
-  adviseHugePages(nullptr, 0);
-  std::vector<char> small(100, 'a');
-  adviseHugePages(small.data(), small.size());
-  EXPECT_EQ(std::string(small.begin(), small.end()), std::string(100, 'a'));
-  std::vector<uint32_t> big(3 << 20);  // 12 MiB, an unaligned start
-  for (size_t i = 0; i < big.size(); ++i) big[i] = uint32_t(i * 2654435761u);
-  adviseHugePages(reinterpret_cast<char*>(big.data()) + 3, big.size() * 4 - 7);
-  for (size_t i = 0; i < big.size(); ++i) ASSERT_EQ(big[i], uint32_t(i * 2654435761u));
-  std::vector<uint32_t> fresh;
-  fresh.reserve(big.size());
-  adviseHugePages(fresh.data(), big.size() * 4);  // before its first write, as the merge does
-  fresh.assign(big.begin(), big.end());
-  EXPECT_EQ(fresh, big);
 }
