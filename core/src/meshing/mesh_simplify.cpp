@@ -289,7 +289,7 @@ class Simplifier {
     // triangle allows its new ones at most that much error, however far its own chord was (the
     // mesher's chords across a crease can be most of a voxel deep).
     while (std::ldexp(tol_, maxLevel_ + 1) <= std::max(tol_, grid_.voxel) * (1 + 1e-12)) ++maxLevel_;
-    for (int k = 0; k <= maxLevel_ + 1; ++k) levelTol_.push_back(std::ldexp(tol_, k));
+    for (size_t k = 0; k < levelTol_.size(); ++k) levelTol_[k] = std::ldexp(tol_, int(k));
     if (tape_->numVars() > 3 && opt_.fixedCoords.size() < tape_->numVars() - 3)
       throw std::invalid_argument("simplifyMesh: the model has " + std::to_string(tape_->numVars()) +
                                   " coordinates; give values for x[4..] (fixedCoords)");
@@ -325,7 +325,7 @@ class Simplifier {
     int worst = -1;  // over the triangles that collapses made
     for (uint32_t t = 0; t < w_.tris.size(); ++t)
       if (tAlive_[t] && w_.made[t]) worst = std::max<int>(worst, w_.level[t]);
-    stats_.errorBound = worst < 0 ? 0 : std::ldexp(tol_, worst);
+    stats_.errorBound = worst < 0 ? 0 : levelTol_[size_t(worst)];
     return stats_;
   }
   const Work& work() const { return w_; }
@@ -1354,7 +1354,9 @@ class Simplifier {
   MinHeap<Candidate> queue_;
   BatchEvaluator<double> batch_;
   int maxLevel_ = 0;  // the last error level
-  std::vector<double> levelTol_;  // e_k = tol * 2^k, k = 0 .. maxLevel_ + 1
+  // e_k = tol * 2^k for every level a triangle can hold (int8_t): a level carried from a
+  // worker's payload may exceed maxLevel_ (the decoder allows up to 15), and still counts.
+  std::array<double, 128> levelTol_{};
   bool deferred_;
   std::vector<char> madeNow_;  // per triangle: made by a collapse of this run
 };
