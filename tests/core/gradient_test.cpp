@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
 #include "frep/evaluators/eval.h"
+#include "frep/evaluators/interval.h"
 #include "frep/expressions/expr.h"
 
 using namespace frep;
@@ -290,4 +292,89 @@ TEST(Gradient, NewtonStepsOnSphereReachTheSurface) {
   EXPECT_LE(steps, 6);
   EXPECT_NEAR(std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]), 2.0, 1e-14);
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(x[i], 2.0 * dir[i], 1e-14);  // moved along the ray
+}
+
+// ---- BatchGradientEvaluator: the scalar evaluator's bits, lane by lane ------------------------
+
+namespace {
+
+bool sameBits(double a, double b) { return (std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Every lane of one batch against GradientEvaluator at the same point: value and the partials
+// along x[1..3] (0 past the tape's vars), bit for bit (NaN against NaN).
+void expectBatchMatchesScalar(const TapePtr& tape, const std::vector<std::vector<double>>& points, BatchGradientEvaluator& be) {
+  const uint32_t nv = tape->numVars();
+  be.reserve(*tape);
+  for (size_t l = 0; l < points.size(); ++l)
+    for (uint32_t i = 0; i < nv; ++i) be.in(i)[l] = points[l][i];
+  be.eval(*tape, points.size());
+  GradientEvaluator ge;
+  std::vector<double> g(nv);
+  for (size_t l = 0; l < points.size(); ++l) {
+    std::fill(g.begin(), g.end(), 0.0);
+    const double v = ge.eval(*tape, points[l].data(), g.data());
+    ASSERT_TRUE(sameBits(be.value()[l], v)) << "lane " << l << ": " << be.value()[l] << " vs " << v;
+    for (uint32_t j = 0; j < 3; ++j)
+      ASSERT_TRUE(sameBits(be.partial(int(j))[l], j < nv ? g[j] : 0.0))
+          << "lane " << l << " d/dx" << j << ": " << be.partial(int(j))[l] << " vs " << (j < nv ? g[j] : 0.0);
+  }
+}
+
+// Points that reach every branch: random ones, zeros (abs, sqrt, the zero-derivative rule), ties
+// (min/max), arguments past the own sin/cos range, infinities and NaN.
+std::vector<std::vector<double>> branchPoints(std::mt19937_64& rng, uint32_t nv, size_t n) {
+  const double special[] = {0.0, -0.0, 1.0, -1.0, 0.5, 1e9, -3e12, INFINITY, -INFINITY, NAN};
+  std::vector<std::vector<double>> pts(n, std::vector<double>(nv));
+  for (size_t l = 0; l < n; ++l)
+    for (uint32_t i = 0; i < nv; ++i)
+      pts[l][i] = rng() % 5 == 0 ? special[rng() % 10] : -1.5 + 3.0 * double(rng() % 1000003) / 1000003.0;
+  return pts;
+}
+
+}  // namespace
+
+TEST(BatchGradient, EveryOpBitIdenticalToGradientEvaluator) {
+  // Random expressions over every op RandomExpr has (smooth and piecewise), with 2, 3 and 4
+  // vars (x[4] is a fixed coordinate), full and partial batches, and one evaluator reused
+  // across tapes (rebinding).
+  BatchGradientEvaluator be;
+  std::mt19937_64 rng(17);
+  int tapes = 0;
+  for (uint64_t seed = 0; seed < 120; ++seed) {
+    RandomExpr gen(seed, false);
+    Expr e = gen.gen(1 + int(seed % 5));
+    const uint32_t nv = 2 + uint32_t(seed % 3);
+    if (nv == 4) e = e + Expr::x(3) * Expr::x(0);
+    auto tape = Tape::compile(e, nv);
+    const size_t n = seed % 4 == 0 ? BatchGradientEvaluator::kBatch : 1 + rng() % BatchGradientEvaluator::kBatch;
+    expectBatchMatchesScalar(tape, branchPoints(rng, nv, n), be);
+    ++tapes;
+  }
+  EXPECT_EQ(tapes, 120);
+}
+
+TEST(BatchGradient, RegisterReuseAndPrunedTapes) {
+  // In-place instructions (out == a), and tapes pruned over boxes (as the mesher's block
+  // tapes are), which share their root's register layout.
+  BatchGradientEvaluator be;
+  std::mt19937_64 rng(5);
+  const Expr gyroid = sin(8.0 * X) * cos(8.0 * Y) + sin(8.0 * Y) * cos(8.0 * Z) + sin(8.0 * Z) * cos(8.0 * X);
+  const Expr model = min(1.0 - X * X - Y * Y - Z * Z, 0.3 - abs(gyroid));
+  auto tape = Tape::compile(model, 3);
+  expectBatchMatchesScalar(Tape::compile(sin(sin(sin(X * Y))), 2), branchPoints(rng, 2, 64), be);
+  IntervalEvaluator iv;
+  for (int k = 0; k < 20; ++k) {
+    Interval box[3];
+    for (auto& b : box) {
+      const double lo = -1.2 + 2.0 * double(rng() % 1000) / 1000.0;
+      b = Interval(lo, lo + 0.05);
+    }
+    (void)iv.eval(*tape, box);
+    const TapePtr pruned = iv.pruned(tape);
+    std::vector<std::vector<double>> pts(1 + rng() % 200, std::vector<double>(3));
+    for (auto& p : pts)
+      for (int a = 0; a < 3; ++a) p[size_t(a)] = box[a].lo + 0.05 * double(rng() % 1000) / 1000.0;
+    expectBatchMatchesScalar(pruned, pts, be);
+    expectBatchMatchesScalar(tape, pts, be);
+  }
 }

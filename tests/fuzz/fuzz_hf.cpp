@@ -58,10 +58,15 @@ void frep::fuzz::hf(const uint8_t* data, size_t size) {
   BatchEvaluator<double> be;
   be.reserve(*tape);
   GradientEvaluator ge;
+  BatchGradientEvaluator bge;
+  bge.reserve(*tape);
   double grad[3];
   for (size_t k = 0; k < 4; ++k)
     for (uint32_t a = 0; a < n; ++a) be.in(a)[k] = points[k][a];
   const double* batch = be.eval(*tape, 4);
+  for (size_t k = 0; k < 4; ++k)
+    for (uint32_t a = 0; a < n; ++a) bge.in(a)[k] = points[k][a];
+  bge.eval(*tape, 4);
   double values[4];
   for (size_t k = 0; k < 4; ++k) values[k] = batch[k];
   for (size_t k = 0; k < 4; ++k) {
@@ -69,7 +74,10 @@ void frep::fuzz::hf(const uint8_t* data, size_t size) {
     FREP_FUZZ_CHECK(same(v, values[k]));
     FREP_FUZZ_CHECK(std::isnan(v) || whole.contains(v));
     FREP_FUZZ_CHECK(same(pe.eval(*pruned, points[k]), v));
-    (void)ge.eval(*tape, points[k], grad);
+    std::fill_n(grad, 3, 0.0);
+    const double gv = ge.eval(*tape, points[k], grad);  // the batch gradient gives its bits
+    FREP_FUZZ_CHECK(same(bge.value()[k], gv));
+    for (uint32_t a = 0; a < 3; ++a) FREP_FUZZ_CHECK(same(bge.partial(int(a))[k], a < n ? grad[a] : 0.0));
   }
 }
 

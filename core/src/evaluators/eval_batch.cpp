@@ -12,16 +12,11 @@
 #include "frep/expressions/sin_cos.h"
 #include "frep/expressions/field_function.h"
 #include "frep/extremum/extremum.h"
+#include "isa_clones.h"
 
 namespace frep {
 
 namespace {
-
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define FREP_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define FREP_CLONES
-#endif
 
 // Lanes (< n) whose argument is outside the own sin/cos range (sin_cos.h), NaN included.
 inline size_t lanesOutOfTrigRange(const double* a, size_t n) {

@@ -1,14 +1,18 @@
-// Forward-mode gradient evaluator: a value register file plus one derivative row per register
-// (d reg / d x[j] for every coordinate j). Conventions match the symbolic derivative() in
-// expr.cpp: piecewise ops take the derivative of the branch applyOp takes, and a zero input
-// derivative contributes nothing (so an infinite partial times a constant input stays 0).
+// Forward-mode gradient evaluators: a value register file plus one derivative row per register
+// (d reg / d x[j] for every coordinate j), for one point (GradientEvaluator) or for a batch of
+// points in lanes (BatchGradientEvaluator, the same formulas lane by lane). Conventions match
+// the symbolic derivative() in expr.cpp: piecewise ops take the derivative of the branch applyOp
+// takes, and a zero input derivative contributes nothing (so an infinite partial times a
+// constant input stays 0).
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/field_function.h"
 #include "frep/expressions/sin_cos.h"
 #include "frep/extremum/extremum.h"
+#include "isa_clones.h"
 
 namespace frep {
 
@@ -156,6 +160,202 @@ double GradientEvaluator::eval(const Tape& tape, const double* x, double* grad) 
   const double* dres = d + size_t(tape.resultReg()) * nv;
   std::copy(dres, dres + nv, grad);
   return v[tape.resultReg()];
+}
+
+// ---- batches of points ---------------------------------------------------------------------
+
+namespace {
+
+constexpr size_t kLanes = BatchGradientEvaluator::kBatch;
+
+// Partials are kept along x[1..3] only: row j of register r is der[(r * 3 + j) * kLanes].
+inline double* row(double* der, uint32_t reg, uint32_t j) { return der + (size_t(reg) * 3 + j) * kLanes; }
+
+// An op with one partial per input, p[l] (and q[l] for the second input): the output rows as
+// GradientEvaluator writes them (term of each input row). Reads lane l of the input rows before
+// writing lane l of the output row, so the output may alias an input.
+inline void chain1(double* der, const Instr& ins, uint32_t nd, const double* p, size_t n) {
+  for (uint32_t j = 0; j < nd; ++j) {
+    const double* da = row(der, ins.a, j);
+    double* o = row(der, ins.out, j);
+    for (size_t l = 0; l < n; ++l) o[l] = term(p[l], da[l]);
+  }
+}
+inline void chain2(double* der, const Instr& ins, uint32_t nd, const double* p, const double* q, size_t n) {
+  for (uint32_t j = 0; j < nd; ++j) {
+    const double *da = row(der, ins.a, j), *db = row(der, ins.b, j);
+    double* o = row(der, ins.out, j);
+    for (size_t l = 0; l < n; ++l) o[l] = term(p[l], da[l]) + term(q[l], db[l]);
+  }
+}
+// Min/max/select: lane l's row is that of the input the value took (pick[l]: the second, b).
+inline void pickRows(double* der, uint32_t out, uint32_t first, uint32_t second, uint32_t nd, const char* pick, size_t n) {
+  for (uint32_t j = 0; j < nd; ++j) {
+    const double *x = row(der, first, j), *y = row(der, second, j);
+    double* o = row(der, out, j);
+    for (size_t l = 0; l < n; ++l) o[l] = pick[l] ? y[l] : x[l];
+  }
+}
+
+// The tape over n lanes (values reg-major, val[r * kLanes + l]). The common ops run as loops
+// over lanes; every other op runs GradientEvaluator's code lane by lane. Each op computes its
+// value and partials from its inputs first and writes its output rows after (out may alias an
+// input). p, q, t, pick: scratch of kLanes.
+FREP_CLONES void runGradientTape(const Instr* code, size_t ninstr, double* val, double* der, uint32_t nd, size_t n,
+                                 double* p, double* q, double* t, char* pick) {
+  for (size_t k = 0; k < ninstr; ++k) {
+    const Instr& ins = code[k];
+    const double* A = val + size_t(ins.a) * kLanes;
+    const double* B = val + size_t(ins.b) * kLanes;
+    const double* C = val + size_t(ins.c) * kLanes;
+    double* O = val + size_t(ins.out) * kLanes;
+    switch (ins.op) {
+      case Op::Add:
+        for (size_t l = 0; l < n; ++l) p[l] = 1.0;
+        chain2(der, ins, nd, p, p, n);
+        for (size_t l = 0; l < n; ++l) O[l] = A[l] + B[l];
+        continue;
+      case Op::Sub:
+        for (size_t l = 0; l < n; ++l) p[l] = 1.0, q[l] = -1.0;
+        chain2(der, ins, nd, p, q, n);
+        for (size_t l = 0; l < n; ++l) O[l] = A[l] - B[l];
+        continue;
+      case Op::Mul:
+        chain2(der, ins, nd, B, A, n);  // d(ab) = b da + a db
+        for (size_t l = 0; l < n; ++l) O[l] = A[l] * B[l];
+        continue;
+      case Op::Div:
+        for (size_t l = 0; l < n; ++l) p[l] = 1.0 / B[l], q[l] = -A[l] / (B[l] * B[l]);
+        chain2(der, ins, nd, p, q, n);
+        for (size_t l = 0; l < n; ++l) O[l] = A[l] / B[l];
+        continue;
+      case Op::Neg:
+        for (size_t l = 0; l < n; ++l) p[l] = -1.0;
+        chain1(der, ins, nd, p, n);
+        for (size_t l = 0; l < n; ++l) O[l] = -A[l];
+        continue;
+      case Op::Abs:
+        for (size_t l = 0; l < n; ++l) p[l] = A[l] > 0.0 ? 1.0 : (A[l] < 0.0 ? -1.0 : 0.0);
+        chain1(der, ins, nd, p, n);
+        for (size_t l = 0; l < n; ++l) O[l] = std::fabs(A[l]);
+        continue;
+      case Op::Sqrt:
+        for (size_t l = 0; l < n; ++l) t[l] = A[l] > 0.0 ? std::sqrt(A[l]) : 0.0;
+        for (size_t l = 0; l < n; ++l) p[l] = A[l] > 0.0 ? 1.0 / (2.0 * t[l]) : 0.0;
+        chain1(der, ins, nd, p, n);
+        for (size_t l = 0; l < n; ++l) O[l] = t[l];
+        continue;
+      case Op::Sin:
+      case Op::Cos: {
+        // sin and cos of every lane (t, p), as ownSin/ownCos give them; d sin = cos, d cos = -sin.
+        bool inRange = true;
+        for (size_t l = 0; l < n; ++l) inRange &= ownTrigInRange(A[l]);
+        if (inRange)
+          for (size_t l = 0; l < n; ++l) ownSinCosInRange(A[l], t[l], p[l]);
+        else
+          for (size_t l = 0; l < n; ++l) ownSinCos(A[l], t[l], p[l]);
+        if (ins.op == Op::Cos)
+          for (size_t l = 0; l < n; ++l) std::swap(t[l], p[l]), p[l] = -p[l];
+        chain1(der, ins, nd, p, n);
+        for (size_t l = 0; l < n; ++l) O[l] = t[l];
+        continue;
+      }
+      case Op::Min:
+        for (size_t l = 0; l < n; ++l) pick[l] = B[l] < A[l];
+        pickRows(der, ins.out, ins.a, ins.b, nd, pick, n);
+        for (size_t l = 0; l < n; ++l) O[l] = pick[l] ? B[l] : A[l];
+        continue;
+      case Op::Max:
+        for (size_t l = 0; l < n; ++l) pick[l] = B[l] > A[l];
+        pickRows(der, ins.out, ins.a, ins.b, nd, pick, n);
+        for (size_t l = 0; l < n; ++l) O[l] = pick[l] ? B[l] : A[l];
+        continue;
+      case Op::Select:
+        for (size_t l = 0; l < n; ++l) pick[l] = A[l] != 0.0;
+        pickRows(der, ins.out, ins.c, ins.b, nd, pick, n);
+        for (size_t l = 0; l < n; ++l) O[l] = pick[l] ? B[l] : C[l];
+        continue;
+      case Op::Copy:
+        for (uint32_t j = 0; j < nd; ++j) {
+          const double* da = row(der, ins.a, j);
+          double* o = row(der, ins.out, j);
+          if (o != da) std::copy(da, da + n, o);
+        }
+        if (O != A) std::copy(A, A + n, O);
+        continue;
+      default:
+        break;
+    }
+    // Any other op: GradientEvaluator::eval's step for each lane.
+    const bool constant = isPiecewiseConstant(ins.op), unary = opArity(ins.op) == 1;
+    for (size_t l = 0; l < n; ++l) {
+      const double a = A[l], b = B[l], c = C[l];
+      const double value = applyOp(ins.op, a, b, c, ins.imm);
+      const Partials pt = constant || ins.op == Op::Frac ? Partials{} : partials(ins.op, a, b, value, ins.imm);
+      for (uint32_t j = 0; j < nd; ++j) {
+        double* o = row(der, ins.out, j);
+        const double da = row(der, ins.a, j)[l], db = row(der, ins.b, j)[l];
+        o[l] = constant ? 0.0 : ins.op == Op::Frac ? da : unary ? term(pt.da, da) : term(pt.da, da) + term(pt.db, db);
+      }
+      O[l] = value;
+    }
+  }
+}
+
+}  // namespace
+
+void BatchGradientEvaluator::bind(const Tape& tape) {
+  const size_t nr = tape.numRegs();
+  if (boundId_ == tape.root()->id() && val_.size() >= nr * kBatch) return;
+  // Uniform rows hold their value in every lane and partials 0; coordinate rows unit partials.
+  // Temporaries are always written before they are read.
+  val_.assign(nr * kBatch, 0.0);
+  der_.assign(nr * 3 * kBatch, 0.0);
+  const auto& u = tape.uniforms();
+  for (size_t r = 0; r < u.size(); ++r) std::fill_n(val_.data() + r * kBatch, kBatch, u[r]);
+  for (uint32_t i = 0; i < std::min(tape.numVars(), 3u); ++i) std::fill_n(row(der_.data(), tape.varReg(i), i), kBatch, 1.0);
+  boundId_ = tape.root()->id();
+  numUniformsBound_ = tape.numUniforms();
+}
+
+void BatchGradientEvaluator::reserve(const Tape& tape) { bind(tape); }
+
+double* BatchGradientEvaluator::in(uint32_t var) {
+  // Vars follow the uniforms in every tape derived from the same root.
+  return val_.data() + size_t(numUniformsBound_ + var) * kBatch;
+}
+
+void BatchGradientEvaluator::eval(const Tape& tape, size_t count) {
+  bind(tape);
+  if (count > kBatch) throw std::invalid_argument("BatchGradientEvaluator: more than kBatch points");
+  const uint32_t nv = tape.numVars(), nd = std::min(nv, 3u);
+  double* value = out_.data();
+  if (tape.hasExtrema() || !tape.fields().empty()) {
+    x_.resize(nv);
+    g_.resize(nv);
+    for (size_t l = 0; l < count; ++l) {
+      for (uint32_t i = 0; i < nv; ++i) x_[i] = in(i)[l];
+      std::fill(g_.begin(), g_.end(), 0.0);
+      value[l] = scalar_.eval(tape, x_.data(), g_.data());
+      for (uint32_t j = 0; j < 3; ++j) out_[(j + 1) * kBatch + l] = j < nd ? g_[j] : 0.0;
+    }
+    return;
+  }
+  // Lanes past count are computed and ignored (whole vectors; the scratch follows the outputs).
+  const size_t n = std::min(kBatch, (count + 7) & ~size_t(7));
+  scratch_.resize(3 * kBatch);
+  pick_.resize(kBatch);
+  runGradientTape(tape.code().data(), tape.code().size(), val_.data(), der_.data(), nd, n, scratch_.data(),
+                  scratch_.data() + kBatch, scratch_.data() + 2 * kBatch, pick_.data());
+  const uint32_t r = tape.resultReg();
+  std::copy_n(val_.data() + size_t(r) * kBatch, count, value);
+  for (uint32_t j = 0; j < 3; ++j) {
+    double* o = out_.data() + (j + 1) * kBatch;
+    if (j < nd)
+      std::copy_n(row(der_.data(), r, j), count, o);
+    else
+      std::fill_n(o, count, 0.0);
+  }
 }
 
 }  // namespace frep

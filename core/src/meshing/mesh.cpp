@@ -160,8 +160,8 @@ struct RootWorker {
   std::vector<Interval> box;
   BatchEvaluator<double> batch;
   PointEvaluator point;
-  GradientEvaluator grad;
-  std::vector<double> x, g;
+  BatchGradientEvaluator grad;
+  std::vector<double> x;
   uint64_t rootEvals = 0, gradientEvals = 0, fallbacks = 0;
 };
 
@@ -266,6 +266,7 @@ class RegionMesher {
     groupStart.push_back(order.size());
     tbb::enumerable_thread_specific<RootWorker> workers;
     constexpr size_t B = BatchEvaluator<double>::kBatch;
+    static_assert(B <= BatchGradientEvaluator::kBatch, "a batch of roots gets its normals in one gradient batch");
     parallelChunks(groupStart.size() - 1, 1, opt_.threads, [&](size_t gb, size_t ge) {
       RootWorker& w = workers.local();
       for (size_t g = gb; g < ge; ++g) {
@@ -544,6 +545,7 @@ class RegionMesher {
       }
     }
     const double guard = opt_.endGuard;
+    w.grad.reserve(tape);
     for (size_t l = 0; l < count; ++l) {
       double t = 0.5 * (a[l] + b[l]);
       if (illinois[l] && std::isfinite(ra[l]) && std::isfinite(rb[l]) && ra[l] >= 0 && rb[l] < 0)
@@ -552,14 +554,14 @@ class RegionMesher {
       MeshVertex& v = *vertPtrs[l];
       v.key = edgePtrs[l]->key;
       for (int c = 0; c < 3; ++c) v.position[c] = pin[l][c] + t * dp[l][c];
-      // Normal: -grad f, or the edge direction where the gradient is unusable.
-      w.x.resize(std::max<uint32_t>(nvars_, 3));
-      w.g.resize(std::max<uint32_t>(nvars_, 3));
-      for (uint32_t c = 0; c < nvars_; ++c) w.x[c] = c < 3 ? v.position[c] : opt_.fixedCoords[c - 3];
-      std::fill(w.g.begin(), w.g.end(), 0.0);
-      w.grad.eval(tape, w.x.data(), w.g.data());
-      ++w.gradientEvals;
-      double n[3] = {-w.g[0], -w.g[1], -w.g[2]};
+      for (uint32_t c = 0; c < nvars_; ++c) w.grad.in(c)[l] = c < 3 ? v.position[c] : opt_.fixedCoords[c - 3];
+    }
+    // Normals: -grad f, or the edge direction where the gradient is unusable.
+    w.grad.eval(tape, count);
+    w.gradientEvals += count;
+    for (size_t l = 0; l < count; ++l) {
+      MeshVertex& v = *vertPtrs[l];
+      double n[3] = {-w.grad.partial(0)[l], -w.grad.partial(1)[l], -w.grad.partial(2)[l]};
       double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
       if (!(len > 0) || !std::isfinite(len)) {
         for (int c = 0; c < 3; ++c) n[c] = dp[l][c];

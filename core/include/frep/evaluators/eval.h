@@ -129,4 +129,31 @@ class GradientEvaluator {
   std::vector<double> xbuf_, gbuf_, row_;
 };
 
+// 5. Forward-mode gradients of up to kBatch points at once, in structure-of-arrays form: for
+//    every lane the same value and partials, bit for bit, as GradientEvaluator::eval, whose
+//    formulas it runs lane by lane (the common ops as vectorised loops). Only the partials along
+//    x[1..3] are kept (the others are independent of them). Tapes with extremum or field nodes
+//    go through GradientEvaluator lane by lane, in lane order.
+//    Usage: fill in(i)[k] for var i and point k < count (every var, x[4..] included), call eval,
+//    read value()[k] and partial(axis)[k] (axis 0..2; 0 past the tape's vars).
+class BatchGradientEvaluator {
+ public:
+  static constexpr size_t kBatch = 256;
+  void reserve(const Tape& tape);
+  double* in(uint32_t var);  // valid after reserve(tape)
+  void eval(const Tape& tape, size_t count);
+  const double* value() const { return out_.data(); }
+  const double* partial(int axis) const { return out_.data() + size_t(axis + 1) * kBatch; }
+
+ private:
+  void bind(const Tape& tape);
+  std::vector<double> val_, der_;  // val_: numRegs * kBatch; der_: (numRegs * 3 + axis) * kBatch
+  std::vector<double> out_ = std::vector<double>(4 * kBatch, 0.0);  // value, then 3 partials
+  std::vector<double> x_, g_, scratch_;
+  std::vector<char> pick_;
+  uint64_t boundId_ = 0;
+  uint32_t numUniformsBound_ = 0;
+  GradientEvaluator scalar_;  // tapes with extremum or field nodes
+};
+
 }  // namespace frep
