@@ -1177,7 +1177,7 @@ class Master {
       pieces.reserve(outputs_.size());
       for (auto& out : outputs_) pieces.push_back(std::move(out.piece));
       outputs_.clear();
-      o.mesh = mergePiecesReleasing(pieces);
+      o.mesh = mergePiecesReleasing(pieces, !allocatorPolicyApplied());
       report_.vertices = o.mesh.positions.size();
       report_.triangles = o.mesh.triangles.size();
     }

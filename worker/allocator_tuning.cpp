@@ -17,6 +17,8 @@ constexpr size_t kHugePage = size_t(2) << 20;
 // merge's working set, so the one madvise below covers what follows.
 constexpr size_t kHeapRoom = size_t(1) << 30;
 
+bool applied = false;
+
 }  // namespace
 
 void adviseHugePages(void* data, size_t bytes) {
@@ -42,6 +44,9 @@ void applyAllocatorPolicy() {
   std::free(block);                               // pair is not elided; freed, the room stays)
   char* const after = static_cast<char*>(sbrk(0));
   if (after > before) adviseHugePages(before, size_t(after - before));
+  applied = true;
 }
+
+bool allocatorPolicyApplied() { return applied; }
 
 }  // namespace frep::farm

@@ -12,8 +12,11 @@ namespace frep::farm {
 // again. Every thread allocates from the main arena, and the heap is advised for transparent
 // huge pages (adviseHugePages), so fresh memory faults in 2 MiB at a time. At 256^3 the default
 // mesh took 130,000 faults before, 25,000 after (docs/mesh.md). What is freed stays reusable
-// until exit or an explicit malloc_trim (the master's mesh merge calls it to keep its memory flat).
+// until exit or an explicit malloc_trim, which would also drop the heap's huge-page advice (so
+// the master's mesh merge does not trim where the policy is applied).
 void applyAllocatorPolicy();
+// Whether this process called applyAllocatorPolicy.
+bool allocatorPolicyApplied();
 
 // Asks the kernel to back the whole 2 MiB pages inside [data, data + bytes) with transparent huge
 // pages (madvise MADV_HUGEPAGE; a hint, ignored where unsupported). For a large buffer filled

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -26,4 +27,16 @@ TEST(AllocatorTuning, AdviseHugePagesKeepsAnyBufferIntact) {
   adviseHugePages(fresh.data(), big.size() * 4);  // before its first write, as the merge does
   fresh.assign(big.begin(), big.end());
   EXPECT_EQ(fresh, big);
+}
+
+TEST(AllocatorTuning, PolicyIsReportedOnceApplied) {
+  // In a child process: the policy is process-wide (the master's mesh merge reads the flag to
+  // keep the freed pieces instead of trimming the heap).
+  EXPECT_EXIT(
+      {
+        if (frep::farm::allocatorPolicyApplied()) std::exit(1);
+        frep::farm::applyAllocatorPolicy();
+        std::exit(frep::farm::allocatorPolicyApplied() ? 0 : 2);
+      },
+      ::testing::ExitedWithCode(0), "");
 }

@@ -131,15 +131,16 @@ Mesh mergeKeyed(const std::vector<MeshPiece>& pieces, const std::function<void(s
 
 Mesh mergePieces(const std::vector<MeshPiece>& pieces) { return mergeKeyed(pieces, nullptr); }
 
-Mesh mergePiecesReleasing(std::vector<MeshPiece>& pieces) {
+Mesh mergePiecesReleasing(std::vector<MeshPiece>& pieces, bool trimHeap) {
   size_t released = 0;
   Mesh mesh = mergeKeyed(pieces, [&](size_t i) {
     std::vector<MeshVertex>().swap(pieces[i].vertices);
     std::vector<std::array<uint32_t, 3>>().swap(pieces[i].triangles);
     pieces[i].carry = SimplifyCarry();
-    if (++released % 16 == 0) malloc_trim(0);  // hand the freed pieces back (they are small heap blocks)
+    // hand the freed pieces back (they are small heap blocks)
+    if (trimHeap && ++released % 16 == 0) malloc_trim(0);
   });
-  malloc_trim(0);
+  if (trimHeap) malloc_trim(0);
   return mesh;
 }
 
