@@ -183,33 +183,49 @@ struct Work {
 // The state of a mesh (vertices in key order, triangles canonical) with what earlier passes
 // carried: quadrics beyond a vertex's own tangent plane, error levels, made triangles.
 // The mesh's vertex and triangle arrays move into the work (the caller replaces the mesh after).
-Work workOf(Mesh&& mesh) {
+Work workOf(Mesh&& mesh, int threads) {
   Work w;
   w.pos = std::move(mesh.positions);
   w.normal = std::move(mesh.normals);
   w.key = std::move(mesh.keys);
-  w.quad.resize(w.pos.size());
-  for (size_t v = 0; v < w.pos.size(); ++v) w.quad[v].addPlane(w.normal[v], w.pos[v]);
-  w.moved.assign(w.pos.size(), 0);
-  w.locked.assign(w.pos.size(), 0);
-  w.settled.assign(w.pos.size(), 0);
-  for (const SimplifyCarry::Vertex& c : mesh.carry.vertices) {
-    if (c.index >= w.pos.size()) throw std::invalid_argument("simplifyMesh: a carried vertex past the mesh's vertices");
-    w.quad[c.index] = Quadric::unpacked(c.quadric);
-    w.moved[c.index] = c.moved;
-    w.settled[c.index] = c.settled;
-  }
-  w.tris = std::move(mesh.triangles);
-  w.level.assign(w.tris.size(), -1);
-  w.made.assign(w.tris.size(), 0);
-  if (!mesh.carry.triangles.empty()) {
-    if (mesh.carry.triangles.size() != w.tris.size())
-      throw std::invalid_argument("simplifyMesh: the carried triangle states do not match the triangles");
-    for (size_t t = 0; t < w.tris.size(); ++t) {
-      w.level[t] = int8_t((mesh.carry.triangles[t] & 0x7f) - 1);
-      w.made[t] = (mesh.carry.triangles[t] & 0x80) != 0;
+  const size_t nv = w.pos.size(), nt = mesh.triangles.size();
+  for (const SimplifyCarry::Vertex& c : mesh.carry.vertices)
+    if (c.index >= nv) throw std::invalid_argument("simplifyMesh: a carried vertex past the mesh's vertices");
+  if (!mesh.carry.triangles.empty() && mesh.carry.triangles.size() != nt)
+    throw std::invalid_argument("simplifyMesh: the carried triangle states do not match the triangles");
+  // The master's serial stretch between the merge and the first block pass: in chunks, on all
+  // its threads (each entry written once; the same arrays for any thread count).
+  constexpr size_t kGrain = 1 << 14;
+  w.quad.resize(nv);
+  w.moved.resize(nv);
+  w.locked.resize(nv);
+  w.settled.resize(nv);
+  parallelChunks(nv, kGrain, threads, [&](size_t b, size_t e) {
+    for (size_t v = b; v < e; ++v) {
+      w.quad[v] = Quadric();
+      w.quad[v].addPlane(w.normal[v], w.pos[v]);
+      w.moved[v] = 0, w.locked[v] = 0, w.settled[v] = 0;
     }
-  }
+  });
+  const std::vector<SimplifyCarry::Vertex>& carried = mesh.carry.vertices;  // distinct indices (mergePieces)
+  parallelChunks(carried.size(), kGrain, threads, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const SimplifyCarry::Vertex& c = carried[i];
+      w.quad[c.index] = Quadric::unpacked(c.quadric);
+      w.moved[c.index] = c.moved;
+      w.settled[c.index] = c.settled;
+    }
+  });
+  w.tris = std::move(mesh.triangles);
+  w.level.resize(nt);
+  w.made.resize(nt);
+  const std::vector<uint8_t>& states = mesh.carry.triangles;
+  parallelChunks(nt, kGrain, threads, [&](size_t b, size_t e) {
+    for (size_t t = b; t < e; ++t) {
+      w.level[t] = states.empty() ? int8_t(-1) : int8_t((states[t] & 0x7f) - 1);
+      w.made[t] = !states.empty() && (states[t] & 0x80) != 0;
+    }
+  });
   return w;
 }
 
@@ -1689,16 +1705,22 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
   SimplifyStats stats;
   stats.trianglesBefore = stats.trianglesAfter = mesh.triangles.size() + 2 * mesh.carry.counters.collapses;
   if (!(options.tolerance > 0) || mesh.triangles.empty()) return stats;
-  Work w = workOf(std::move(mesh));
+  Work w = workOf(std::move(mesh), options.threads);
   stats += mesh.carry.counters;  // the regions' share (simplifyRegion in the workers)
   mesh.carry = SimplifyCarry();
   // Four block passes (kBlockVoxels), each centred on what the one before left along its block
   // faces; the global pass finishes the rest. Blocks the bricks' own simplification did are
   // skipped (the result is the same).
   const std::array<int64_t, 3> cells = gridCells(grid);
-  for (int pass = 0; pass < kWorkerPasses; ++pass)
-    blockPass(w, tape, grid, options, pass,
-              [&](const BlockKey& b) { return !bricksDid(b, pass, options.bricksSimplified, cells); }, stats);
+  for (int pass = 0; pass < kWorkerPasses; ++pass) {
+    // Bricks of whole first-pass blocks did every first-pass block: nothing to look for.
+    const int brick = options.bricksSimplified;
+    if (pass == 0 && kBlockShift[0] == 0 && brick > 0 && brick % kBlockVoxels[0] == 0) {
+      if (options.progress) options.progress(pass, 0, 0);
+      continue;
+    }
+    blockPass(w, tape, grid, options, pass, [&](const BlockKey& b) { return !bricksDid(b, pass, brick, cells); }, stats);
+  }
   for (int pass = kWorkerPasses; pass < 4; ++pass) blockPass(w, tape, grid, options, pass, [](const BlockKey&) { return true; }, stats);
   SimplifyStats s2;
   std::unique_ptr<Simplifier> second = simplifyChecked([&w] { return w; }, tape, grid, options, s2);
@@ -1721,7 +1743,7 @@ void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid,
   }
   m.triangles = std::move(piece.triangles);
   m.carry = std::move(piece.carry);
-  Work w = workOf(std::move(m));
+  Work w = workOf(std::move(m), options.threads);
   SimplifyStats stats;
   const std::array<int64_t, 3> cells = gridCells(grid), rlo{lo[0], lo[1], lo[2]}, rhi{hi[0], hi[1], hi[2]};
   for (int pass = 0; pass < kWorkerPasses; ++pass)
