@@ -1552,8 +1552,12 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
   std::vector<Result> results(blocks.size());
   std::vector<char> vAlive(nv, 1), tAlive(nt, 1);
   // activeIn[t]: the block one of whose own vertices t has (a triangle with an owned vertex lies
-  // in that block's shrunk box, so it is one block's only: each entry has one writer).
-  std::vector<uint32_t> activeIn(nt, UINT32_MAX);
+  // in that block's shrunk box, so it is one block's only: each entry has one writer). Other
+  // blocks read it to skip their own active triangles among the obstacles: the entry equals
+  // their index exactly when they wrote it (relaxed atomics: a concurrent write by the entry's
+  // one writer is another block's index either way).
+  std::unique_ptr<std::atomic<uint32_t>[]> activeIn(new std::atomic<uint32_t>[nt]);
+  for (size_t t = 0; t < nt; ++t) activeIn[t].store(UINT32_MAX, std::memory_order_relaxed);
   auto solve = [&](size_t i) {
     const BlockKey& b = blocks[i];
     // This block run's tag (Work::settled): neighbouring blocks' differ.
@@ -1564,14 +1568,14 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
     std::vector<uint32_t> active, globalOf;  // the block's triangles; local vertex -> global
     for (uint32_t v : own)
       for (uint32_t k = vtStart[v]; k < vtStart[v + 1]; ++k)
-        if (activeIn[vtList[k]] != i) activeIn[vtList[k]] = uint32_t(i), active.push_back(vtList[k]);
+        if (activeIn[vtList[k]].load(std::memory_order_relaxed) != i)
+          activeIn[vtList[k]].store(uint32_t(i), std::memory_order_relaxed), active.push_back(vtList[k]);
     std::sort(active.begin(), active.end());
     V3 lo, hi;
     shrunk(b, lo, hi);
     std::vector<uint32_t> obstacles;
     for (uint32_t t : near[i]) {
-      if (std::binary_search(active.begin(), active.end(), t)) continue;  // (activeIn[t] may be
-                                                                           // another block's write)
+      if (activeIn[t].load(std::memory_order_relaxed) == i) continue;  // active here
       V3 tl = g.pos[g.tris[t][0]], th = tl;
       for (uint32_t v : g.tris[t])
         for (int k = 0; k < 3; ++k) tl[k] = std::min(tl[k], g.pos[v][k]), th[k] = std::max(th[k], g.pos[v][k]);
