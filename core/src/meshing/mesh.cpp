@@ -22,6 +22,7 @@
 #include "frep/evaluators/eval.h"
 #include "meshing/kuhn_tables.h"
 #include "meshing/mesh_extremum_roots.h"
+#include "meshing/radix_sort.h"
 #include "sampling/parallel_chunks.h"
 
 namespace frep {
@@ -238,7 +239,7 @@ class RegionMesher {
       keyTris.insert(keyTris.end(), o.tris.begin(), o.tris.end());
       quads.insert(quads.end(), o.quads.begin(), o.quads.end());
     }
-    std::sort(edges.begin(), edges.end());
+    radixSortByKey(edges, [](const CrossEdge& e) { return e.key; });  // equal keys are one edge's records
     edges.erase(std::unique(edges.begin(), edges.end(),
                             [](const CrossEdge& a, const CrossEdge& b) { return a.key == b.key; }),
                 edges.end());
@@ -259,7 +260,7 @@ class RegionMesher {
       auto e = edgeKeyParts(edges[i].key);
       order[i] = {edgeKey(e[0] & ~7, e[1] & ~7, e[2] & ~7, 0), uint32_t(i)};
     }
-    std::sort(order.begin(), order.end());
+    radixSortByKey(order, [](const std::pair<uint64_t, uint32_t>& o) { return o.first; });  // then by edge: stable
     std::vector<size_t> groupStart;
     for (size_t i = 0; i < order.size(); ++i)
       if (i == 0 || order[i].first != order[i - 1].first) groupStart.push_back(i);
