@@ -350,6 +350,7 @@ int main(int argc, char** argv) {
     applyAllocatorPolicy();  // the fake workers stand in for frep-worker processes: its allocator policy
     return runFakeWorkers(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), std::atoi(argv[5]));
   }
+  applyAllocatorPolicy();  // the master here stands in for frep sample's, which applies it too
   const bool masterOnly = argc >= 2 && std::string(argv[1]) == "--master-only";
   // --master-only --streaming: only the streamed runs (profiling the merge into a sink).
   const bool streamingOnly = masterOnly && argc == 3 && std::string(argv[2]) == "--streaming";

@@ -120,7 +120,7 @@ int runMesh(const MeshRequest& request) {
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);
   LoadedModel m = loadModel(request.model, true);
   // The master merges and simplifies the whole mesh: its blocks' vectors come and go by the
-  // thousand (frep sample keeps glibc's default: its merge hands memory back to stay flat).
+  // thousand (docs/farm.md, "The processes' allocator").
   farm::applyAllocatorPolicy();
   // A 1D or 2D object is meshed as frep sample samples it: the slab or prism it is in 3D
   // (constant along the missing axes), cut by the box.

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "allocator_tuning.h"
 #include "arg_parse.h"
 #include "brick.h"
 #include "frep/io/atomic_output.h"
@@ -59,6 +60,9 @@ int runSample(const SampleRequest& request) {
     options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
   checkJobSize(grid, options.brickVoxels);  // before the model is even read: refused at once
   LoadedModel m = loadModel(request.model, true);
+  // The master receives, journals, decodes and streams every brick: its buffers come and go by
+  // the brick (farm::applyAllocatorPolicy, docs/farm.md "The processes' allocator").
+  farm::applyAllocatorPolicy();
 
   io::AtomicOutput out("-O/--out", request.region.out);
   io::AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");

@@ -1,4 +1,5 @@
-// The allocator policy of the processes that compute bricks (frep-worker) and merge meshes (frep mesh).
+// The allocator policy of the processes that compute bricks (frep-worker) and of the masters
+// (frep mesh, frep sample).
 #pragma once
 
 #include <cstddef>
