@@ -56,8 +56,10 @@ int LocalWorkers::reap() {
     if (::waitpid(*it, &status, WNOHANG) == *it) {
       lastExit_ = WIFSIGNALED(status) ? "killed by signal " + std::to_string(WTERMSIG(status))
                                       : "exited with " + std::to_string(WEXITSTATUS(status));
-      if (WIFSIGNALED(status))
+      if (WIFSIGNALED(status) && !(terminating_ && WTERMSIG(status) == SIGTERM))
         spdlog::warn("local worker pid {} killed by signal {}", *it, WTERMSIG(status));
+      else if (WIFSIGNALED(status))
+        spdlog::debug("local worker pid {} ended by the SIGTERM it was sent", *it);
       else
         spdlog::debug("local worker pid {} exited with {}", *it, WEXITSTATUS(status));
       it = pids_.erase(it);
@@ -70,6 +72,7 @@ int LocalWorkers::reap() {
 }
 
 void LocalWorkers::terminateAll() {
+  terminating_ = true;
   for (pid_t p : pids_) ::kill(p, SIGTERM);
   auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
   while (!pids_.empty() && std::chrono::steady_clock::now() < deadline) {

@@ -14,7 +14,9 @@ class LocalWorkers {
   LocalWorkers(std::string executable, std::vector<std::string> args);
   ~LocalWorkers();  // terminates what still runs
   void spawn(int count);
-  // Reaps exited workers; returns how many exited since the last call.
+  // Reaps exited workers; returns how many exited since the last call. A worker killed by a
+  // signal is a warning, except by the SIGTERM terminateAll sent (e.g. one still starting when
+  // a small job ended: it has nothing to hand back).
   int reap();
   int running() const { return int(pids_.size()); }
   // How the last reaped worker ended ("killed by signal 6", "exited with 2"), for messages.
@@ -27,6 +29,7 @@ class LocalWorkers {
   std::vector<std::string> args_;
   std::vector<pid_t> pids_;
   std::string lastExit_ = "still running";
+  bool terminating_ = false;  // terminateAll sent SIGTERM
 };
 
 // Path of a program installed next to the running one (build/bin/frep -> build/bin/NAME).
