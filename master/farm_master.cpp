@@ -150,6 +150,15 @@ struct Peer {
   uint64_t finished = 0;        // bricks it computed that were merged
 };
 
+// The decode threads: as asked, or (0) every core but the two that the scheduling loop and
+// ZeroMQ's I/O thread keep busy, at least one (the loop's own). More only add TBB workers that
+// spin for work between batches on the cores the loop needs: on 2 cores, 125 against 148 us of
+// master CPU a streamed brick (docs/farm.md, "Throughput").
+int decodeThreadsFor(int requested) {
+  if (requested > 0) return requested;
+  return std::max(1, tbb::this_task_arena::max_concurrency() - 2);
+}
+
 class Master {
  public:
   Master(const JobSpec& job, const FarmOptions& opt)
@@ -158,8 +167,8 @@ class Master {
         jobId_(jobIdOf(job)),
         grid_(gridOf(job)),
         op_(operationOf(job)),
-        decoders_(opt.decodeThreads > 0 ? opt.decodeThreads : tbb::task_arena::automatic),
-        mergers_(opt.decodeThreads > 0 ? opt.decodeThreads : tbb::task_arena::automatic),
+        decoders_(decodeThreadsFor(opt.decodeThreads)),
+        mergers_(decodeThreadsFor(opt.decodeThreads)),
         streaming_(op_ == Operation::Sample && opt.sampleSink.leaves) {
     if (opt.brickVoxels < 8 || opt.brickVoxels % 8 != 0)
       throw std::invalid_argument("--brick must be a positive multiple of 8 voxels");

@@ -57,7 +57,7 @@ struct FarmOptions {
   std::string workerExecutable;  // local mode: path of frep-worker ("" = next to this program)
   int workerThreads = 1;         // local mode: threads per worker
   int threads = 0;               // in-process mode: threads per brick (0: all cores)
-  int decodeThreads = 0;         // farm: threads verifying and decoding results (0: all cores, 1: the loop's own)
+  int decodeThreads = 0;         // farm: threads verifying and decoding results (0: every core but two, at least 1; 1: the loop's own)
                                  // (streaming a sample: as many again merge its slabs, on their own thread)
   std::string logLevel = "warn"; // local mode: workers' --log-level
   SampleSink sampleSink;         // "sample": stream the merged output (see SampleSink)
