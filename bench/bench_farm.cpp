@@ -365,7 +365,7 @@ int main(int argc, char** argv) {
               "1024^3 in 64^3 bricks, %d leaves (150 kB) a brick, journal on; master CPU = the master's process\n"
               "(loop, decoders, ZeroMQ I/O thread), loop = its scheduling thread alone; \"all cores\" = the\n"
               "master's default decode threads (every core but two, at least one: %d here)\n",
-              leavesPerBrick, std::max(1, int(std::thread::hardware_concurrency()) - 2));
+              leavesPerBrick, defaultDecodeThreads());
   // Decoding on the scheduling loop alone (decodeThreads 1) against the default decode threads
   // (0: every core but two; the label keeps its name so that bench_farm_ab.sh compares with
   // older builds), building the output (result.leaves) or streaming it into a counting sink,

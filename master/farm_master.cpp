@@ -150,14 +150,7 @@ struct Peer {
   uint64_t finished = 0;        // bricks it computed that were merged
 };
 
-// The decode threads: as asked, or (0) every core but the two that the scheduling loop and
-// ZeroMQ's I/O thread keep busy, at least one (the loop's own). More only add TBB workers that
-// spin for work between batches on the cores the loop needs: on 2 cores, 125 against 148 us of
-// master CPU a streamed brick (docs/farm.md, "Throughput").
-int decodeThreadsFor(int requested) {
-  if (requested > 0) return requested;
-  return std::max(1, tbb::this_task_arena::max_concurrency() - 2);
-}
+int decodeThreadsFor(int requested) { return requested > 0 ? requested : defaultDecodeThreads(); }
 
 class Master {
  public:
@@ -1322,5 +1315,10 @@ uint64_t peakRssBytes() {
   if (getrusage(RUSAGE_SELF, &ru) != 0) return 0;
   return uint64_t(ru.ru_maxrss) * 1024;  // kilobytes on Linux
 }
+
+// More decode threads than this only add TBB workers that spin for work between batches on the
+// cores the loop needs: on 2 cores, 125 against 148 us of master CPU a streamed brick
+// (docs/farm.md, "Throughput").
+int defaultDecodeThreads() { return std::max(1, tbb::this_task_arena::max_concurrency() - 2); }
 
 }  // namespace frep::farm

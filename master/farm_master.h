@@ -38,6 +38,10 @@ struct SampleSink {
   std::function<void(const std::vector<LeafBlock>& slabLeaves)> leaves;
 };
 
+// The decode threads of FarmOptions::decodeThreads 0: every core but the two that the master's
+// scheduling loop and ZeroMQ's I/O thread keep busy, at least one (then the loop's own).
+int defaultDecodeThreads();
+
 struct FarmOptions {
   int workers = -1;              // local worker processes: -1 one per core, 0 compute in-process
   std::string listen;            // cluster mode: bind here (tcp://*:5555) and spawn nothing
@@ -57,7 +61,7 @@ struct FarmOptions {
   std::string workerExecutable;  // local mode: path of frep-worker ("" = next to this program)
   int workerThreads = 1;         // local mode: threads per worker
   int threads = 0;               // in-process mode: threads per brick (0: all cores)
-  int decodeThreads = 0;         // farm: threads verifying and decoding results (0: every core but two, at least 1; 1: the loop's own)
+  int decodeThreads = 0;         // farm: threads verifying and decoding results (0: defaultDecodeThreads(); 1: the loop's own)
                                  // (streaming a sample: as many again merge its slabs, on their own thread)
   std::string logLevel = "warn"; // local mode: workers' --log-level
   SampleSink sampleSink;         // "sample": stream the merged output (see SampleSink)

@@ -339,7 +339,6 @@ TEST(BatchGradient, EveryOpBitIdenticalToGradientEvaluator) {
   // across tapes (rebinding).
   BatchGradientEvaluator be;
   std::mt19937_64 rng(17);
-  int tapes = 0;
   for (uint64_t seed = 0; seed < 120; ++seed) {
     RandomExpr gen(seed, false);
     Expr e = gen.gen(1 + int(seed % 5));
@@ -348,9 +347,7 @@ TEST(BatchGradient, EveryOpBitIdenticalToGradientEvaluator) {
     auto tape = Tape::compile(e, nv);
     const size_t n = seed % 4 == 0 ? BatchGradientEvaluator::kBatch : 1 + rng() % BatchGradientEvaluator::kBatch;
     expectBatchMatchesScalar(tape, branchPoints(rng, nv, n), be);
-    ++tapes;
   }
-  EXPECT_EQ(tapes, 120);
 }
 
 TEST(BatchGradient, RegisterReuseAndPrunedTapes) {

@@ -343,8 +343,6 @@ void BatchGradientEvaluator::eval(const Tape& tape, size_t count) {
   }
   // Lanes past count are computed and ignored (whole vectors; the scratch follows the outputs).
   const size_t n = std::min(kBatch, (count + 7) & ~size_t(7));
-  scratch_.resize(3 * kBatch);
-  pick_.resize(kBatch);
   runGradientTape(tape.code().data(), tape.code().size(), val_.data(), der_.data(), nd, n, scratch_.data(),
                   scratch_.data() + kBatch, scratch_.data() + 2 * kBatch, pick_.data());
   const uint32_t r = tape.resultReg();

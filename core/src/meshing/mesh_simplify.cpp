@@ -207,15 +207,11 @@ Work workOf(Mesh&& mesh, int threads) {
       w.moved[v] = 0, w.locked[v] = 0, w.settled[v] = 0;
     }
   });
-  const std::vector<SimplifyCarry::Vertex>& carried = mesh.carry.vertices;  // distinct indices (mergePieces)
-  parallelChunks(carried.size(), kGrain, threads, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      const SimplifyCarry::Vertex& c = carried[i];
-      w.quad[c.index] = Quadric::unpacked(c.quadric);
-      w.moved[c.index] = c.moved;
-      w.settled[c.index] = c.settled;
-    }
-  });
+  for (const SimplifyCarry::Vertex& c : mesh.carry.vertices) {  // in order: a repeated index, the last wins
+    w.quad[c.index] = Quadric::unpacked(c.quadric);
+    w.moved[c.index] = c.moved;
+    w.settled[c.index] = c.settled;
+  }
   w.tris = std::move(mesh.triangles);
   w.level.resize(nt);
   w.made.resize(nt);

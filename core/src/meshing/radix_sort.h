@@ -19,8 +19,7 @@ void radixSortByKey(std::vector<T>& v, Key key) {
     std::stable_sort(v.begin(), v.end(), [&](const T& a, const T& b) { return key(a) < key(b); });
     return;
   }
-  std::vector<std::array<size_t, 256>> count(8);  // every byte's histogram, in one pass
-  for (auto& c : count) c.fill(0);
+  std::vector<std::array<size_t, 256>> count(8);  // every byte's histogram (zeroed), in one pass
   for (const T& x : v) {
     const uint64_t k = key(x);
     for (int b = 0; b < 8; ++b) ++count[size_t(b)][(k >> (8 * b)) & 255];

@@ -149,8 +149,9 @@ class BatchGradientEvaluator {
   void bind(const Tape& tape);
   std::vector<double> val_, der_;  // val_: numRegs * kBatch; der_: (numRegs * 3 + axis) * kBatch
   std::vector<double> out_ = std::vector<double>(4 * kBatch, 0.0);  // value, then 3 partials
-  std::vector<double> x_, g_, scratch_;
-  std::vector<char> pick_;
+  std::vector<double> x_, g_;
+  std::vector<double> scratch_ = std::vector<double>(3 * kBatch);  // runGradientTape's p, q, t
+  std::vector<char> pick_ = std::vector<char>(kBatch);
   uint64_t boundId_ = 0;
   uint32_t numUniformsBound_ = 0;
   GradientEvaluator scalar_;  // tapes with extremum or field nodes
