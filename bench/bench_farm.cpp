@@ -82,9 +82,7 @@ std::string fakePayload(const std::array<int32_t, 3>& lo, int leaves) {
   return encodeBrick(b);
 }
 
-// Fake workers replay results encoded before the job starts (payload and CRC per brick, sent
-// without a copy), so what is measured is the master, not the workers. They run in a child
-// process (this program with --fake-workers), so the master's CPU time is the parent's.
+// The results the fake workers replay, encoded before the job starts (payload and CRC per brick).
 struct Replay {
   int brickVoxels, perAxis, leaves;
   std::vector<std::string> payloads;  // by brick index (i * perAxis + j) * perAxis + k
@@ -97,42 +95,60 @@ struct Replay {
   }
 };
 
-void fakeWorker(const std::string& ep, const std::string& id, const Replay& replay) {
+// Fake workers replay the pre-encoded results (sent without a copy), so what is measured is the
+// master, not the workers. They run in a child process (this program with --fake-workers), so
+// the master's CPU time is the parent's. They stand in for workers on other machines, so they
+// cost this machine as little as they can: one thread and one ZeroMQ context (one I/O thread)
+// serve every fake's dealer socket, instead of a thread and an I/O thread each (~99 against
+// ~60 us of CPU a brick, taken from the 2 cores the master runs on).
+void fakeWorkers(const std::string& ep, int fakes, const Replay& replay) {
   zmq::context_t ctx(1);
-  zmq::socket_t s(ctx, zmq::socket_type::dealer);
-  s.set(zmq::sockopt::linger, 0);
-  s.connect(ep);
-  Envelope hello;
-  hello.mutable_hello()->set_worker_id(id);  // distinct ids: a shared id reads as one worker reconnecting
-  send(s, "", hello);
-  for (;;) {
-    zmq::pollitem_t item{static_cast<void*>(s), 0, ZMQ_POLLIN, 0};
-    zmq::poll(&item, 1, std::chrono::milliseconds(50));
-    Incoming in;
-    while (receive(s, false, in, nullptr)) {
-      if (in.envelope.body_case() == Envelope::kBye) return;
-      if (in.envelope.body_case() != Envelope::kTask) continue;
-      const Task& t = in.envelope.task();
-      uint32_t crc = 0;
-      const std::string& payload = replay.payload(t, crc);
-      Envelope r;
-      r.set_job_id(in.envelope.job_id());
-      r.set_proto_major(kProtoMajor);
-      r.set_proto_minor(kProtoMinor);
-      Result* res = r.mutable_result();
-      res->set_brick_id(t.brick_id());
-      res->set_attempt(t.attempt());
-      res->set_leaves(uint32_t(replay.leaves));
-      res->set_payload_crc32(crc);
-      std::string head = r.SerializeAsString();
-      s.send(zmq::buffer(head), zmq::send_flags::sndmore);
-      s.send(zmq::message_t(const_cast<char*>(payload.data()), payload.size(), nullptr), zmq::send_flags::none);
+  std::vector<zmq::socket_t> sockets;
+  for (int i = 0; i < fakes; ++i) {
+    zmq::socket_t& s = sockets.emplace_back(ctx, zmq::socket_type::dealer);
+    s.set(zmq::sockopt::linger, 0);
+    s.connect(ep);
+    Envelope hello;
+    hello.mutable_hello()->set_worker_id("fake-" + std::to_string(i));  // distinct: a shared id reads as one worker reconnecting
+    send(s, "", hello);
+  }
+  std::vector<zmq::pollitem_t> items;
+  for (auto& s : sockets) items.push_back({static_cast<void*>(s), 0, ZMQ_POLLIN, 0});
+  for (size_t open = sockets.size(); open > 0;) {
+    zmq::poll(items.data(), items.size(), std::chrono::milliseconds(50));
+    for (size_t w = 0; w < sockets.size(); ++w) {
+      if (!items[w].socket) continue;  // told bye
+      zmq::socket_t& s = sockets[w];
+      Incoming in;
+      while (items[w].socket && receive(s, false, in, nullptr)) {
+        if (in.envelope.body_case() == Envelope::kBye) {
+          items[w].socket = nullptr, items[w].fd = -1, --open;  // zmq::poll skips a null socket with fd -1
+          break;
+        }
+        if (in.envelope.body_case() != Envelope::kTask) continue;
+        const Task& t = in.envelope.task();
+        uint32_t crc = 0;
+        const std::string& payload = replay.payload(t, crc);
+        Envelope r;
+        r.set_job_id(in.envelope.job_id());
+        r.set_proto_major(kProtoMajor);
+        r.set_proto_minor(kProtoMinor);
+        Result* res = r.mutable_result();
+        res->set_brick_id(t.brick_id());
+        res->set_attempt(t.attempt());
+        res->set_leaves(uint32_t(replay.leaves));
+        res->set_payload_crc32(crc);
+        std::string head = r.SerializeAsString();
+        s.send(zmq::buffer(head), zmq::send_flags::sndmore);
+        s.send(zmq::message_t(const_cast<char*>(payload.data()), payload.size(), nullptr), zmq::send_flags::none);
+      }
     }
   }
 }
 
 // Child process: encodes every brick's result, says "ready", reads the master's endpoint from
-// stdin and serves it with `fakes` workers until each is told bye.
+// stdin, serves it with `fakes` workers until each is told bye and says "served" with the CPU
+// seconds that took it (the share of this machine the stand-ins for remote workers used).
 int runFakeWorkers(int fakes, int res, int brickVoxels, int leaves) {
   Replay replay{brickVoxels, (res + brickVoxels - 1) / brickVoxels, leaves, {}, {}};
   for (int i = 0; i < replay.perAxis; ++i)
@@ -147,16 +163,21 @@ int runFakeWorkers(int fakes, int res, int brickVoxels, int leaves) {
   if (!std::fgets(ep, sizeof ep, stdin)) return 1;
   std::string endpoint(ep);
   while (!endpoint.empty() && (endpoint.back() == '\n' || endpoint.back() == '\r')) endpoint.pop_back();
-  std::vector<std::thread> ws;
-  for (int i = 0; i < fakes; ++i) ws.emplace_back(fakeWorker, endpoint, "fake-" + std::to_string(i), std::cref(replay));
-  for (auto& w : ws) w.join();
+  struct rusage r0 {}, r1 {};
+  getrusage(RUSAGE_SELF, &r0);
+  fakeWorkers(endpoint, fakes, replay);
+  getrusage(RUSAGE_SELF, &r1);
+  auto secs = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+  std::printf("served %.6f\n", secs(r1.ru_utime) + secs(r1.ru_stime) - secs(r0.ru_utime) - secs(r0.ru_stime));
   return 0;
 }
 
-// The fake workers' child process: its stdin takes the endpoint, its stdout says "ready".
+// The fake workers' child process: its stdin takes the endpoint, its stdout says "ready", then
+// "served" and its CPU seconds.
 struct FakeFarm {
   pid_t pid = -1;
   FILE* toChild = nullptr;
+  FILE* fromChild = nullptr;
   FakeFarm(int fakes, int res, int brickVoxels, int leaves) {
     int in[2], out[2];
     if (pipe(in) != 0 || pipe(out) != 0) throw std::runtime_error("pipe");
@@ -175,17 +196,24 @@ struct FakeFarm {
     close(in[0]);
     close(out[1]);
     toChild = fdopen(in[1], "w");
-    FILE* fromChild = fdopen(out[0], "r");
+    fromChild = fdopen(out[0], "r");
     char line[64] = {};
     if (!std::fgets(line, sizeof line, fromChild)) throw std::runtime_error("fake workers did not start");
-    std::fclose(fromChild);
   }
   void connect(const std::string& endpoint) {
     std::fprintf(toChild, "%s\n", endpoint.c_str());
     std::fflush(toChild);
   }
+  // After the job (the fakes were told bye): the CPU seconds the child spent serving, or -1.
+  double servedCpuSeconds() {
+    char line[64] = {};
+    double cpu = -1;
+    if (std::fgets(line, sizeof line, fromChild) && std::sscanf(line, "served %lf", &cpu) == 1) return cpu;
+    return -1;
+  }
   ~FakeFarm() {
     if (toChild) std::fclose(toChild);
+    if (fromChild) std::fclose(fromChild);
     int status = 0;
     waitpid(pid, &status, 0);
   }
@@ -222,7 +250,7 @@ uint64_t peakRssSinceReset() {
 }
 
 struct MasterRun {
-  double wall = 0, loopCpu = 0, processCpu = 0, peakRssMb = 0;
+  double wall = 0, loopCpu = 0, processCpu = 0, peakRssMb = 0, fakesCpu = 0;
   uint64_t bricks = 0, leaves = 0;
 };
 
@@ -262,6 +290,7 @@ MasterRun masterRun(int fakes, int res, int brickVoxels, int leaves, int decodeT
     }
   });
   master.join();
+  m.fakesCpu = farm.servedCpuSeconds();
   std::remove(journal);
   return m;
 }
@@ -380,9 +409,9 @@ int main(int argc, char** argv) {
       rate[mode].push_back(double(m.bricks) / m.wall);
       cpuPerBrick[mode].push_back(m.processCpu / double(m.bricks));
       std::printf("  %d fake workers, %s: %llu bricks in %.2f s = %.0f bricks/s wall; master CPU %.0f us/brick, "
-                  "loop %.0f us/brick; process peak RSS %.0f MiB\n",
+                  "loop %.0f us/brick; process peak RSS %.0f MiB; fake workers' CPU %.0f us/brick\n",
                   fakes, label[mode], (unsigned long long)m.bricks, m.wall, rate[mode].back(),
-                  1e6 * m.processCpu / double(m.bricks), 1e6 * m.loopCpu / double(m.bricks), m.peakRssMb);
+                  1e6 * m.processCpu / double(m.bricks), 1e6 * m.loopCpu / double(m.bricks), m.peakRssMb, 1e6 * m.fakesCpu / double(m.bricks));
     }
   if (streamingOnly) return 0;
   auto median = [](std::vector<double> v) {

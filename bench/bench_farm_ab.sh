@@ -21,11 +21,13 @@ while [ "$i" -lt "$ROUNDS" ]; do
   done
   i=$((i + 1))
 done
-# Fields of a run line: "... = R bricks/s wall; master CPU C us/brick, loop L us/brick; process peak RSS M MiB"
+# Fields of a run line: "... = R bricks/s wall; master CPU C us/brick, loop L us/brick; process peak RSS M MiB[; fake workers' CPU F us/brick]"
 median() { sort -n | awk '{v[NR] = $1} END {print v[int((NR + 1) / 2)]}'; }
-stat() { sed -n "s/.*= \([0-9]*\) bricks\/s wall; master CPU \([0-9]*\) us\/brick.*peak RSS \([0-9]*\) MiB/\1 \2 \3/p" "$out/$1" | awk -v f="$2" '{print $f}' | median; }
+stat() { sed -n "s/.*= \([0-9]*\) bricks\/s wall; master CPU \([0-9]*\) us\/brick.*peak RSS \([0-9]*\) MiB.*/\1 \2 \3/p" "$out/$1" | awk -v f="$2" '{print $f}' | median; }
+# The fake workers' own CPU a brick (printed by builds since 2026-12-03; "-" for older ones).
+fakes() { sed -n "s/.*fake workers' CPU \([0-9]*\) us\/brick.*/\1/p" "$out/$1" | median; }
 for which in base new; do
-  echo "$which: median $(stat "$which" 1) bricks/s wall, $(stat "$which" 2) us master CPU per brick, peak RSS $(stat "$which" 3) MiB"
+  echo "$which: median $(stat "$which" 1) bricks/s wall, $(stat "$which" 2) us master CPU per brick, peak RSS $(stat "$which" 3) MiB, fake workers' CPU $(fakes "$which" | grep . || echo -) us per brick"
 done
 awk -v rb="$(stat base 1)" -v rn="$(stat new 1)" -v cb="$(stat base 2)" -v cn="$(stat new 2)" -v mb="$(stat base 3)" -v mn="$(stat new 3)" \
   'BEGIN {printf "new/base: %.2fx bricks/s wall, %.2fx bricks per CPU-second (%.0f -> %.0f), %.2fx peak RSS\n", rn / rb, cb / cn, 1e6 / cb, 1e6 / cn, mn / mb}'

@@ -17,6 +17,7 @@
 #include <optional>
 #include <set>
 #include <thread>
+#include <utility>
 #include <zmq.hpp>
 
 #include <string_view>
@@ -64,7 +65,7 @@ struct SignalScope {
 };
 
 constexpr size_t kMaxEnvelopeBytes = 1 << 20;  // a task or result header is a few KB at most
-constexpr int kCredit = 2;                     // bricks in flight per worker (hides latency)
+constexpr int kCredit = 4;                     // bricks in flight per worker (hides latency)
 // Hostile peers (docs/farm.md, "Threat model"): an un-welcomed routing id may send only a
 // hello, checked before parsing; garbage bans its routing id. The ban list and the welcomed
 // workers are bounded so strangers cannot grow the master's state without limit.
@@ -77,6 +78,44 @@ constexpr int kRouterRcvHwm = 64;       // queued messages per connection (ZMQ_R
 // ends at a message of another kind, at the end of a turn's drain, or at these bounds.
 constexpr size_t kMaxArrivals = 64;
 constexpr size_t kMaxArrivalBytes = 64 << 20;
+// A received message kept for the merge, counted against the master's budget while it lives.
+class HeldPayload {
+ public:
+  HeldPayload() = default;
+  // Takes `message` if the held bytes stay within `budget`; else leaves it.
+  static HeldPayload take(zmq::message_t& message, std::atomic<size_t>& held, size_t budget) {
+    HeldPayload h;
+    const size_t size = message.size();
+    if (held.fetch_add(size, std::memory_order_relaxed) + size > budget) {
+      held.fetch_sub(size, std::memory_order_relaxed);
+      return h;
+    }
+    h.message_ = std::move(message);
+    h.held_ = &held;
+    return h;
+  }
+  HeldPayload(HeldPayload&& o) noexcept { *this = std::move(o); }
+  HeldPayload& operator=(HeldPayload&& o) noexcept {
+    if (this != &o) {
+      release();
+      message_ = std::move(o.message_);
+      held_ = std::exchange(o.held_, nullptr);
+    }
+    return *this;
+  }
+  ~HeldPayload() { release(); }
+  bool held() const { return held_ != nullptr; }
+  std::string_view bytes() const { return {static_cast<const char*>(message_.data()), message_.size()}; }
+
+ private:
+  void release() {
+    if (held_) held_->fetch_sub(message_.size(), std::memory_order_relaxed);
+    held_ = nullptr;
+    message_ = zmq::message_t();
+  }
+  zmq::message_t message_;
+  std::atomic<size_t>* held_ = nullptr;
+};
 
 enum class Departure { Left, Dead, Dropped };
 
@@ -103,13 +142,16 @@ struct Brick {
 };
 
 // "sample": what the master keeps of a merged brick until its slab is merged: where its verified
-// FRB2 payload is (compact leaves take about half the bytes of decoded ones): in the journal,
-// which holds it anyway (page cache, not the master's memory), or without a journal in the
-// payload arena; its leaves' origins (where they go in the sorted output) and its tiles.
+// FRB2 payload is (compact leaves take about half the bytes of decoded ones): with a journal, the
+// message as received while the held bytes stay within FarmOptions::heldPayloadBytes (reading the
+// journal's copy back and checking its CRC again was 15-20% of the streamed master's CPU), else
+// the journal's copy (page cache, not the master's memory); without a journal, a copy in the
+// payload arena; and its leaves' origins (where they go in the sorted output) and its tiles.
 // Verifying a payload only scans it (scanBrick); its slab's merge decodes it once, straight into
 // the output (Master::decodeSlab: streaming, once the slab's bricks are all in; else in finish()).
 struct KeptBrick {
   PayloadArena::Piece payload;  // without a journal
+  HeldPayload received;         // with one, within the budget
   bool inJournal = false;       // with one: the payload's offset, size and CRC-32 there
   uint64_t journalAt = 0, size = 0;
   uint32_t crc = 0;
@@ -669,7 +711,8 @@ class Master {
         // Journaled before it is merged (judge); a copy that turns out to be a duplicate is
         // harmless there (a resume merges the first record of a brick).
         if (a.ok) journalAndKeep(a.brick, data, size, crc, a.kept);
-        a.payload = zmq::message_t();  // freed now: the next message's buffer reuses its memory
+        if (a.ok && a.kept.inJournal) a.kept.received = HeldPayload::take(a.payload, heldBytes_, opt_.heldPayloadBytes);
+        a.payload = zmq::message_t();  // not held: freed now, the next message's buffer reuses its memory
       });
     });
     for (Arrival& a : arrivals_) judge(router, a);
@@ -722,10 +765,8 @@ class Master {
   }
 
   // A verified payload: appended to the journal if there is one, and for "sample" kept until
-  // the merge: where the journal has it, or (no journal) a copy in the arena. Safe on the decode
-  // threads at once. (Keeping the received message itself until its slab's merge instead, while
-  // streaming, cost more than reading it back: 141-167 against 136-143 us of master CPU a brick
-  // in bench_farm, the held buffers cold and the heap growing and shrinking.)
+  // the merge: where the journal has it (the caller may hold the message as well, KeptBrick),
+  // or (no journal) a copy in the arena. Safe on the decode threads at once.
   void journalAndKeep(uint64_t brick, const void* data, size_t size, uint32_t crc, KeptBrick& kept) {
     if (journal_) {
       const uint64_t at = journal_->add(brick, data, size, crc);
@@ -1005,10 +1046,11 @@ class Master {
     }
   }
 
-  // A kept payload's bytes: in the arena, or read back from the journal into this thread's
-  // buffer and checked against the CRC-32 it was verified with (the file is the master's own,
-  // but what it merges must be exactly what it verified).
+  // A kept payload's bytes: as received, in the arena, or read back from the journal into this
+  // thread's buffer and checked against the CRC-32 it was verified with (the file is the
+  // master's own, but what it merges must be exactly what it verified).
   std::string_view keptPayload(const KeptBrick& k, size_t brick) {
+    if (k.received.held()) return k.received.bytes();
     if (!k.inJournal) return {k.payload.data(), k.payload.size()};
     std::string& buffer = readBuffers_.local();
     buffer.resize(k.size);
@@ -1211,6 +1253,7 @@ class Master {
   std::map<std::string, std::string> aliases_;  // old routing id -> new, of reconnected workers
   std::vector<BrickOutput> outputs_;  // "mesh", "render": the merged bricks' results, by brick
   PayloadArena arena_;                // "sample": the kept payloads (before kept_ and arrivals_, which hold pieces of it)
+  std::atomic<size_t> heldBytes_{0};  // "sample": bytes of received payloads kept (HeldPayload; before kept_ too)
   std::vector<KeptBrick> kept_;       // "sample": the merged bricks' payloads, by brick
   tbb::enumerable_thread_specific<std::string> readBuffers_;  // "sample": payloads read back from the journal
   std::vector<Arrival> arrivals_;  // results received, not yet verified (verifyArrivals)

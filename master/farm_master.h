@@ -55,6 +55,9 @@ struct FarmOptions {
   std::string curveDir;          // require CURVE keys (frep keygen)
   bool insecure = false;         // allow --listen on a non-loopback address without curveDir
   std::string journalPath;       // empty: no journal
+  // "sample" with a journal: bytes of received payloads kept in memory until their slab's merge
+  // (beyond it the merge reads the journal's copy back; 0: always read back).
+  size_t heldPayloadBytes = size_t(256) << 20;
   bool resume = false;
   bool progressJson = false;     // JSON progress events on stdout
   bool progressBar = false;      // progress bar on stderr

@@ -148,14 +148,36 @@ TEST(Farm, ResumeRecomputesOnlyUnjournaledBricks) {
   std::filesystem::remove(journal);
 }
 
-// The master keeps merged "sample" payloads in its journal and reads them back for the merge
-// (docs/farm.md, "Back-pressure"): a record changed in between is refused by the CRC-32 it was
-// verified with (an I/O error naming the journal and the brick), never merged.
+// With a journal, the master keeps merged "sample" payloads as received up to
+// FarmOptions::heldPayloadBytes and reads the others back from the journal for the merge: the
+// same bytes whether it holds all of them, some (a budget of a few payloads) or none.
+TEST(Farm, HeldOrReadBackPayloadsMergeToTheSameResult) {
+  JobSpec j = job(96);
+  FarmOutcome ref = runJob(j, fast(0));
+  const std::string journal =
+      std::filesystem::temp_directory_path() / ("frep-test-held-" + std::to_string(getpid()) + ".journal");
+  for (size_t budget : {size_t(256) << 20, size_t(100) << 10, size_t(0)}) {
+    FarmOptions o = fast(2);
+    o.journalPath = journal;
+    o.heldPayloadBytes = budget;
+    FarmOutcome got = runJob(j, o);
+    SCOPED_TRACE("held payload budget " + std::to_string(budget));
+    expectSame(ref.result, got.result);
+    EXPECT_TRUE(got.report.poisoned.empty());
+  }
+  std::filesystem::remove(journal);
+}
+
+// A payload the master reads back from its journal for the merge (docs/farm.md,
+// "Back-pressure"; all of them here, heldPayloadBytes 0) that changed after it was written is
+// refused by the CRC-32 it was verified with (an I/O error naming the journal and the brick),
+// never merged.
 TEST(Farm, AJournalRecordChangedBeforeTheMergeIsRefused) {
   const std::string journal =
       std::filesystem::temp_directory_path() / ("frep-test-changed-" + std::to_string(getpid()) + ".journal");
   FarmOptions o = fast(0);
   o.journalPath = journal;
+  o.heldPayloadBytes = 0;
   MasterThread m(job(96), o);  // 27 bricks, one slow worker: the job lasts seconds after its first record
   WorkerProcess w(m.endpoint(), {"FREP_TEST_SLOW_MS=200"});
   const std::uintmax_t firstPayload = 12 + 20;  // journal header, then the first record's

@@ -81,11 +81,13 @@ void expectStreamedAsMerged(const FarmOutcome& ref, const FarmOutcome& got, cons
   size_t largest = 0;
   for (size_t k = 0; k < s.slabSizes.size(); ++k) {
     EXPECT_GT(s.slabSizes[k], 0u);
-    for (size_t i = at; i < at + s.slabSizes[k]; ++i)
+    for (size_t i = at; i < at + s.slabSizes[k]; ++i) {
       ASSERT_EQ(slabOf(s.leaves[i].origin, brick), slabsWithLeaves[k]) << "slab " << k << ", leaf " << i;
+    }
     at += s.slabSizes[k];
-    if (k > 0 && s.slabSizes[k] <= largest)
+    if (k > 0 && s.slabSizes[k] <= largest) {
       EXPECT_EQ(s.buffers[k], s.buffers[k - 1]) << "slab " << k << " was handed over in another buffer";
+    }
     largest = std::max(largest, s.slabSizes[k]);
   }
   std::vector<int> slabsWithTiles;
