@@ -120,7 +120,7 @@ void fakeWorkers(const std::string& ep, int fakes, const Replay& replay) {
       if (!items[w].socket) continue;  // told bye
       zmq::socket_t& s = sockets[w];
       Incoming in;
-      while (items[w].socket && receive(s, false, in, nullptr)) {
+      while (receive(s, false, in, nullptr)) {
         if (in.envelope.body_case() == Envelope::kBye) {
           items[w].socket = nullptr, items[w].fd = -1, --open;  // zmq::poll skips a null socket with fd -1
           break;

@@ -1,12 +1,12 @@
 // The master against scripted hostile peers over loopback (docs/farm.md, "Threat model"):
 // only a brick's leaseholder can answer for it or be charged for it, strangers may send only a
 // small hello, and garbage drops the peer, never the brick.
-#include <algorithm>
-#include <set>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <set>
 #include <thread>
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
