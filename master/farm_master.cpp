@@ -21,7 +21,7 @@
 #include <zmq.hpp>
 
 #include <string_view>
-#include <tbb/enumerable_thread_specific.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -31,6 +31,7 @@
 #include "allocator_tuning.h"
 #include "journal.h"
 #include "leaf_order.h"
+#include "leaf_records.h"
 #include "local_workers.h"
 #include "payload_arena.h"
 #include "progress.h"
@@ -147,9 +148,10 @@ struct Brick {
 // message as received while the held bytes stay within FarmOptions::heldPayloadBytes (reading the
 // journal's copy back and checking its CRC again took ~12% of the streamed master's CPU), else
 // the journal's copy (page cache, not the master's memory); without a journal, a copy in the
-// payload arena; and its leaves' origins (where they go in the sorted output) and its tiles.
-// Verifying a payload only scans it (scanBrick); its slab's merge decodes it once, straight into
-// the output (Master::decodeSlab: streaming, once the slab's bricks are all in; else in finish()).
+// payload arena; and its leaves' origins (where they go in the sorted output) and records (where
+// each starts in the payload), and its tiles. Verifying a payload only scans it (scanBrick); its
+// slab's merge decodes each leaf once, in sorted order (Master::slabRecords: streaming, once the
+// slab's bricks are all in; else in finish()).
 struct KeptBrick {
   PayloadArena::Piece payload;  // without a journal
   HeldPayload received;         // with one, within the budget
@@ -157,17 +159,9 @@ struct KeptBrick {
   uint64_t journalAt = 0, size = 0;
   uint32_t crc = 0;
   std::vector<std::array<int32_t, 3>> origins;  // of its leaves, in payload order
+  std::vector<uint32_t> leafAt;                 // where each leaf's record starts in the payload
   std::vector<Tile> tiles;
 };
-
-// What is kept of a decoded brick: its leaves' origins and its tiles (the caller adds the payload).
-KeptBrick keptOf(const BrickOutput& decoded) {
-  KeptBrick k;
-  k.origins.reserve(decoded.leaves.size());
-  for (const LeafBlock& l : decoded.leaves) k.origins.push_back(l.origin);
-  k.tiles = decoded.tiles;
-  return k;
-}
 
 // A result from its brick's holder, waiting to be verified (CRC, codec, inside the brick) and
 // decoded off the scheduling loop (Master::verifyArrivals).
@@ -341,9 +335,11 @@ class Master {
       BrickOutput out = computeBrick(tape, job_, b.lo, b.hi, opt_.threads);
       report_.perWorker["in-process"].computeSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
       KeptBrick kept;
-      if (op_ == Operation::Sample) kept = keptOf(out);
       if (journal_ || op_ == Operation::Sample) {
         const std::string payload = encodePayload(op_, out);
+        std::string err;
+        if (op_ == Operation::Sample && !scanBrick(payload.data(), payload.size(), kept.origins, kept.tiles, kept.leafAt, &err))
+          throw std::logic_error("brick " + std::to_string(b.id) + ": its own payload does not scan: " + err);
         journalAndKeep(b.id, payload.data(), payload.size(), crc32Of(payload.data(), payload.size()), kept);
       }
       commit(b.id, std::move(out), "in-process", true, std::move(kept));
@@ -781,7 +777,7 @@ class Master {
   // to kept, its values left packed), the others are decoded into out.
   bool verifyPayload(const void* data, size_t size, const Brick& b, BrickOutput& out, KeptBrick& kept,
                      std::string* error) const {
-    if (op_ == Operation::Sample) return scanBrick(data, size, kept.origins, kept.tiles, error) && insideBrick(kept, b);
+    if (op_ == Operation::Sample) return scanBrick(data, size, kept.origins, kept.tiles, kept.leafAt, error) && insideBrick(kept, b);
     return decodePayload(op_, data, size, out, error) && insideBrick(out, b);
   }
 
@@ -1047,13 +1043,12 @@ class Master {
     }
   }
 
-  // A kept payload's bytes: as received, in the arena, or read back from the journal into this
-  // thread's buffer and checked against the CRC-32 it was verified with (the file is the
-  // master's own, but what it merges must be exactly what it verified).
-  std::string_view keptPayload(const KeptBrick& k, size_t brick) {
+  // A kept payload's bytes: as received, in the arena, or read back from the journal into
+  // `buffer` and checked against the CRC-32 it was verified with (the file is the master's own,
+  // but what it merges must be exactly what it verified).
+  std::string_view keptPayload(const KeptBrick& k, size_t brick, std::string& buffer) {
     if (k.received.held()) return k.received.bytes();
     if (!k.inJournal) return {k.payload.data(), k.payload.size()};
-    std::string& buffer = readBuffers_.local();
     buffer.resize(k.size);
     journal_->read(k.journalAt, buffer.data(), k.size);
     if (crc32Of(buffer.data(), buffer.size()) != k.crc)
@@ -1065,14 +1060,16 @@ class Master {
   // ---- the merge of a sample ----------------------------------------------------------------
   // The bricks' leaves sorted by origin (as sample() sorts them) and their tiles, one slab of
   // bricks at a time: the bricks are planned x-slab by x-slab and the sort is by x first, so a
-  // slab's leaves follow all the leaves of the slabs before it. Each brick's payload is decoded
-  // (in parallel) straight into its leaves' sorted places; the slab's payloads are then
-  // released, so the master holds the payloads or the output, not both.
+  // slab's leaves follow all the leaves of the slabs before it. A slab's leaf records are sorted
+  // (slabRecords) and decoded in that order, in parallel, into consecutive blocks: the output
+  // (mergeLeaves), or pieces that stay in the cache while the sink reads them (mergeSlabs). The
+  // slab's payloads are then released, so the master holds the payloads or the output, not both.
 
-  // Decodes the slab of bricks [first, last) into out[at, ...) (resized to fit) in `threads`,
-  // releases their payloads and appends their tiles to `tiles`. Returns the slab's leaves.
-  size_t decodeSlab(size_t first, size_t last, std::vector<LeafBlock>& out, size_t at, tbb::task_arena& threads,
-                    std::vector<Tile>& tiles) {
+  // The leaf records of the slab of bricks [first, last), sorted by origin, and its tiles
+  // (appended to `tiles`). Payloads read back from the journal are kept in readBack (one string
+  // a brick) while the records point into them. Runs on `threads`.
+  void slabRecords(size_t first, size_t last, tbb::task_arena& threads, std::vector<LeafRecord>& sorted,
+                   std::vector<std::string>& readBack, std::vector<Tile>& tiles) {
     std::vector<std::array<int32_t, 3>> origins;  // the slab's, brick by brick
     std::vector<size_t> start(1, 0), rank;         // rank[start[brick] + leaf]: the leaf's place in the slab
     for (size_t i = first; i < last; ++i) {
@@ -1080,22 +1077,27 @@ class Master {
       start.push_back(origins.size());
       tiles.insert(tiles.end(), kept_[i].tiles.begin(), kept_[i].tiles.end());
     }
-    out.resize(at + origins.size());  // not zeroed (LeafBlock): decoded into below
+    sorted.resize(origins.size());
+    readBack.resize(last - first);
     threads.execute([&] {
       rankByOrigin(origins, bricks_[first].lo, bricks_[last - 1].hi, rank);
       tbb::parallel_for(first, last, [&](size_t i) {
         const KeptBrick& k = kept_[i];
         if (k.origins.empty()) return;
+        const std::string_view bytes = keptPayload(k, i, readBack[i - first]);
         const size_t* to = rank.data() + start[i - first];
-        const std::string_view bytes = keptPayload(k, i);
-        std::string err;
-        if (!decodeBrickLeaves(bytes.data(), bytes.size(), k.origins.size(),
-                               [&](size_t l) { return &out[at + to[l]]; }, &err))
-          throw std::logic_error("brick " + std::to_string(i) + ": its verified payload no longer decodes: " + err);
+        for (size_t l = 0; l < k.leafAt.size(); ++l) {
+          const size_t end = l + 1 < k.leafAt.size() ? k.leafAt[l + 1] : bytes.size();
+          sorted[to[l]] = LeafRecord{bytes.data() + k.leafAt[l], uint32_t(end - k.leafAt[l])};
+        }
       });
     });
-    for (size_t i = first; i < last; ++i) kept_[i] = KeptBrick{};  // the arena unmaps emptied chunks
-    return origins.size();
+  }
+
+  // After a slab's records were decoded: its payloads go (the arena unmaps emptied chunks).
+  void releaseSlab(size_t first, size_t last, std::vector<std::string>& readBack) {
+    for (size_t i = first; i < last; ++i) kept_[i] = KeptBrick{};
+    readBack.clear();
   }
 
   // Streaming (FarmOptions::sampleSink): the loop hands the merge thread every slab whose bricks
@@ -1113,12 +1115,15 @@ class Master {
     mergeWake_.notify_one();
   }
 
-  // The merge thread: each slab handed over, in order, decoded into one buffer (refilled; it
-  // grows only for a slab larger than all before it) on its own threads, and given to the sink
-  // (its tiles sorted, then its leaves). Stops when told to, once the slabs handed over are done.
+  // The merge thread: each slab handed over, in order, given to the sink: its tiles sorted, then
+  // its leaves in pieces of kSinkPieceLeaves, decoded on its own threads (a piece each) into
+  // buffers that are refilled. Stops when told to, once the slabs handed over are done.
   void mergeSlabs() {
     const SampleSink& sink = opt_.sampleSink;
-    std::vector<LeafBlock> slab;
+    std::vector<std::vector<LeafBlock>> pieces(size_t(std::max(1, mergers_.max_concurrency())));
+    for (auto& p : pieces) p.reserve(kSinkPieceLeaves);
+    std::vector<LeafRecord> sorted;
+    std::vector<std::string> readBack;
     std::vector<Tile> tiles;
     try {
       for (size_t next = 0;; ++next) {
@@ -1128,21 +1133,24 @@ class Master {
           if (slabsReady_ <= next) return;  // stopped, nothing more handed over
         }
         const size_t first = next * perSlab_, last = std::min(bricks_.size(), first + perSlab_);
-        size_t leaves = 0;
-        for (size_t i = first; i < last; ++i) leaves += kept_[i].origins.size();
-        if (leaves > slab.capacity()) {
-          slab = std::vector<LeafBlock>();  // not copied over: refilled below
-          slab.reserve(leaves);
-          // Huge pages: faulting the slab in 4 KiB pages was 16% of the master's CPU (docs/farm.md).
-          adviseHugePages(slab.data(), leaves * sizeof(LeafBlock));
-        }
-        slab.clear();
         tiles.clear();
-        decodeSlab(first, last, slab, 0, mergers_, tiles);
+        slabRecords(first, last, mergers_, sorted, readBack, tiles);
         std::vector<LeafBlock> noLeaves;
         sortByOrigin(noLeaves, tiles);
         if (!tiles.empty() && sink.tiles) sink.tiles(tiles);
-        if (!slab.empty()) sink.leaves(slab);
+        const size_t n = sorted.size();
+        for (size_t round = 0; round < n; round += pieces.size() * kSinkPieceLeaves) {
+          const size_t count = std::min(pieces.size(), (n - round + kSinkPieceLeaves - 1) / kSinkPieceLeaves);
+          auto decodePiece = [&](size_t p) {
+            const size_t from = round + p * kSinkPieceLeaves, to = std::min(n, from + kSinkPieceLeaves);
+            pieces[p].resize(to - from);  // not zeroed (LeafBlock): decoded into
+            decodeLeafRecords(sorted.data() + from, to - from, pieces[p].data());
+          };
+          if (count == 1) decodePiece(0);
+          else mergers_.execute([&] { tbb::parallel_for(size_t(0), count, decodePiece); });
+          for (size_t p = 0; p < count; ++p) sink.leaves(pieces[p]);
+        }
+        releaseSlab(first, last, readBack);
         streamedTiles_.insert(streamedTiles_.end(), tiles.begin(), tiles.end());
         std::lock_guard<std::mutex> lock(mergeMutex_);
         slabsStreamed_ = next + 1;
@@ -1186,8 +1194,19 @@ class Master {
     for (size_t i = firstKept; i < kept_.size(); ++i) leaves += kept_[i].origins.size();
     result.leaves.reserve(leaves);  // filled slab by slab: pages are touched as payloads are freed
     std::vector<Tile> tiles;
-    for (size_t first = firstKept, at = 0; first < kept_.size(); first += perSlab_)
-      at += decodeSlab(first, std::min(kept_.size(), first + perSlab_), result.leaves, at, decoders_, tiles);
+    std::vector<LeafRecord> sorted;
+    std::vector<std::string> readBack;
+    for (size_t first = firstKept; first < kept_.size(); first += perSlab_) {
+      const size_t last = std::min(kept_.size(), first + perSlab_), at = result.leaves.size();
+      slabRecords(first, last, decoders_, sorted, readBack, tiles);
+      result.leaves.resize(at + sorted.size());  // not zeroed (LeafBlock): decoded into below
+      decoders_.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, sorted.size(), kSinkPieceLeaves), [&](const tbb::blocked_range<size_t>& r) {
+          decodeLeafRecords(sorted.data() + r.begin(), r.size(), result.leaves.data() + at + r.begin());
+        });
+      });
+      releaseSlab(first, last, readBack);
+    }
     std::vector<LeafBlock> noLeaves;
     sortByOrigin(noLeaves, tiles);
     result.tiles.insert(result.tiles.end(), tiles.begin(), tiles.end());  // after the streamed slabs' tiles
@@ -1256,7 +1275,6 @@ class Master {
   PayloadArena arena_;                // "sample": the kept payloads (before kept_ and arrivals_, which hold pieces of it)
   std::atomic<size_t> heldBytes_{0};  // "sample": bytes of received payloads kept (HeldPayload; before kept_ too)
   std::vector<KeptBrick> kept_;       // "sample": the merged bricks' payloads, by brick
-  tbb::enumerable_thread_specific<std::string> readBuffers_;  // "sample": payloads read back from the journal
   std::vector<Arrival> arrivals_;  // results received, not yet verified (verifyArrivals)
   size_t arrivalBytes_ = 0;
   tbb::task_arena decoders_;       // the decode threads (FarmOptions::decodeThreads)

@@ -24,19 +24,24 @@ namespace frep::farm {
 // (docs/farm.md, "Throughput"). Streaming is on when `leaves` is set. The bricks are planned in
 // x-slabs; as soon as every brick of the next slab is merged (not after the job's last brick),
 // the master's merge thread calls, for that slab, `tiles` with its tiles sorted (if it has any),
-// then `leaves` with its leaves sorted by origin (if it has any). The slabs follow one another
-// in the sort, so the calls in turn hand over result's tiles and leaves in result's order, and a
-// slab's tiles never cover an earlier slab's leaves. The calls come from the merge thread, one at
-// a time, all before runJob returns; an exception from either ends the job (runJob throws it).
-// A job that does not complete (a brick poisoned, or interrupted) hands over only the slabs
-// before the first one it did not complete: result.leaves holds the merged leaves of the others
-// (result.tiles always holds every tile, sorted). The slab is one buffer, refilled (it grows
-// only for a slab larger than all before it): read it during the call and keep nothing that
-// points into it.
+// then `leaves` with its leaves sorted by origin (if it has any), in pieces: kSinkPieceLeaves
+// leaves a call, the slab's last piece the rest. The slabs follow one another in the sort, so
+// the calls in turn hand over result's tiles and leaves in result's order, and a slab's tiles
+// never cover an earlier slab's leaves. The calls come from the merge thread, one at a time, all
+// before runJob returns; an exception from either ends the job (runJob throws it). A job that
+// does not complete (a brick poisoned, or interrupted) hands over only the slabs before the
+// first one it did not complete: result.leaves holds the merged leaves of the others
+// (result.tiles always holds every tile, sorted). A piece is one of a few buffers (one per merge
+// thread), refilled: read it during the call and keep nothing that points into it.
 struct SampleSink {
   std::function<void(const std::vector<Tile>& tiles)> tiles;  // optional
-  std::function<void(const std::vector<LeafBlock>& slabLeaves)> leaves;
+  std::function<void(const std::vector<LeafBlock>& leaves)> leaves;
 };
+
+// The leaves of a SampleSink::leaves call (but a slab's last): ~0.5 MB, decoded into a buffer
+// that stays in the core's cache while the sink reads it (a whole slab's buffer, ~70 MB for a
+// 1024^2 slab of surface bricks, went through memory twice: decoded into, then read).
+constexpr size_t kSinkPieceLeaves = 256;
 
 // The decode threads of FarmOptions::decodeThreads 0: every core but the two that the master's
 // scheduling loop and ZeroMQ's I/O thread keep busy, at least one (then the loop's own).

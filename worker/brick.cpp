@@ -342,9 +342,43 @@ std::string encodeBrick(const BrickOutput& out) {
 }
 
 namespace {
-// The one FRB2 parser behind decodeBrick, scanBrick and decodeBrickLeaves, so all three accept
-// exactly the same payloads. The sink sizes the output (begin), takes each tile, and says where
-// leaf i's values go (leaf: nullptr to check its bytes only, without expanding them).
+// One leaf record of an FRB2 payload, at r.p: its origin, mask and values into *l (nullptr: its
+// bytes are checked and skipped, not expanded). Returns why it is malformed, or nullptr.
+const char* readLeaf(Reader& r, LeafBlock* l, std::array<int32_t, 3>& origin) {
+  uint32_t flags = 0;
+  std::array<uint64_t, kLeafVoxels / 64> active{};
+  if (!r.get(origin[0]) || !r.get(origin[1]) || !r.get(origin[2]) || !r.get(flags) ||
+      !r.bytes(active.data(), sizeof active))
+    return "payload: truncated leaf";
+  if ((origin[0] | origin[1] | origin[2]) & 7) return "payload: leaf origin not a multiple of 8";
+  if (flags & ~kCompact) return "payload: unknown leaf flags";
+  if (l) l->origin = origin, l->active = active;
+  if (!(flags & kCompact)) {
+    constexpr size_t kValueBytes = kLeafVoxels * sizeof(float);
+    if (size_t(r.end - r.p) < kValueBytes) return "payload: truncated leaf values";
+    if (l) std::memcpy(l->values.data(), r.p, kValueBytes);
+    r.p += kValueBytes;
+    return nullptr;
+  }
+  std::array<uint64_t, kLeafVoxels / 64> positive{};
+  float magnitude = 0;
+  if (!r.bytes(positive.data(), sizeof positive) || !r.get(magnitude)) return "payload: truncated leaf";
+  const size_t activeCount = countVoxels(active.data());
+  if (size_t(r.end - r.p) < activeCount * sizeof(float)) return "payload: truncated leaf values";
+  if (!l) {
+    r.p += activeCount * sizeof(float);
+    return nullptr;
+  }
+  uint32_t m = 0;
+  std::memcpy(&m, &magnitude, sizeof m);
+  r.p = expandCompactLeaf(l->values.data(), active.data(), positive.data(), m, r.p);
+  return nullptr;
+}
+
+// The one FRB2 parser behind decodeBrick and scanBrick (and, leaf by leaf, decodeLeafAt), so
+// they accept exactly the same payloads. The sink sizes the output (begin), takes each tile,
+// and says where leaf i's values go (leaf: nullptr to check its bytes only, without expanding
+// them; it learns where the leaf's record starts).
 template <typename Sink>
 bool walkBrick(const void* data, size_t size, Sink& sink, std::string* error) {
   auto fail = [&](const char* why) {
@@ -359,7 +393,7 @@ bool walkBrick(const void* data, size_t size, Sink& sink, std::string* error) {
   r.get(nt);
   // Every leaf takes at least 92 bytes: reject absurd counts before allocating.
   if (uint64_t(nt) * 20 + uint64_t(nl) * 92 > size - 12) return fail("payload: counts exceed its size");
-  if (!sink.begin(nl, nt)) return fail("payload: not the expected number of leaves");
+  sink.begin(nl, nt);
   for (uint32_t i = 0; i < nt; ++i) {
     Tile t{};
     int32_t inside = 0;
@@ -370,35 +404,10 @@ bool walkBrick(const void* data, size_t size, Sink& sink, std::string* error) {
     sink.tile(i, t);
   }
   for (uint32_t i = 0; i < nl; ++i) {
+    const size_t at = size_t(r.p - static_cast<const char*>(data));
     std::array<int32_t, 3> origin{};
-    uint32_t flags = 0;
-    std::array<uint64_t, kLeafVoxels / 64> active{};
-    if (!r.get(origin[0]) || !r.get(origin[1]) || !r.get(origin[2]) || !r.get(flags) ||
-        !r.bytes(active.data(), sizeof active))
-      return fail("payload: truncated leaf");
-    if ((origin[0] | origin[1] | origin[2]) & 7) return fail("payload: leaf origin not a multiple of 8");
-    if (flags & ~kCompact) return fail("payload: unknown leaf flags");
-    LeafBlock* l = sink.leaf(i, origin);
-    if (l) l->origin = origin, l->active = active;
-    if (!(flags & kCompact)) {
-      constexpr size_t kValueBytes = kLeafVoxels * sizeof(float);
-      if (size_t(r.end - r.p) < kValueBytes) return fail("payload: truncated leaf values");
-      if (l) std::memcpy(l->values.data(), r.p, kValueBytes);
-      r.p += kValueBytes;
-      continue;
-    }
-    std::array<uint64_t, kLeafVoxels / 64> positive{};
-    float magnitude = 0;
-    if (!r.bytes(positive.data(), sizeof positive) || !r.get(magnitude)) return fail("payload: truncated leaf");
-    const size_t activeCount = countVoxels(active.data());
-    if (size_t(r.end - r.p) < activeCount * sizeof(float)) return fail("payload: truncated leaf values");
-    if (!l) {
-      r.p += activeCount * sizeof(float);
-      continue;
-    }
-    uint32_t m = 0;
-    std::memcpy(&m, &magnitude, sizeof m);
-    r.p = expandCompactLeaf(l->values.data(), active.data(), positive.data(), m, r.p);
+    if (const char* why = readLeaf(r, sink.leaf(i, at), origin)) return fail(why);
+    sink.origin(i, origin);
   }
   if (r.p != r.end) return fail("payload: trailing bytes");
   return true;
@@ -408,46 +417,46 @@ bool walkBrick(const void* data, size_t size, Sink& sink, std::string* error) {
 bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* error) {
   struct Sink {
     BrickOutput& out;
-    bool begin(uint32_t nl, uint32_t nt) {
+    void begin(uint32_t nl, uint32_t nt) {
       out.tiles.resize(nt);
       out.leaves.resize(nl);
-      return true;
     }
     void tile(uint32_t i, const Tile& t) { out.tiles[i] = t; }
-    LeafBlock* leaf(uint32_t i, const std::array<int32_t, 3>&) { return &out.leaves[i]; }
+    LeafBlock* leaf(uint32_t i, size_t) { return &out.leaves[i]; }
+    void origin(uint32_t, const std::array<int32_t, 3>&) {}
   } sink{out};
   return walkBrick(data, size, sink, error);
 }
 
 bool scanBrick(const void* data, size_t size, std::vector<std::array<int32_t, 3>>& origins, std::vector<Tile>& tiles,
-               std::string* error) {
+               std::vector<uint32_t>& leafAt, std::string* error) {
   struct Sink {
     std::vector<std::array<int32_t, 3>>& origins;
     std::vector<Tile>& tiles;
-    bool begin(uint32_t nl, uint32_t nt) {
+    std::vector<uint32_t>& leafAt;
+    void begin(uint32_t nl, uint32_t nt) {
       origins.resize(nl);
       tiles.resize(nt);
-      return true;
+      leafAt.resize(nl);
     }
     void tile(uint32_t i, const Tile& t) { tiles[i] = t; }
-    LeafBlock* leaf(uint32_t i, const std::array<int32_t, 3>& o) {
-      origins[i] = o;
+    LeafBlock* leaf(uint32_t i, size_t at) {
+      leafAt[i] = uint32_t(at);  // counts were checked against the size: a payload under 4 GiB
       return nullptr;
     }
-  } sink{origins, tiles};
+    void origin(uint32_t i, const std::array<int32_t, 3>& o) { origins[i] = o; }
+  } sink{origins, tiles, leafAt};
+  if (size > UINT32_MAX) {
+    if (error) *error = "payload: larger than 4 GiB";
+    return false;
+  }
   return walkBrick(data, size, sink, error);
 }
 
-bool decodeBrickLeaves(const void* data, size_t size, size_t leaves, const std::function<LeafBlock*(size_t)>& slot,
-                       std::string* error) {
-  struct Sink {
-    size_t leaves;
-    const std::function<LeafBlock*(size_t)>& slot;
-    bool begin(uint32_t nl, uint32_t) { return nl == leaves; }
-    void tile(uint32_t, const Tile&) {}
-    LeafBlock* leaf(uint32_t i, const std::array<int32_t, 3>&) { return slot(i); }
-  } sink{leaves, slot};
-  return walkBrick(data, size, sink, error);
+bool decodeLeafAt(const char* record, size_t bytes, LeafBlock& leaf) {
+  Reader r{record, record + bytes};
+  std::array<int32_t, 3> origin{};
+  return !readLeaf(r, &leaf, origin) && r.p == r.end;
 }
 
 // ---- mesh pieces ----------------------------------------------------------------------------

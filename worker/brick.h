@@ -4,7 +4,6 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -96,14 +95,16 @@ std::string encodeBrick(const BrickOutput& out);
 // Returns false (with a reason) on a malformed payload; never reads out of bounds.
 bool decodeBrick(const void* data, size_t size, BrickOutput& out, std::string* error);
 // The same checks as decodeBrick (the same parser), keeping only the leaves' origins (in payload
-// order) and the tiles: the master verifies a result without expanding its values.
+// order), where each leaf's record starts in the payload (leafAt, bytes from its start) and the
+// tiles: the master verifies a result without expanding its values. A payload of 4 GiB or more
+// (which the master never receives) is refused.
 bool scanBrick(const void* data, size_t size, std::vector<std::array<int32_t, 3>>& origins, std::vector<Tile>& tiles,
-               std::string* error);
-// Decodes a payload's leaves straight to where they go: leaf i to *slot(i) (its origin, mask and
-// values; tiles are skipped). Fails as decodeBrick does, and when the payload has not `leaves`
-// leaves (then before any slot is asked for).
-bool decodeBrickLeaves(const void* data, size_t size, size_t leaves, const std::function<LeafBlock*(size_t)>& slot,
-                       std::string* error);
+               std::vector<uint32_t>& leafAt, std::string* error);
+// Decodes one leaf record of a payload that scanBrick accepted: the `bytes` from a leafAt to the
+// next one (the last: to the payload's end) into `leaf` (its origin, mask and values), as
+// decodeBrick decodes that leaf. False, without reading past them, if the bytes are not exactly
+// one well-formed leaf record.
+bool decodeLeafAt(const char* record, size_t bytes, LeafBlock& leaf);
 
 // Mesh piece codec (little-endian, version in the magic): "FRM4", regionLo (3 x i32), the
 // piece's MeshStats (6 x u64: cells visited, crossed, root evals, gradient evals, sample point

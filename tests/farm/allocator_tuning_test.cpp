@@ -1,5 +1,4 @@
-// adviseHugePages (worker/allocator_tuning.h), the hint the allocator policy and the master's
-// streamed slab use.
+// adviseHugePages (worker/allocator_tuning.h), the hint the allocator policy gives the heap.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -24,7 +23,7 @@ TEST(AllocatorTuning, AdviseHugePagesKeepsAnyBufferIntact) {
   for (size_t i = 0; i < big.size(); ++i) ASSERT_EQ(big[i], uint32_t(i * 2654435761u));
   std::vector<uint32_t> fresh;
   fresh.reserve(big.size());
-  adviseHugePages(fresh.data(), big.size() * 4);  // before its first write, as the merge does
+  adviseHugePages(fresh.data(), big.size() * 4);  // before its first write
   fresh.assign(big.begin(), big.end());
   EXPECT_EQ(fresh, big);
 }

@@ -277,9 +277,10 @@ TEST(Protocol, PayloadCodecRejectsMalformedInput) {
   }
 }
 
-// scanBrick (the master's verification) and decodeBrickLeaves (its merge, into place) share
-// decodeBrick's parser: on every truncation and on random corruption of a payload with compact
-// and full leaves and tiles, all three accept the same inputs, and what they give agrees.
+// scanBrick (the master's verification) and decodeLeafAt (its merge, leaf by leaf in sorted
+// order) share decodeBrick's parser: on every truncation and on random corruption of a payload
+// with compact and full leaves and tiles, scanBrick accepts what decodeBrick accepts, and each
+// leaf record it finds decodes alone to decodeBrick's leaf.
 TEST(Protocol, ScanAndDecodeInPlaceAcceptExactlyWhatDecodeAccepts) {
   BrickOutput b;
   for (int k = 0; k < 3; ++k) {
@@ -299,34 +300,32 @@ TEST(Protocol, ScanAndDecodeInPlaceAcceptExactlyWhatDecodeAccepts) {
     BrickOutput full;
     std::vector<std::array<int32_t, 3>> origins;
     std::vector<Tile> tiles;
-    std::string e1, e2, e3;
+    std::vector<uint32_t> leafAt;
+    std::string e1, e2;
     const bool decoded = decodeBrick(m.data(), m.size(), full, &e1);
-    const bool scanned = scanBrick(m.data(), m.size(), origins, tiles, &e2);
-    std::vector<LeafBlock> placed(decoded ? full.leaves.size() : 3);
-    size_t asked = 0;
-    const bool inPlace = decodeBrickLeaves(
-        m.data(), m.size(), placed.size(), [&](size_t l) { return ++asked, &placed[placed.size() - 1 - l]; }, &e3);
+    const bool scanned = scanBrick(m.data(), m.size(), origins, tiles, leafAt, &e2);
     ASSERT_EQ(decoded, scanned) << e1 << " / " << e2;
     if (!decoded) {
       EXPECT_EQ(e1, e2);
-      EXPECT_FALSE(inPlace);
       return;
     }
-    ASSERT_TRUE(inPlace) << e3;
     ASSERT_EQ(origins.size(), full.leaves.size());
+    ASSERT_EQ(leafAt.size(), full.leaves.size());
     ASSERT_EQ(tiles.size(), full.tiles.size());
     for (size_t l = 0; l < origins.size(); ++l) {
       EXPECT_EQ(origins[l], full.leaves[l].origin);
-      EXPECT_EQ(placed[placed.size() - 1 - l].origin, full.leaves[l].origin);
-      EXPECT_EQ(placed[placed.size() - 1 - l].active, full.leaves[l].active);
-      EXPECT_EQ(std::memcmp(placed[placed.size() - 1 - l].values.data(), full.leaves[l].values.data(),
-                            sizeof full.leaves[l].values),
-                0);  // bit for bit (corruption makes NaNs)
+      // Each leaf's record, from its leafAt to the next (the last: to the end), decodes alone to
+      // the same leaf, bit for bit (corruption makes NaNs); a byte less or more is refused.
+      const size_t end = l + 1 < leafAt.size() ? leafAt[l + 1] : m.size();
+      ASSERT_LT(leafAt[l], end);
+      LeafBlock placed;
+      ASSERT_TRUE(decodeLeafAt(m.data() + leafAt[l], end - leafAt[l], placed)) << "leaf " << l;
+      EXPECT_EQ(placed.origin, full.leaves[l].origin);
+      EXPECT_EQ(placed.active, full.leaves[l].active);
+      EXPECT_EQ(std::memcmp(placed.values.data(), full.leaves[l].values.data(), sizeof full.leaves[l].values), 0);
+      EXPECT_FALSE(decodeLeafAt(m.data() + leafAt[l], end - leafAt[l] - 1, placed));
+      if (end < m.size()) EXPECT_FALSE(decodeLeafAt(m.data() + leafAt[l], end - leafAt[l] + 1, placed));
     }
-    // Another leaf count than the payload's is refused before any slot is asked for.
-    asked = 0;
-    EXPECT_FALSE(decodeBrickLeaves(m.data(), m.size(), placed.size() + 1, [&](size_t) { return ++asked, nullptr; }, &e3));
-    EXPECT_EQ(asked, 0u);
   };
   agree(s);
   BrickOutput back;
@@ -408,8 +407,15 @@ TEST(Protocol, DecodingWritesEveryByteOfALeafWhateverWasThereBefore) {
     std::vector<LeafBlock> leaves(b.leaves.size());
     std::memset(static_cast<void*>(leaves.data()), fill, leaves.size() * sizeof(LeafBlock));
     std::string err;
-    if (inPlace) {
-      EXPECT_TRUE(decodeBrickLeaves(s.data(), s.size(), leaves.size(), [&](size_t l) { return &leaves[l]; }, &err)) << err;
+    if (inPlace) {  // as the master's merge does: scanned, then leaf record by leaf record
+      std::vector<std::array<int32_t, 3>> origins;
+      std::vector<Tile> tiles;
+      std::vector<uint32_t> leafAt;
+      EXPECT_TRUE(scanBrick(s.data(), s.size(), origins, tiles, leafAt, &err)) << err;
+      for (size_t l = 0; l < leafAt.size(); ++l) {
+        const size_t end = l + 1 < leafAt.size() ? leafAt[l + 1] : s.size();
+        EXPECT_TRUE(decodeLeafAt(s.data() + leafAt[l], end - leafAt[l], leaves[l])) << "leaf " << l;
+      }
     } else {
       BrickOutput out;
       out.leaves = leaves;

@@ -1,12 +1,14 @@
 // FarmOptions::sampleSink: the merged sample streamed slab by slab (as each slab's bricks are all
 // merged) hands over exactly the tiles and leaves, in exactly the order, that FarmOutcome::result
-// holds without it, each slab's tiles before its leaves, in one reused buffer; whatever order
-// the bricks arrive in, and when the job does not complete or the sink fails.
+// holds without it, each slab's tiles before its leaves, its leaves in pieces of
+// kSinkPieceLeaves in a few reused buffers; whatever order the bricks arrive in, and when the job
+// does not complete or the sink fails.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cstdio>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <thread>
 #include <zmq.hpp>
@@ -17,13 +19,13 @@ using namespace farmtest;
 
 namespace {
 
-// What a sink saw: the tiles (and for each call, how many leaves had come before it), each
-// slab's leaves and where the buffer was.
+// What a sink saw: the tiles (and for each call, how many leaves had come before it), the leaves
+// (and each call's count and buffer).
 struct Streamed {
   std::vector<Tile> tiles;
   std::vector<size_t> tileCallSizes, leavesBeforeTileCall;
   std::vector<LeafBlock> leaves;
-  std::vector<size_t> slabSizes;
+  std::vector<size_t> callSizes;
   std::vector<const LeafBlock*> buffers;
   SampleSink sink() {
     SampleSink s;
@@ -32,13 +34,15 @@ struct Streamed {
       leavesBeforeTileCall.push_back(leaves.size());
       tiles.insert(tiles.end(), t.begin(), t.end());
     };
-    s.leaves = [this](const std::vector<LeafBlock>& slab) {
-      leaves.insert(leaves.end(), slab.begin(), slab.end());
-      slabSizes.push_back(slab.size());
-      buffers.push_back(slab.data());
+    s.leaves = [this](const std::vector<LeafBlock>& piece) {
+      leaves.insert(leaves.end(), piece.begin(), piece.end());
+      callSizes.push_back(piece.size());
+      buffers.push_back(piece.data());
     };
     return s;
   }
+  // The leaves handed over per x-slab (of `brick` voxels) that had any, in the order of the calls.
+  std::vector<size_t> slabSizes(int brick) const;
 };
 
 void expectSameLeaves(const std::vector<LeafBlock>& want, const std::vector<LeafBlock>& got) {
@@ -62,10 +66,18 @@ void expectSameTiles(const std::vector<Tile>& want, const std::vector<Tile>& got
 // The x-slab (of `brick` voxels) of a leaf or tile origin.
 int slabOf(const std::array<int32_t, 3>& origin, int brick) { return origin[0] / brick; }
 
+std::vector<size_t> Streamed::slabSizes(int brick) const {
+  std::vector<size_t> sizes;
+  for (size_t i = 0; i < leaves.size(); ++i)
+    if (i == 0 || slabOf(leaves[i].origin, brick) != slabOf(leaves[i - 1].origin, brick)) sizes.push_back(1);
+    else ++sizes.back();
+  return sizes;
+}
+
 // The stream against the result built without a sink: the same tiles and leaves in the same
-// order, result.leaves empty; one leaves call per x-slab of bricks that has leaves (each within
-// its slab), one tiles call per x-slab that has tiles, before any leaf of that slab or a later
-// one; a new buffer only for a slab larger than every one before it.
+// order, result.leaves empty; each leaves call within one x-slab of bricks, a slab's calls of
+// kSinkPieceLeaves leaves but its last (1 to kSinkPieceLeaves), in at most one buffer per core;
+// one tiles call per x-slab that has tiles, before any leaf of that slab or a later one.
 void expectStreamedAsMerged(const FarmOutcome& ref, const FarmOutcome& got, const Streamed& s, int brick) {
   EXPECT_TRUE(got.result.leaves.empty());
   expectSameTiles(ref.result.tiles, s.tiles);
@@ -73,23 +85,18 @@ void expectStreamedAsMerged(const FarmOutcome& ref, const FarmOutcome& got, cons
   expectSameLeaves(ref.result.leaves, s.leaves);
   EXPECT_EQ(got.report.leaves, ref.result.leaves.size());
   size_t at = 0;
-  std::vector<int> slabsWithLeaves;
-  for (const LeafBlock& l : ref.result.leaves)
-    if (slabsWithLeaves.empty() || slabsWithLeaves.back() != slabOf(l.origin, brick))
-      slabsWithLeaves.push_back(slabOf(l.origin, brick));
-  ASSERT_EQ(s.slabSizes.size(), slabsWithLeaves.size());
-  size_t largest = 0;
-  for (size_t k = 0; k < s.slabSizes.size(); ++k) {
-    EXPECT_GT(s.slabSizes[k], 0u);
-    for (size_t i = at; i < at + s.slabSizes[k]; ++i) {
-      ASSERT_EQ(slabOf(s.leaves[i].origin, brick), slabsWithLeaves[k]) << "slab " << k << ", leaf " << i;
-    }
-    at += s.slabSizes[k];
-    if (k > 0 && s.slabSizes[k] <= largest) {
-      EXPECT_EQ(s.buffers[k], s.buffers[k - 1]) << "slab " << k << " was handed over in another buffer";
-    }
-    largest = std::max(largest, s.slabSizes[k]);
+  for (size_t k = 0; k < s.callSizes.size(); ++k) {
+    ASSERT_GT(s.callSizes[k], 0u);
+    ASSERT_LE(s.callSizes[k], kSinkPieceLeaves);
+    const int slab = slabOf(s.leaves[at].origin, brick);
+    for (size_t i = at; i < at + s.callSizes[k]; ++i)
+      ASSERT_EQ(slabOf(s.leaves[i].origin, brick), slab) << "call " << k << ", leaf " << i;
+    at += s.callSizes[k];
+    const bool slabsLast = at == s.leaves.size() || slabOf(s.leaves[at].origin, brick) != slab;
+    if (!slabsLast) EXPECT_EQ(s.callSizes[k], kSinkPieceLeaves) << "call " << k << " is not its slab's last";
   }
+  std::set<const LeafBlock*> buffers(s.buffers.begin(), s.buffers.end());
+  EXPECT_LE(buffers.size(), std::max(1u, std::thread::hardware_concurrency()));
   std::vector<int> slabsWithTiles;
   for (const Tile& t : ref.result.tiles)
     if (slabsWithTiles.empty() || slabsWithTiles.back() != slabOf(t.origin, brick)) slabsWithTiles.push_back(slabOf(t.origin, brick));
@@ -126,7 +133,7 @@ TEST(SampleSink, StreamsTheLeavesAndTilesOfARealJobAsTheResultHoldsThem) {
       FarmOutcome got = runJob(j, o);
       std::remove(path.c_str());
       expectStreamedAsMerged(ref, got, s, 32);
-      EXPECT_EQ(s.slabSizes.size(), 3u);
+      EXPECT_EQ(s.slabSizes(32).size(), 3u);
     }
 }
 
@@ -262,8 +269,10 @@ TEST(SampleSink, StreamsScriptedPayloadsSlabBySlabWhateverTheirOrder) {
       FarmOutcome got = scriptedJob(path, s.sink(), outOfOrder);
       if (journal) std::remove(path.c_str());
       expectStreamedAsMerged(ref, got, s, 32);
-      ASSERT_EQ(s.slabSizes.size(), 3u);  // x-slab 1 is empty
-      EXPECT_LT(s.slabSizes[0], s.slabSizes[2]);
+      const std::vector<size_t> slabs = s.slabSizes(32);
+      ASSERT_EQ(slabs.size(), 3u);  // x-slab 1 is empty
+      EXPECT_LT(slabs[0], slabs[2]);
+      EXPECT_GT(slabs[2], kSinkPieceLeaves);  // streamed in more than one piece
     }
 }
 
@@ -304,7 +313,7 @@ TEST(SampleSink, AnIncompleteJobHandsOverTheSlabsBeforeItsFirstIncompleteOne) {
     EXPECT_EQ(s.leaves.size() + got.result.leaves.size(), got.report.leaves);
     if (std::string(crash) == "3") {
       EXPECT_TRUE(s.tileCallSizes.empty());
-      EXPECT_TRUE(s.slabSizes.empty());
+      EXPECT_TRUE(s.callSizes.empty());
       expectSameLeaves(leavesOf(ref.result.leaves, 0, 3, p.lo, p.hi), got.result.leaves);
     } else {
       ASSERT_EQ(p.lo, (std::array<int32_t, 3>{64, 32, 0}));
@@ -324,9 +333,11 @@ TEST(SampleSink, AFailingSinkEndsTheJobAndAResumeStreamsTheSame) {
   std::remove(path.c_str());
   FarmOptions o = fast(0);
   o.journalPath = path;
-  int calls = 0;
-  o.sampleSink.leaves = [&](const std::vector<LeafBlock>&) {
-    if (++calls == 2) throw std::runtime_error("the consumer failed");
+  int secondSlabCalls = 0;
+  o.sampleSink.leaves = [&](const std::vector<LeafBlock>& piece) {
+    if (slabOf(piece.front().origin, 32) != 1) return;
+    ++secondSlabCalls;
+    throw std::runtime_error("the consumer failed");  // at the second slab's first piece
   };
   try {
     runJob(j, o);
@@ -334,7 +345,7 @@ TEST(SampleSink, AFailingSinkEndsTheJobAndAResumeStreamsTheSame) {
   } catch (const std::runtime_error& e) {
     EXPECT_STREQ(e.what(), "the consumer failed");
   }
-  EXPECT_EQ(calls, 2);
+  EXPECT_EQ(secondSlabCalls, 1);
   o.resume = true;
   Streamed s;
   o.sampleSink = s.sink();

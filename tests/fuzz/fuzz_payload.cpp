@@ -3,8 +3,9 @@
 // (decodeMeshPiece, then the master's merge of it), 2 an Envelope frame (wire.cpp's parse) and,
 // when it holds a welcome, the job a worker would compute (fuzz_target.h). Oracles: a payload
 // that decodes re-encodes to bytes that decode and re-encode to the same bytes (the codec has
-// one meaning per payload), scanBrick and decodeBrickLeaves accept exactly what decodeBrick
-// accepts and give the same origins, tiles and leaves, and nothing crashes or reads out of bounds.
+// one meaning per payload), scanBrick accepts exactly what decodeBrick accepts and gives the same
+// origins and tiles, decodeLeafAt decodes each leaf record it finds to the same leaf, and nothing
+// crashes or reads out of bounds.
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -20,32 +21,33 @@ namespace {
 void sampleBrick(const uint8_t* data, size_t size) {
   farm::BrickOutput out;
   std::string err;
-  // The master's two other readers of the format accept exactly what decodeBrick accepts:
-  // scanBrick (verification: origins and tiles) and decodeBrickLeaves (the merge, into place).
+  // The master's two other readers of the format: scanBrick (verification: origins, tiles and
+  // where each leaf's record starts) accepts exactly what decodeBrick accepts, and decodeLeafAt
+  // (the merge, leaf by leaf) decodes each record alone to decodeBrick's leaf.
   std::vector<std::array<int32_t, 3>> origins;
   std::vector<Tile> tiles;
+  std::vector<uint32_t> leafAt;
   std::string scanErr;
-  const bool scanned = farm::scanBrick(data, size, origins, tiles, &scanErr);
+  const bool scanned = farm::scanBrick(data, size, origins, tiles, leafAt, &scanErr);
   if (!farm::decodeBrick(data, size, out, &err)) {
     FREP_FUZZ_CHECK(!err.empty());
     FREP_FUZZ_CHECK(!scanned && scanErr == err);
     return;
   }
-  FREP_FUZZ_CHECK(scanned && origins.size() == out.leaves.size() && tiles.size() == out.tiles.size());
-  std::vector<LeafBlock> placed(out.leaves.size());
-  FREP_FUZZ_CHECK(farm::decodeBrickLeaves(
-      data, size, placed.size(), [&](size_t l) { return &placed[placed.size() - 1 - l]; }, &err));
+  FREP_FUZZ_CHECK(scanned && origins.size() == out.leaves.size() && leafAt.size() == out.leaves.size() &&
+                  tiles.size() == out.tiles.size());
   for (size_t l = 0; l < out.leaves.size(); ++l) {
     const LeafBlock& a = out.leaves[l];
-    const LeafBlock& b = placed[placed.size() - 1 - l];
+    const size_t end = l + 1 < leafAt.size() ? leafAt[l + 1] : size;
+    FREP_FUZZ_CHECK(leafAt[l] < end && end <= size);
+    LeafBlock b;
+    FREP_FUZZ_CHECK(farm::decodeLeafAt(reinterpret_cast<const char*>(data) + leafAt[l], end - leafAt[l], b));
     FREP_FUZZ_CHECK(a.origin == origins[l] && b.origin == a.origin && b.active == a.active &&
                     std::memcmp(a.values.data(), b.values.data(), sizeof a.values) == 0);
   }
   for (size_t t = 0; t < tiles.size(); ++t)
     FREP_FUZZ_CHECK(tiles[t].origin == out.tiles[t].origin && tiles[t].size == out.tiles[t].size &&
                     tiles[t].inside == out.tiles[t].inside);
-  FREP_FUZZ_CHECK(!farm::decodeBrickLeaves(data, size, placed.size() + 1, [&](size_t) -> LeafBlock* { return nullptr; },
-                                           &err));
   const std::string once = farm::encodeBrick(out);
   farm::BrickOutput again;
   FREP_FUZZ_CHECK(farm::decodeBrick(once.data(), once.size(), again, &err));
