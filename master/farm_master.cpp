@@ -1133,37 +1133,43 @@ class Master {
 
   // The merge thread: each slab handed over, in order, given to the sink: its tiles sorted, then
   // its leaves in pieces of kSinkPieceLeaves, decoded on its own threads (a piece each) into
-  // buffers that are refilled. Stops when told to, once the slabs handed over are done.
+  // buffers that are refilled; on every core once the loop is done (told to stop: the slabs
+  // left are all there is to do). Stops when told to, once the slabs handed over are done.
   void mergeSlabs() {
     const SampleSink& sink = opt_.sampleSink;
-    std::vector<std::vector<LeafBlock>> pieces(size_t(std::max(1, mergers_.max_concurrency())));
+    std::vector<std::vector<LeafBlock>> pieces(
+        size_t(std::max({1, mergers_.max_concurrency(), allCores_.max_concurrency()})));
     for (auto& p : pieces) p.reserve(kSinkPieceLeaves);
     std::vector<LeafRecord> sorted;
     std::vector<std::string> readBack;
     std::vector<Tile> tiles;
     try {
       for (size_t next = 0;; ++next) {
+        bool alone = false;
         {
           std::unique_lock<std::mutex> lock(mergeMutex_);
           mergeWake_.wait(lock, [&] { return slabsReady_ > next || mergeStop_; });
           if (slabsReady_ <= next) return;  // stopped, nothing more handed over
+          alone = mergeStop_;
         }
+        tbb::task_arena& threads = alone ? allCores_ : mergers_;
+        const size_t inParallel = size_t(std::max(1, threads.max_concurrency()));
         const size_t first = next * perSlab_, last = std::min(bricks_.size(), first + perSlab_);
         tiles.clear();
-        slabRecords(first, last, mergers_, sorted, readBack, tiles);
+        slabRecords(first, last, threads, sorted, readBack, tiles);
         std::vector<LeafBlock> noLeaves;
         sortByOrigin(noLeaves, tiles);
         if (!tiles.empty() && sink.tiles) sink.tiles(tiles);
         const size_t n = sorted.size();
-        for (size_t round = 0; round < n; round += pieces.size() * kSinkPieceLeaves) {
-          const size_t count = std::min(pieces.size(), (n - round + kSinkPieceLeaves - 1) / kSinkPieceLeaves);
+        for (size_t round = 0; round < n; round += inParallel * kSinkPieceLeaves) {
+          const size_t count = std::min(inParallel, (n - round + kSinkPieceLeaves - 1) / kSinkPieceLeaves);
           auto decodePiece = [&](size_t p) {
             const size_t from = round + p * kSinkPieceLeaves, to = std::min(n, from + kSinkPieceLeaves);
             pieces[p].resize(to - from);  // not zeroed (LeafBlock): decoded into
             decodeLeafRecords(sorted.data() + from, to - from, pieces[p].data());
           };
           if (count == 1) decodePiece(0);
-          else mergers_.execute([&] { tbb::parallel_for(size_t(0), count, decodePiece); });
+          else threads.execute([&] { tbb::parallel_for(size_t(0), count, decodePiece); });
           for (size_t p = 0; p < count; ++p) sink.leaves(pieces[p]);
         }
         releaseSlab(first, last, readBack);
@@ -1295,6 +1301,7 @@ class Master {
   size_t arrivalBytes_ = 0;
   tbb::task_arena decoders_;       // the decode threads (FarmOptions::decodeThreads)
   tbb::task_arena mergers_;        // streaming: the merge thread's decoders (as many)
+  tbb::task_arena allCores_;       // streaming: the merge thread's, once the loop is done
   // Streaming (mergeSlabs): slabs of perSlab_ bricks, the bricks of each not merged yet, the
   // slabs handed to the merge thread (loop's count, and under mergeMutex_ the merge thread's),
   // the slabs it gave the sink and their tiles (read after it ends).
