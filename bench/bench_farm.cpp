@@ -6,7 +6,8 @@
 //     merged per second, the master's CPU per brick), decoding on the scheduling loop alone
 //     against decoding on all cores, and streaming the merge into a sink that only counts the
 //     leaves (FarmOptions::sampleSink: what a consumer that writes as it goes costs the master),
-//     and from it how many real workers one master keeps busy at the brick time measured in 1.
+//     and from it how many real workers one master keeps busy at the brick time measured in 1;
+//     the streamed runs once more with 64 fake workers (256 bricks in flight).
 // `bench_farm --master-only` runs 2 and 3 (`--master-only --streaming`: only the streamed runs).
 #include <algorithm>
 #include <chrono>

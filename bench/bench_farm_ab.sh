@@ -3,7 +3,8 @@
 # bench_farm --master-only of BASE and of NEW (their bin/ directories), ROUNDS times each in
 # turn (default 3), then the medians of the "decoding on all cores" runs (bricks/s wall, master
 # CPU per brick, peak RSS) and NEW/BASE ratios. NEW_LINE (default the same) names the runs of
-# NEW to compare, e.g. "streaming into a sink" (the merge streamed to a consumer, not built).
+# NEW to compare, e.g. "streaming into a sink" (the merge streamed to a consumer, not built;
+# "streaming into a sink, 256 in flight": the same with 64 fake workers).
 # The fake workers share the machine, so wall rates follow the load; master CPU per brick is
 # the steadier figure. BASE_LINE (default "decoding on all cores") names the runs of BASE, e.g.
 # "streaming into a sink" to compare the streamed runs of both.

@@ -1221,7 +1221,7 @@ class Master {
     for (size_t first = firstKept; first < kept_.size(); first += perSlab_) {
       const size_t last = std::min(kept_.size(), first + perSlab_), at = result.leaves.size();
       slabRecords(first, last, decoders_, sorted, readBack, tiles);
-      result.leaves.resize(at + sorted.size());  // not zeroed (LeafBlock): decoded into below
+      result.leaves.resize(at + sorted.size());  // not zeroed (LeafBlock): decoded into below, in ranges of a sink's piece
       decoders_.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, sorted.size(), kSinkPieceLeaves), [&](const tbb::blocked_range<size_t>& r) {
           decodeLeafRecords(sorted.data() + r.begin(), r.size(), result.leaves.data() + at + r.begin());

@@ -441,7 +441,7 @@ bool scanBrick(const void* data, size_t size, std::vector<std::array<int32_t, 3>
     }
     void tile(uint32_t i, const Tile& t) { tiles[i] = t; }
     LeafBlock* leaf(uint32_t i, size_t at) {
-      leafAt[i] = uint32_t(at);  // counts were checked against the size: a payload under 4 GiB
+      leafAt[i] = uint32_t(at);  // fits: scanBrick refuses payloads of 4 GiB or more
       return nullptr;
     }
     void origin(uint32_t i, const std::array<int32_t, 3>& o) { origins[i] = o; }
