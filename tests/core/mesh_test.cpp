@@ -372,6 +372,34 @@ TEST(Mesh, ExtremumVerticesLieOnTheSurface) {
   EXPECT_NEAR(mc::enclosedVolume(a.positions, a.triangles), vol, 0.01 * vol);
 }
 
+TEST(Mesh, ExtremumModelsAreClosedAcrossLeafBoundaries) {
+  // Issue 29: with the extremum path's band of 0, two 8^3 tiles of opposite signs could meet
+  // with the surface between their last and first points; neither was a leaf, so the cells
+  // between them were never visited and the mesh had holes on leaf boundaries. A 4D ball
+  // projected to 3D (the unit ball, eq. 4.2) and a ball swept along a segment (a capsule), at
+  // grids where the holes appeared: closed, one sphere each, volumes near the formulas.
+  const Expr ball4 = 1.0 - square(X()) - square(Y()) - square(Z()) - square(Expr::x(3));
+  const Expr projected = project(ball4, 4, {3}, Bounds{{-1.0}, {1.0}});
+  const Expr ball = 0.5 - sqrt(square(X()) + square(Y()) + square(Z()));
+  Motion line;
+  line.translation = {-1.0 + 2.0 * X(), Expr::constant(0.0), Expr::constant(0.0)};
+  const Expr capsule = sweep(ball, 3, line, 0.0, 1.0);
+  struct Case {
+    const char* name;
+    Expr model;
+    GridSpec grid;
+    double volume;
+  } cases[] = {{"projected 4D ball", projected, cubeGrid(1.2, 64), 4.0 / 3.0 * kPi},
+               {"swept ball", capsule, cubeGrid(1.6, 72), kPi * 0.25 * 2.0 + 4.0 / 3.0 * kPi * 0.125}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    Mesh m = meshGrid(Tape::compile(c.model, 3), c.grid, {}, 32);
+    EXPECT_EQ(mc::checkEdgePairs(m.triangles, m.positions.size()), "");
+    EXPECT_EQ(mc::eulerCharacteristic(m.triangles, m.positions.size()), 2);
+    EXPECT_NEAR(mc::enclosedVolume(m.positions, m.triangles), c.volume, 0.005 * c.volume);
+  }
+}
+
 TEST(Mesh, ExtremumNonConvexSumIsSplitInvariant) {
   // Issue 17's L-shaped slab (+) ball (frMinkowski's form: max over the ball's box of
   // min(A(X - u), B(u))), whose field is kinked at the surface: the same mesh for one region,

@@ -198,6 +198,7 @@ class RegionMesher {
     so.bandVoxels = extremumPath ? 0 : 1;
     so.pointwiseSearches = extremumPath;  // signs that do not depend on the region
     so.extremumSignsOnly = extremumPath;  // ... and only signs: searches stop once theirs is known
+    so.tilesCoverCells = true;            // every crossed cell starts in a leaf, whatever the band
     so.fixedCoords = opt_.fixedCoords;
     so.threads = opt_.threads;
     for (int a = 0; a < 3; ++a) {

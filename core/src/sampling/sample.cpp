@@ -113,14 +113,19 @@ class Sampler {
  private:
   static constexpr int64_t kWorkSide = 32;
 
-  // Interval of f over the grid points of box b (inclusive indices), dilated by the band.
-  Interval evalBox(Worker& w, const Box3& b, const Tape& tape) {
+  // Interval of f over the grid points of box b (inclusive indices), dilated by the band. A
+  // cube of a leaf or more (`cells`) also covers the far corners of its cells where the band
+  // does not: with SampleOptions::tilesCoverCells a tile's sign then holds on every corner of
+  // its cells, so a cell whose corners change sign always starts in a leaf (the mesher visits
+  // the cells of leaves only; without this, two tiles of opposite signs left a hole between).
+  Interval evalBox(Worker& w, const Box3& b, const Tape& tape, bool cells = true) {
     const int64_t d = opt_.bandVoxels;
+    const int64_t dHi = cells && opt_.tilesCoverCells ? std::max<int64_t>(d, 1) : d;
     w.box.resize(std::max<size_t>(nvars_, 1));
     for (uint32_t v = 0; v < nvars_; ++v) {
       if (v < 3) {
         double l = grid_.origin[v] + double(b[v] - d) * grid_.voxel;
-        double h = grid_.origin[v] + double(b[v + 3] + d) * grid_.voxel;
+        double h = grid_.origin[v] + double(b[v + 3] + dHi) * grid_.voxel;
         w.box[v] = Interval(l, h);
       } else {
         w.box[v] = Interval(opt_.fixedCoords[v - 3]);
@@ -219,7 +224,7 @@ class Sampler {
       int qx = ((q >> 2) & 1) * 4, qy = ((q >> 1) & 1) * 4, qz = (q & 1) * 4;
       Box3 qb;
       if (!clip({o[0] + qx, o[1] + qy, o[2] + qz}, 4, qb)) continue;
-      int qc = sideClass(evalBox(w, qb, *leafTape));
+      int qc = sideClass(evalBox(w, qb, *leafTape, false));  // point signs only
       if (qc != 0) {
         fillSign(qx, qy, qz, 4, int8_t(qc));
         continue;
@@ -228,7 +233,7 @@ class Sampler {
         int ex = qx + ((e >> 2) & 1) * 2, ey = qy + ((e >> 1) & 1) * 2, ez = qz + (e & 1) * 2;
         Box3 eb;
         if (!clip({o[0] + ex, o[1] + ey, o[2] + ez}, 2, eb)) continue;
-        int ec = sideClass(evalBox(w, eb, *leafTape));
+        int ec = sideClass(evalBox(w, eb, *leafTape, false));
         if (ec != 0) {
           fillSign(ex, ey, ez, 2, int8_t(ec));
           continue;

@@ -68,6 +68,10 @@ struct SampleOptions {
   // With pointwiseSearches: a model whose result is an extremum node stores values of which
   // only the sign is the cold search's (ExtremumSolver::solveSign): for readers of signs only.
   bool extremumSignsOnly = false;
+  // Every cube of 8^3 or more is classified over its points and the next point on each high
+  // side, so a tile's sign holds on all corners of its cells (what a mesher reading the cells of
+  // leaves only needs; a band of 1 or more covers them anyway).
+  bool tilesCoverCells = false;
   // Index-space region to sample, [lo, hi) per axis; lo must be a multiple of 8. Default: all.
   std::array<int32_t, 3> regionLo{0, 0, 0};
   std::array<int32_t, 3> regionHi{-1, -1, -1};
