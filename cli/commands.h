@@ -83,6 +83,7 @@ struct MeshRequest {
   int threads = 0;         // threads of the in-process run (--workers 0); 0: all cores
   double tolerance = -1;   // --tolerance, voxels (SimplifyOptions); < 0: the default (0.1, 0 for a .vdb)
   bool noSharp = false;    // --no-sharp: SimplifyOptions::sharpFeatures = false
+  bool openRim = false;    // --open-rim: no caps where the box cuts the solid (an open mesh there)
   std::string logLevel = "info";
   std::string format;      // --format: the format of -O whatever its extension ("" = from it)
   std::string up;          // --up z|y: the file's up axis ("" = the format's: y for .glb, else z)

@@ -184,6 +184,9 @@ int main(int argc, char** argv) {
                       "(default 0.1; 0 keeps every triangle of the marching tetrahedra)");
   meshCmd->add_flag("--no-sharp", mesh.noSharp,
                     "Keep merged vertices on the mesher's vertices instead of the model's edges and corners");
+  meshCmd->add_flag("--open-rim", mesh.openRim,
+                    "Where the box cuts the solid, leave the mesh open on the box's faces instead of capping it "
+                    "(default: the closed mesh of solid ∩ box)");
 
   PovRequest pov;
   CLI::App* povCmd = app.add_subcommand("pov", "POV-Ray scene of Minkowski terms: $ ... <+> ... $ in a scene, or a .hf "

@@ -6,12 +6,14 @@
 
 #include <cctype>
 #include <chrono>
+#include <bitset>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 
 #include "allocator_tuning.h"
 #include "arg_parse.h"
+#include "brick.h"
 #include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "exit_codes.h"
@@ -107,6 +109,14 @@ int runMeshVdb(const MeshRequest& request) {
 
 }  // namespace
 
+// "x-min, z-max" for the faces of facesReached's bits.
+std::string faceNames(unsigned faces) {
+  std::string s;
+  for (int b = 0; b < 6; ++b)
+    if (faces & (1u << b)) s += std::string(s.empty() ? "" : ", ") + "xyz"[b / 2] + (b % 2 ? "-max" : "-min");
+  return s;
+}
+
 int runMesh(const MeshRequest& request) {
   if (hasVdbExtension(request.model.path)) return runMeshVdb(request);
   if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj, .stl, .wrl, .pov, .3mf, .glb) is required");
@@ -135,12 +145,39 @@ int runMesh(const MeshRequest& request) {
       throw badArgs("--res/-g: the grid needs 2 to " + std::to_string(kMaxMeshGridPoints - 1) + " points per axis");
   checkJobSize(grid, options.brickVoxels);
 
+  // A solid cut by the box is meshed as solid ∩ box, capped on the faces that cut it (the field
+  // min(f, box faces) on a grid one voxel larger on every side), unless --open-rim.
+  const GridSpec userGrid = grid;
+  const unsigned cutFaces = facesReached(Tape::compile(m.field, 3), grid, {}, request.threads);
+  const bool capped = cutFaces != 0 && !request.openRim;
+  if (cutFaces != 0)
+    spdlog::warn("the solid is cut by the box's face{} {}: {}", std::bitset<6>(cutFaces).count() > 1 ? "s" : "",
+                 faceNames(cutFaces),
+                 capped ? "the mesh is capped there (solid ∩ box); --open-rim leaves it open"
+                        : "the mesh is open there (--open-rim)");
+  if (capped) {
+    for (int a = 0; a < 3; ++a) {
+      grid.origin[a] -= grid.voxel;
+      grid.dims[a] += 2;
+    }
+    if (grid.dims[0] >= kMaxMeshGridPoints || grid.dims[1] >= kMaxMeshGridPoints || grid.dims[2] >= kMaxMeshGridPoints)
+      throw badArgs("--res/-g: the grid needs 2 to " + std::to_string(kMaxMeshGridPoints - 3) +
+                    " points per axis when the box cuts the solid");
+    checkJobSize(grid, options.brickVoxels);
+  }
+
   openMeshOutputFiles(outputs);
   io::AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
   // Adaptive simplification: each worker does the blocks inside its brick, the master the rest
   // (deterministic, so the file still does not depend on the split; docs/mesh.md).
   // Not by default for models with extremum nodes: every check would run searches.
-  TapePtr tape = Tape::compile(m.field, 3);
+  farm::JobSpec job = makeJob(m, request.model.path, grid, "mesh");
+  if (capped)
+    for (int a = 0; a < 3; ++a) {
+      job.mutable_mesh()->add_cap_lo(userGrid.origin[a]);
+      job.mutable_mesh()->add_cap_hi(userGrid.origin[a] + userGrid.voxel * (userGrid.dims[a] - 1));
+    }
+  TapePtr tape = farm::compileJobModel(job);  // the workers' field, capped or not
   SimplifyOptions so;
   so.tolerance = request.tolerance >= 0 ? request.tolerance : tape->hasExtrema() ? 0.0 : 0.1;
   so.sharpFeatures = !request.noSharp;
@@ -148,7 +185,6 @@ int runMesh(const MeshRequest& request) {
   so.bricksSimplified = so.tolerance > 0 ? options.brickVoxels : 0;
   if (request.tolerance < 0 && tape->hasExtrema())
     spdlog::info("the model has extremum nodes: not simplified (each check would run a search); give --tolerance to");
-  farm::JobSpec job = makeJob(m, request.model.path, grid, "mesh");
   job.mutable_mesh()->set_tolerance(so.tolerance);
   job.mutable_mesh()->set_no_sharp(!so.sharpFeatures);
   spdlog::info("meshing '{}' on {}x{}x{} points of {}", m.model.objectName, grid.dims[0], grid.dims[1], grid.dims[2],
@@ -171,6 +207,8 @@ int runMesh(const MeshRequest& request) {
   report.sharpFeatures = so.sharpFeatures;
   report.simplify = ss;
   report.vertices = mesh.positions.size();
+  report.cutFaces = faceNames(cutFaces);
+  report.capped = capped;
   report.triangles = mesh.triangles.size();
   const double simplifySeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - meshSeconds;
@@ -186,12 +224,12 @@ int runMesh(const MeshRequest& request) {
   // the same for any split of the job (colour.h).
   const bool coloured = !m.colour.empty() && wantsColours(outputs);
   if (coloured) colourMesh(mesh, ColourField(m.colour, 3), 0.5 * grid.voxel, request.threads);
-  const std::array<double, 6> extent{grid.origin[0],
-                                  grid.origin[1],
-                                  grid.origin[2],
-                                  grid.origin[0] + grid.voxel * (grid.dims[0] - 1),
-                                  grid.origin[1] + grid.voxel * (grid.dims[1] - 1),
-                                  grid.origin[2] + grid.voxel * (grid.dims[2] - 1)};
+  const std::array<double, 6> extent{userGrid.origin[0],
+                                  userGrid.origin[1],
+                                  userGrid.origin[2],
+                                  userGrid.origin[0] + userGrid.voxel * (userGrid.dims[0] - 1),
+                                  userGrid.origin[1] + userGrid.voxel * (userGrid.dims[1] - 1),
+                                  userGrid.origin[2] + userGrid.voxel * (userGrid.dims[2] - 1)};
   std::vector<std::string> wrote = writeMeshOutputs(outputs, mesh, request, m.model.objectName, comment, extent, grid.voxel);
   writeReport(reportOut, report);
   std::remove(options.journalPath.c_str());  // the output is complete: nothing to resume

@@ -1347,7 +1347,14 @@ std::string FarmReport::toJson() const {
   j["extremum"] = {{"searches", extremumSearches}, {"uncertified", extremumUncertified}, {"error_bounds", errorBounds}};
   j["operation"] = operation;
   if (operation == "mesh") {
-    j["output"] = {{"vertices", vertices}, {"triangles", triangles}};
+    j["output"] = {{"vertices", vertices}, {"triangles", triangles}, {"capped", capped}};
+    nlohmann::json cut = nlohmann::json::array();
+    for (size_t b = 0; b < cutFaces.size();) {
+      size_t e = cutFaces.find(", ", b);
+      cut.push_back(cutFaces.substr(b, e == std::string::npos ? std::string::npos : e - b));
+      b = e == std::string::npos ? cutFaces.size() : e + 2;
+    }
+    j["output"]["cut_faces"] = cut;
     if (simplifyTolerance > 0)
       j["output"]["simplification"] = {{"tolerance_voxels", simplifyTolerance},
                                        {"sharp_features", sharpFeatures},

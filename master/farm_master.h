@@ -105,6 +105,8 @@ struct FarmReport {
   double simplifyTolerance = 0;  // voxels; 0: not simplified
   bool sharpFeatures = false;
   SimplifyStats simplify;
+  std::string cutFaces;  // "mesh": the box's faces that cut the solid ("x-min, z-max"; "" none)
+  bool capped = false;   // ... and whether the mesh was capped there (solid ∩ box)
   uint64_t retries = 0, duplicates = 0, lateResults = 0, malformed = 0, oversized = 0;
   uint64_t deadWorkers = 0, handedBack = 0, stragglerReissues = 0, leaseReissues = 0, refused = 0;
   uint64_t curveRejected = 0;

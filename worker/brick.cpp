@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 #include "frep/extremum/extremum.h"
@@ -112,6 +113,13 @@ Expr jobField(const JobSpec& job, uint32_t* dimsOut) {
 }
 }  // namespace
 
+namespace {
+Vec3 vec3(const google::protobuf::RepeatedField<double>& v, const char* name) {
+  if (v.size() != 3) throw std::invalid_argument(std::string("job: ") + name + " needs 3 values");
+  return {v[0], v[1], v[2]};
+}
+}  // namespace
+
 Expr jobFieldOf(const JobSpec& job) {
   uint32_t dims = 0;
   return jobField(job, &dims);
@@ -121,6 +129,13 @@ TapePtr compileJobModel(const JobSpec& job) {
   uint32_t dims = 0;
   Expr f = jobField(job, &dims);
   if (operationOf(job) == Operation::Render) return viewTape(f, cameraOf(job));
+  if (operationOf(job) == Operation::Mesh && (job.mesh().cap_lo_size() || job.mesh().cap_hi_size())) {
+    const Vec3 lo = vec3(job.mesh().cap_lo(), "cap_lo"), hi = vec3(job.mesh().cap_hi(), "cap_hi");
+    for (int a = 0; a < 3; ++a)
+      if (!(std::isfinite(lo[a]) && std::isfinite(hi[a]) && lo[a] < hi[a]))
+        throw std::invalid_argument("job: mesh cap box needs finite lo < hi on every axis");
+    f = clipToBox(f, lo, hi);  // solid ∩ box: capped where the box cuts the solid
+  }
   return Tape::compile(f, std::min(dims, 3u));
 }
 
@@ -133,12 +148,6 @@ Expr clipToBox(const Expr& f, const Vec3& lo, const Vec3& hi) {
   return e;
 }
 
-namespace {
-Vec3 vec3(const google::protobuf::RepeatedField<double>& v, const char* name) {
-  if (v.size() != 3) throw std::invalid_argument(std::string("job: render ") + name + " needs 3 values");
-  return {v[0], v[1], v[2]};
-}
-}  // namespace
 
 Camera cameraOf(const JobSpec& job) {
   const RenderSpec& v = job.render();
@@ -305,7 +314,9 @@ bool compactable(const LeafBlock& l, float& magnitude) {
     else if (m != magnitude) return false;
   }
   if (!found) magnitude = 0;
-  return true;
+  // A band of 0 stores the signs as +0 and the negative float nearest 0 (sample.h storedValue):
+  // not a +-magnitude pair, so such leaves travel whole.
+  return !found || magnitude >= std::numeric_limits<float>::min();
 }
 }  // namespace
 

@@ -749,7 +749,7 @@ class Simplifier {
     stats_.modelEvals += 2 * lanes_;
     bool any = false;
     for (size_t i = 0; i < lanes_; ++i)
-      if (std::signbit(f[2 * i]) || !std::signbit(f[2 * i + 1])) failed_[laneQuery_[i]] = 1, any = true;
+      if (!insideValue(f[2 * i]) || insideValue(f[2 * i + 1])) failed_[laneQuery_[i]] = 1, any = true;
     lanes_ = 0;
     return any;
   }

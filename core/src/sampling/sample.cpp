@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "frep/evaluators/eval.h"
@@ -69,6 +70,9 @@ class Sampler {
       if (lo_[a] < 0 || lo_[a] >= hi_[a]) throw std::invalid_argument("sample: empty region");
     }
     background_ = float(opt.bandVoxels * grid.voxel);
+    // Outside points the band decided: -background, or with a band of 0 the negative float
+    // nearest 0 (-0 would read as inside: sample.h insideValue).
+    outsideValue_ = background_ > 0 ? -background_ : -std::numeric_limits<float>::denorm_min();
   }
 
   SampleResult run() {
@@ -247,7 +251,7 @@ class Sampler {
             }
       }
     }
-    for (int i = 0; i < kLeafVoxels; ++i) blk.values[i] = sign[i] > 0 ? background_ : -background_;
+    for (int i = 0; i < kLeafVoxels; ++i) blk.values[i] = sign[i] > 0 ? background_ : outsideValue_;
     evaluatePoints(w, blk, *leafTape, todo.data(), ntodo);
     w.leaves.push_back(blk);
   }
@@ -272,10 +276,10 @@ class Sampler {
         double f = out[k];
         if (std::isnan(f)) {
           ++w.stats.nanValues;
-          blk.values[off] = -background_;
+          blk.values[off] = outsideValue_;
           continue;
         }
-        blk.values[off] = float(f);
+        blk.values[off] = storedValue(f);  // the class of f, also for tiny negatives
         blk.active[off >> 6] |= uint64_t(1) << (off & 63);
       }
       w.stats.pointEvals += count;
@@ -289,7 +293,7 @@ class Sampler {
   SampleOptions opt_;
   uint32_t nvars_;
   int64_t lo_[3], hi_[3];
-  float background_;
+  float background_, outsideValue_;
 };
 
 }  // namespace
@@ -326,6 +330,37 @@ double insideVolume(const SampleResult& r) {
               l.values[leafOffset(x, y, z)] >= 0)
             ++inside;
   return double(inside) * g.voxel * g.voxel * g.voxel;
+}
+
+unsigned facesReached(const TapePtr& tape, const GridSpec& grid, const std::vector<double>& fixedCoords,
+                      int threads) {
+  unsigned faces = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int side = 0; side < 2; ++side) {
+      const int32_t layer = side ? grid.dims[a] - 1 : 0;
+      SampleOptions opt;
+      opt.bandVoxels = 0;
+      opt.pointwiseSearches = true;  // a sign per point, as the mesher's
+      opt.extremumSignsOnly = true;
+      opt.fixedCoords = fixedCoords;
+      opt.threads = threads;
+      opt.regionLo[a] = layer - layer % kLeafDim;
+      opt.regionHi[a] = layer + 1;
+      const SampleResult r = sample(tape, grid, opt);
+      bool reached = false;
+      for (const Tile& t : r.tiles) reached = reached || (t.inside && t.origin[a] <= layer && layer < t.origin[a] + t.size);
+      for (const LeafBlock& l : r.leaves) {
+        if (reached || layer < l.origin[a] || layer >= l.origin[a] + kLeafDim) continue;
+        for (int i = 0; i < kLeafVoxels && !reached; ++i) {
+          const int local[3] = {i >> 6, (i >> 3) & 7, i & 7};
+          bool inGrid = local[a] == layer - l.origin[a];
+          for (int b = 0; b < 3; ++b) inGrid = inGrid && l.origin[b] + local[b] < grid.dims[b];
+          reached = inGrid && insideValue(l.values[size_t(i)]);
+        }
+      }
+      if (reached) faces |= 1u << (2 * a + side);
+    }
+  return faces;
 }
 
 double latticeVolume(const GridSpec& g, const std::function<bool(const std::array<double, 3>&)>& inside) {

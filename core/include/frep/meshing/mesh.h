@@ -13,8 +13,8 @@
 // evaluation is a search, share grid-point values between edges instead (MeshOptions::
 // extremumVertices, mesh_extremum_roots.cpp).
 //
-// Sign rule: a grid point is inside when its value's sign bit is clear (+0 is inside, -0, NaN
-// and negative values are outside), so every edge has a strict sign change or none.
+// Sign rule: a grid point is inside when f >= 0 (both zeros inside; NaN and negative values
+// outside), so every edge has a strict sign change or none.
 #pragma once
 
 #include <array>
@@ -39,10 +39,8 @@ inline std::array<int64_t, 4> edgeKeyParts(EdgeKey key) {
 }
 constexpr int64_t kMaxMeshGridPoints = int64_t(1) << 19;
 
-// The sign rule: inside when the sign bit is clear and the value is not NaN (+0 inside, -0
-// outside), for floats and doubles alike, so sampled float values and direct double
-// evaluations classify every point the same way.
-inline bool insideValue(double f) { return !std::isnan(f) && !std::signbit(f); }
+// The sign rule (insideValue, storedValue) is in frep/sampling/sample.h.
+
 
 // Rotates a triangle (winding kept) to start at its smallest index: the canonical form of the
 // triangles of MeshPiece and Mesh.

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -57,6 +58,18 @@ struct Tile {
   bool inside;                     // the whole cube is inside (f > 0) or outside (f < 0)
 };
 
+// The sign rule: inside when f >= 0 (both zeros: a point on the boundary belongs to the closed
+// solid, as in the papers) and not NaN. Stored floats keep the class of the double they come
+// from (storedValue), so sampled values and direct evaluations classify every point the same way.
+inline bool insideValue(double f) { return f >= 0; }
+// f as a float of the same class: a negative value too small for a float is stored as the
+// negative float nearest 0 (not -0, which would read as inside), a zero of either sign as +0.
+inline float storedValue(double f) {
+  const float s = static_cast<float>(f);
+  if (s != 0.0f) return s;
+  return f < 0 ? -std::numeric_limits<float>::denorm_min() : 0.0f;
+}
+
 struct SampleOptions {
   // Voxels within this many voxels (Chebyshev) of a possible zero are sampled. 0: only the
   // points of 2^3 blocks whose own box may hold a zero (every other point keeps a certified sign
@@ -106,6 +119,13 @@ void sortByOrigin(std::vector<LeafBlock>& leaves, std::vector<Tile>& tiles);
 // Volume of the inside of a sampled model as counted on its lattice: the grid points with
 // f >= 0 (voxels of inside tiles and leaf values >= 0, within the grid) times the voxel volume.
 double insideVolume(const SampleResult& r);
+
+// Which faces of the grid's box the solid reaches: bit 2a for the low face along axis a, bit
+// 2a + 1 for the high one, set when a grid point on that face is inside (f >= 0). Found by
+// sampling each face's layer of points (band 0: interval-certified tiles, only points near the
+// surface evaluated), so a solid well inside the box costs a few interval evaluations.
+unsigned facesReached(const TapePtr& tape, const GridSpec& grid, const std::vector<double>& fixedCoords = {},
+                      int threads = 0);
 // The same count for a shape given by a predicate on world points: the grid points p of g with
 // inside(p), times the voxel volume.
 double latticeVolume(const GridSpec& g, const std::function<bool(const std::array<double, 3>&)>& inside);
