@@ -59,6 +59,7 @@ struct FarmRequest {
   bool resume = false;
   bool json = false;         // JSON progress events on stdout
   bool noProgress = false;
+  bool strict = false;       // --strict: uncertified extremum searches fail the job (exit 8)
   std::string curveDir;
   bool insecure = false;     // --listen on the network without --curve
 };

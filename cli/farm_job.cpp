@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <fstream>
 #include <thread>
+#include <spdlog/spdlog.h>
 #include <zmq.hpp>
 
 #include "arg_parse.h"
@@ -170,7 +171,19 @@ std::string poisonedMessage(const farm::FarmReport& report) {
 }
 }  // namespace
 
-void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report) {
+void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report, bool strict) {
+  if (report.extremumUncertified > 0) {
+    const std::string what = std::to_string(report.extremumUncertified) + " of " +
+                             std::to_string(report.extremumSearches) +
+                             " extremum searches stopped at their box limit before certifying their tolerance; "
+                             "the widest gap left is " + formatNumber(report.extremumWidestGap) +
+                             " (raise the search's box limit or loosen its tolerance)";
+    if (strict) {
+      writeReport(reportOut, report);
+      throw CliError(kExitUncertified, what + "; --strict: nothing written");
+    }
+    spdlog::warn("{}", what);
+  }
   if (!report.interrupted && report.poisoned.empty()) return;
   writeReport(reportOut, report);
   if (report.interrupted)

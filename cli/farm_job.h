@@ -46,7 +46,7 @@ void writeReport(io::AtomicOutput& reportOut, const farm::FarmReport& report);
 
 // An interrupted or poisoned job: writes the report and throws CliError with exit 6 (resume) or
 // 5 (the poisoned bricks named). Returns when the job is complete.
-void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report);
+void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report, bool strict = false);
 
 // The same without a report or journal (frep render): throws CliError with exit 6 or 5.
 void requireComplete(const farm::FarmReport& report);

@@ -53,7 +53,7 @@ HfpTranslation translateHfp(int argc, char** argv) {
       continue;
     }
     if (a.rfind("--", 0) == 0) {  // frep's own options (--workers 2, --res=64, ...) pass on
-      static const std::set<std::string> flags = {"--resume", "--json", "--no-progress", "--insecure", "--no-sharp", "--open-rim",
+      static const std::set<std::string> flags = {"--resume", "--json", "--no-progress", "--insecure", "--no-sharp", "--open-rim", "--strict",
                                                   "--timing"};
       t.args.push_back(a);
       if (!flags.count(a) && a.find('=') == std::string::npos && i + 1 < argc) t.args.push_back(argv[++i]);

@@ -172,10 +172,14 @@ int runMesh(const MeshRequest& request) {
   // (deterministic, so the file still does not depend on the split; docs/mesh.md).
   // Not by default for models with extremum nodes: every check would run searches.
   farm::JobSpec job = makeJob(m, request.model.path, grid, "mesh");
+  // The caps lie 2e-3 voxel inside the box's faces: the roots on the edges that leave the box
+  // then fall inside the edges (not on the faces' grid points, where endGuard would push them
+  // out), so every vertex lies in the box.
+  const double capInset = 2e-3 * userGrid.voxel;
   if (capped)
     for (int a = 0; a < 3; ++a) {
-      job.mutable_mesh()->add_cap_lo(userGrid.origin[a]);
-      job.mutable_mesh()->add_cap_hi(userGrid.origin[a] + userGrid.voxel * (userGrid.dims[a] - 1));
+      job.mutable_mesh()->add_cap_lo(userGrid.origin[a] + capInset);
+      job.mutable_mesh()->add_cap_hi(userGrid.origin[a] + userGrid.voxel * (userGrid.dims[a] - 1) - capInset);
     }
   TapePtr tape = farm::compileJobModel(job);  // the workers' field, capped or not
   SimplifyOptions so;
@@ -193,7 +197,7 @@ int runMesh(const MeshRequest& request) {
   jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
   farm::FarmReport& report = outcome.report;
-  requireComplete(reportOut, report);
+  requireComplete(reportOut, report, request.farm.strict);
   Mesh& mesh = outcome.mesh;
   const double meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (so.tolerance > 0)
@@ -202,10 +206,24 @@ int runMesh(const MeshRequest& request) {
                  mesh.triangles.size(), so.tolerance, so.sharpFeatures ? "on" : "off");
   if (so.tolerance > 0) jsonPhase("simplify");
   so.progress = farm::simplifyProgress(options.progressBar, options.progressJson);
+  // The bound of the whole pipeline: the mesher's chords and roots (searches included), then
+  // what the simplification certified for the triangles it made (docs/mesh.md, "Error bound").
+  const double rawBound = rawMeshErrorBound(mesh, *tape, grid);
   SimplifyStats ss = simplifyMesh(mesh, tape, grid, so);
+  report.surfaceErrorBound = std::max(rawBound, so.tolerance > 0 ? ss.errorBound : 0.0);
   report.simplifyTolerance = so.tolerance;
   report.sharpFeatures = so.sharpFeatures;
   report.simplify = ss;
+  // Every mesh written is closed and oriented: checked here, after the merge and the
+  // simplification, so a fault anywhere in the pipeline is an error, never a silent file.
+  uint64_t unpaired = 0;
+  const std::string defect = closureDefect(mesh.triangles, mesh.positions.size(), &unpaired);
+  if (!defect.empty() && (capped || cutFaces == 0)) {  // --open-rim: open where the box cuts, by request
+    writeReport(reportOut, report);
+    throw CliError(kExitOpenMesh, "internal error: the merged mesh is not closed (" + std::to_string(unpaired) +
+                                      " unpaired directed edges; first: " + defect +
+                                      "); nothing written. Please report it with the command line");
+  }
   report.vertices = mesh.positions.size();
   report.cutFaces = faceNames(cutFaces);
   report.capped = capped;

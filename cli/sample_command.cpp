@@ -79,7 +79,7 @@ int runSample(const SampleRequest& request) {
   jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
   const farm::FarmReport& report = outcome.report;
-  requireComplete(reportOut, report);
+  requireComplete(reportOut, report, request.farm.strict);
 
   io::VdbMetadata meta;
   meta.gridName = m.model.objectName;

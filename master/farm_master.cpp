@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -326,6 +327,8 @@ class Master {
       report_.domainErrors.add(out.stats.domainErrors);
       report_.extremumSearches += out.extremumSearches;
       report_.extremumUncertified += out.extremumUncertified;
+      report_.extremumSignDecided += out.extremumSignDecided;
+      report_.extremumWidestGap = std::max(report_.extremumWidestGap, out.extremumWidestGap);
       for (auto& [rid, p] : peers_)
         if (p.workerId == who) ++p.finished;
       auto& share = report_.perWorker[who];
@@ -764,6 +767,9 @@ class Master {
     out.stats.nanValues = r.nan_values();
     out.extremumSearches = r.extremum_searches();
     out.extremumUncertified = r.extremum_uncertified();
+    out.extremumSignDecided = r.extremum_sign_decided();
+    // A peer's gap only widens what the report admits (never a NaN, never below 0).
+    out.extremumWidestGap = r.extremum_widest_gap() >= 0 ? r.extremum_widest_gap() : INFINITY;
     for (int k = 0; k < r.domain_errors_size() && k < int(kDomainErrorKinds); ++k)
       out.stats.domainErrors.n[k] = r.domain_errors(k);
     report_.perWorker[a.workerId].computeSeconds += r.compute_seconds();
@@ -1344,7 +1350,11 @@ std::string FarmReport::toJson() const {
   nlohmann::json dom = nlohmann::json::object();
   for (size_t k = 0; k < kDomainErrorKinds; ++k) dom[domainErrorName(DomainError(k))] = domainErrors.n[k];
   j["domain_errors"] = dom;
-  j["extremum"] = {{"searches", extremumSearches}, {"uncertified", extremumUncertified}, {"error_bounds", errorBounds}};
+  j["extremum"] = {{"searches", extremumSearches},
+                   {"sign_decided", extremumSignDecided},
+                   {"uncertified", extremumUncertified},
+                   {"widest_uncertified_gap", extremumUncertified ? nlohmann::json(extremumWidestGap) : nlohmann::json()},
+                   {"error_bounds", errorBounds}};
   j["operation"] = operation;
   if (operation == "mesh") {
     j["output"] = {{"vertices", vertices}, {"triangles", triangles}, {"capped", capped}};
@@ -1355,6 +1365,7 @@ std::string FarmReport::toJson() const {
       b = e == std::string::npos ? cutFaces.size() : e + 2;
     }
     j["output"]["cut_faces"] = cut;
+    j["surface_error_bound"] = surfaceErrorBound;
     if (simplifyTolerance > 0)
       j["output"]["simplification"] = {{"tolerance_voxels", simplifyTolerance},
                                        {"sharp_features", sharpFeatures},

@@ -107,6 +107,7 @@ struct FarmReport {
   SimplifyStats simplify;
   std::string cutFaces;  // "mesh": the box's faces that cut the solid ("x-min, z-max"; "" none)
   bool capped = false;   // ... and whether the mesh was capped there (solid ∩ box)
+  double surfaceErrorBound = 0;  // "mesh": no point of the mesh is further from the surface (world units)
   uint64_t retries = 0, duplicates = 0, lateResults = 0, malformed = 0, oversized = 0;
   uint64_t deadWorkers = 0, handedBack = 0, stragglerReissues = 0, leaseReissues = 0, refused = 0;
   uint64_t curveRejected = 0;
@@ -116,7 +117,8 @@ struct FarmReport {
   uint64_t suspectBricks = 0;   // bricks whose worker died computing them (then retried alone)
   uint64_t reconnects = 0;      // workers back under a new connection, leases kept
   uint64_t masterStalls = 0;    // the master's own loop stopped longer than the liveness window
-  uint64_t extremumSearches = 0, extremumUncertified = 0;
+  uint64_t extremumSearches = 0, extremumUncertified = 0, extremumSignDecided = 0;
+  double extremumWidestGap = 0;  // the widest gap an uncertified search left (infinite: unknown)
   std::vector<std::string> errorBounds;  // one line per extremum node of the model
   int workersSeen = 0;
   std::map<std::string, WorkerShare> perWorker;  // by worker id ("in-process" for --workers 0)

@@ -205,10 +205,13 @@ BrickOutput computeBrick(const TapePtr& tape, const JobSpec& job, const std::arr
   // A process computes one brick at a time, so the change of the process-wide extremum
   // counters over the call is this brick's.
   ExtremumCounters& c = extremumCounters();
-  const uint64_t searches = c.searches, uncertified = c.uncertified;
+  const uint64_t searches = c.searches, uncertified = c.uncertified, signDecided = c.signDecided;
+  c.widestGap = 0.0;
   BrickOutput out = computeBrickOnce(tape, job, lo, hi, threads);
   out.extremumSearches = c.searches - searches;
   out.extremumUncertified = c.uncertified - uncertified;
+  out.extremumSignDecided = c.signDecided - signDecided;
+  out.extremumWidestGap = c.widestGap;
   return out;
 }
 
@@ -270,8 +273,9 @@ std::string describeErrorBounds(const Tape& tape, std::vector<std::string>* line
       line = "grid search (eps " + std::to_string(s.eps) + " over " + std::to_string(s.numParams()) +
              " parameters): set inclusion A_d + B_d in M in A + B with d = " + std::to_string(d);
     } else {
-      line = "branch-and-bound: value certified within " + std::to_string(s.tolerance) +
-             " (searches that ran out of boxes are counted as uncertified)";
+      line = "branch-and-bound: values within " + std::to_string(s.tolerance) +
+             " of the extremum where the search certified it; sign-only searches certify the sign; searches that "
+             "ran out of boxes are counted as uncertified, with the widest gap they left";
     }
     if (lines) lines->push_back(line);
     all += (all.empty() ? "" : "; ") + line;

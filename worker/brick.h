@@ -32,6 +32,8 @@ struct BrickOutput {
   std::vector<Tile> tiles;
   SampleStats stats;
   uint64_t extremumSearches = 0, extremumUncertified = 0;  // this brick's extremum searches
+  uint64_t extremumSignDecided = 0;  // ... sign-only searches that stopped at a certain sign
+  double extremumWidestGap = 0;      // ... the widest gap an uncertified one left
   MeshPiece piece;
   std::vector<RayHit> hits;
   std::array<int32_t, 3> tileLo{}, tileHi{};  // "render": the region of `hits`

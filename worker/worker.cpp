@@ -193,6 +193,8 @@ class ComputeThread {
       for (uint64_t n : b.stats.domainErrors.n) r->add_domain_errors(n);
       r->set_extremum_searches(b.extremumSearches);
       r->set_extremum_uncertified(b.extremumUncertified);
+      r->set_extremum_sign_decided(b.extremumSignDecided);
+      r->set_extremum_widest_gap(b.extremumWidestGap);
     } catch (const std::exception& e) {
       Failed* f = out.env.mutable_failed();
       f->set_brick_id(task.brick_id());

@@ -6,13 +6,13 @@ _frep_options() {
   local model="-o --object -a --params -x --map -i --iso"
   local region="-b --bounds --res -g --grid -O --out"
   local geometric="--t-frames --t-range --v-range --v-cells --w-range --w-cells --c-range --c-levels --g-values"
-  local farm="--workers --threads --listen --expect-workers --brick --heartbeat-ms --resume --json --no-progress --curve --insecure"
+  local farm="--workers --threads --listen --expect-workers --brick --heartbeat-ms --resume --json --no-progress --curve --insecure --strict"
   case "$1" in
     check) echo "-h --help -o --object -b --bounds" ;;
     eval) echo "-h --help $model --at --tolerance" ;;
     slice) echo "-h --help $model $region --axis --at --mask $geometric" ;;
     sample) echo "-h --help $model $region --band --store $farm" ;;
-    mesh) echo "-h --help $model $region --tolerance --no-sharp --format --up --wrl --stl --stlb --pov --cli --gs --timing $farm" ;;
+    mesh) echo "-h --help $model $region --tolerance --no-sharp --open-rim --format --up --wrl --stl --stlb --pov --cli --gs --timing $farm" ;;
     render) echo "-h --help $model -b --bounds -O --out --size --azimuth --elevation --distance --zoom --eye --target --up --perspective --fov --background --colour --color --frames --no-footprint $geometric $farm" ;;
     pov) echo "-h --help -o --object -O --out --thin" ;;
     relate) echo "-h --help --object-a --object-b -b --bounds --min-size --at" ;;

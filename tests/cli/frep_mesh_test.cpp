@@ -112,23 +112,44 @@ TEST_F(FrepTest, MeshOfABlockIsAFewTrianglesWithSharpCornersAndOptionsTurnItOff)
   EXPECT_GT(readPly(readText(path("z.ply"))).triangles.size(), 5000u);
 }
 
-// A 2D object is meshed as the prism frep sample samples (constant along z), cut by the box:
-// a disc becomes a cylinder whose side lies on the circle and whose open rims lie on the box's
-// z faces; the same bytes in-process and on the farm.
+// A 2D object is meshed as the prism frep sample samples (constant along z), cut by the box: a
+// disc becomes a cylinder whose side lies on the circle, capped on the box's z faces (solid ∩
+// box, closed, a warning naming the faces); with --open-rim its open rims lie on those faces.
+// The same bytes in-process and on the farm.
 TEST_F(FrepTest, MeshOfATwoDimensionalObjectIsItsPrism) {
   write("disc.hf", "my_model(x[2], a[1]) { my_model = 1 - x[1]*x[1] - x[2]*x[2]; }\n");
-  ASSERT_EQ(run("mesh disc.hf -b 1.5 --res 48 -O d.ply").code, 0);
+  RunResult farm = run("mesh disc.hf -b 1.5 --res 48 -O d.ply");
+  ASSERT_EQ(farm.code, 0) << farm.err;
+  EXPECT_NE(farm.err.find("the solid is cut by the box's faces z-min, z-max"), std::string::npos) << farm.err;
   ASSERT_EQ(run("mesh disc.hf -b 1.5 --res 48 --workers 0 -O e.ply").code, 0);
   EXPECT_TRUE(readText(path("d.ply")) == readText(path("e.ply")));
-  ReadMesh d = readPly(readText(path("d.ply")));
-  ASSERT_GT(d.triangles.size(), 50u);
   const double voxel = 3.0 / 47;
-  size_t onFaces = 0;
+  ReadMesh d = readPly(readText(path("d.ply")));
+  EXPECT_EQ(mc::checkEdgePairs(d.triangles, d.positions.size()), "");
+  EXPECT_EQ(mc::eulerCharacteristic(d.triangles, d.positions.size()), 2);
+  size_t onCaps = 0;
   for (const auto& p : d.positions) {
+    const bool cap = std::abs(std::abs(p[2]) - 1.5) <= 3e-3 * voxel;  // 2e-3 voxel inside, float32
+    onCaps += cap;
+    EXPECT_LE(std::abs(p[2]), 1.5) << "every vertex in the box";
+    if (!cap) EXPECT_NEAR(std::hypot(p[0], p[1]), 1.0, 0.5 * voxel);
+    else EXPECT_LE(std::hypot(p[0], p[1]), 1.0 + 0.5 * voxel);
+  }
+  EXPECT_GT(onCaps, 60u);
+  // The cylinder of radius 1 and height 3, within the chords of the circle.
+  EXPECT_NEAR(mc::enclosedVolume(d.positions, d.triangles), 3 * M_PI, 0.01 * 3 * M_PI);
+  const std::string report = readText(path("d.ply.report.json"));
+  EXPECT_NE(report.find("\"capped\": true"), std::string::npos) << report;
+
+  ASSERT_EQ(run("mesh disc.hf -b 1.5 --res 48 --open-rim -O o.ply").code, 0);
+  ReadMesh o = readPly(readText(path("o.ply")));
+  size_t onFaces = 0;
+  for (const auto& p : o.positions) {
     EXPECT_NEAR(std::hypot(p[0], p[1]), 1.0, 0.5 * voxel);
     if (std::abs(std::abs(p[2]) - 1.5) < 1e-9) ++onFaces;
   }
   EXPECT_GT(onFaces, 60u);  // both rims
+  EXPECT_NE(mc::checkEdgePairs(o.triangles, o.positions.size()), "");
 }
 
 TEST_F(FrepTest, MeshRejectsBadArguments) {

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "frep/meshing/mesh.h"
 #include "frep/meshing/mesh_predicates.h"
 
 namespace mesh_checks {
@@ -31,20 +32,7 @@ inline double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
 // too: the surface is closed, 2-manifold at edges and consistently oriented. Returns "" or the
 // first problem found.
 inline std::string checkEdgePairs(const std::vector<Tri>& tris, size_t numVertices) {
-  std::map<std::pair<uint32_t, uint32_t>, int> directed;
-  for (size_t t = 0; t < tris.size(); ++t) {
-    for (int c = 0; c < 3; ++c) {
-      uint32_t a = tris[t][c], b = tris[t][(c + 1) % 3];
-      if (a >= numVertices || b >= numVertices) return "triangle " + std::to_string(t) + " has a bad index";
-      if (a == b) return "triangle " + std::to_string(t) + " repeats a vertex";
-      if (++directed[{a, b}] > 1)
-        return "directed edge " + std::to_string(a) + "->" + std::to_string(b) + " occurs twice";
-    }
-  }
-  for (const auto& [e, n] : directed)
-    if (!directed.count({e.second, e.first}))
-      return "edge " + std::to_string(e.first) + "->" + std::to_string(e.second) + " has no opposite";
-  return "";
+  return frep::closureDefect(tris, numVertices);  // the check frep mesh runs before it writes
 }
 
 inline long eulerCharacteristic(const std::vector<Tri>& tris, size_t numVertices) {

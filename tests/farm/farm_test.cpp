@@ -251,7 +251,9 @@ my_model(x[3], a[1]) { array o[2]; o = [0, 0.05]; my_model = frOffsetR(x, ball, 
   EXPECT_EQ(farm.report.extremumSearches, in.report.extremumSearches);
   EXPECT_EQ(farm.report.extremumUncertified, 0u);
   ASSERT_EQ(farm.report.errorBounds.size(), 1u);
-  EXPECT_NE(farm.report.errorBounds[0].find("branch-and-bound: value certified within 0.05"), std::string::npos)
+  EXPECT_NE(farm.report.errorBounds[0].find("branch-and-bound: values within 0.05"), std::string::npos)
       << farm.report.errorBounds[0];
   EXPECT_NE(farm.report.toJson().find("\"error_bounds\""), std::string::npos);
+  EXPECT_EQ(farm.report.extremumSignDecided, in.report.extremumSignDecided);  // what the searches decided
+  EXPECT_NE(farm.report.toJson().find("\"sign_decided\""), std::string::npos);
 }

@@ -285,16 +285,19 @@ def run_case(frep, name, grids, keep):
             rows.append(check_grid(frep, case, g, tmp))
         fails = []
         for r in rows:
-            if r['grid'] in (128, 129) and 'err' in r:
-                e = r.get('err_capped', r['err']) if not r.get('watertight', True) else r['err']
-                if abs(r['err']) > VOLUME_TOL:
-                    r['fail'].append('volume error %+.3f %% > %.1f %%%s' %
-                                     (r['err'], VOLUME_TOL,
-                                      '' if e == r['err'] else ' (with the open rims capped: %+.3f %%)' % e))
-        done = [r for r in rows if 'err' in r]
-        if len(done) >= 2 and abs(done[-1]['err']) > abs(done[0]['err']):
+            # an open mesh (a solid cut by the box, not capped) is judged by its capped volume;
+            # its open rims are a failure of their own (watertight)
+            if 'err' in r:
+                r['eff_err'] = r.get('err_capped', r['err'])
+            if r['grid'] in (128, 129) and 'eff_err' in r and abs(r['eff_err']) > VOLUME_TOL:
+                r['fail'].append('volume error %+.3f %% > %.1f %%%s' %
+                                 (r['eff_err'], VOLUME_TOL, ' (open mesh, rims capped)' if 'err_capped' in r else ''))
+        done = [r for r in rows if 'eff_err' in r]
+        # slack of 0.001 percentage points: exact meshes (a block's 12 triangles) differ only by
+        # float32 rounding from grid to grid
+        if len(done) >= 2 and abs(done[-1]['eff_err']) > abs(done[0]['eff_err']) + 1e-3:
             fails.append('volume error at the finest grid (%d: %+.4f %%) exceeds the coarsest (%d: %+.4f %%)' %
-                         (done[-1]['grid'], done[-1]['err'], done[0]['grid'], done[0]['err']))
+                         (done[-1]['grid'], done[-1]['eff_err'], done[0]['grid'], done[0]['eff_err']))
         return {'case': case.name, 'rows': rows, 'case_fail': fails}
     finally:
         if keep:

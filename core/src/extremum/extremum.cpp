@@ -32,6 +32,8 @@ void resetExtremumCounters() {
   c.pointEvals = 0;
   c.intervalEvals = 0;
   c.uncertified = 0;
+  c.signDecided = 0;
+  c.widestGap = 0.0;
   c.boundCalls = 0;
   c.boundIntervalEvals = 0;
 }
@@ -207,8 +209,16 @@ struct ExtremumSolver::Impl {
     c.searches.fetch_add(1, std::memory_order_relaxed);
     c.pointEvals.fetch_add(r.pointEvals, std::memory_order_relaxed);
     c.intervalEvals.fetch_add(r.intervalEvals, std::memory_order_relaxed);
-    if (s.method == ExtremumMethod::BranchAndBound && !r.certified)
-      c.uncertified.fetch_add(1, std::memory_order_relaxed);
+    if (s.method != ExtremumMethod::BranchAndBound || r.certified) return;
+    if (r.signDecided) {
+      c.signDecided.fetch_add(1, std::memory_order_relaxed);
+      return;
+    }
+    c.uncertified.fetch_add(1, std::memory_order_relaxed);
+    const double gap = r.hi - r.lo;
+    double seen = c.widestGap.load(std::memory_order_relaxed);
+    while (!(seen >= gap) && !c.widestGap.compare_exchange_weak(seen, gap, std::memory_order_relaxed)) {
+    }
   }
 
   // Pasko-Minkowski's eps-grid: every node of a grid with step <= eps (per parameter, in length
@@ -450,6 +460,7 @@ struct ExtremumSolver::Impl {
       S.r.value = sign * S.bestV;
       S.r.lo = S.r.hi = S.r.value;
       S.r.certified = false;
+      S.r.signDecided = true;
       finish(S.r, S.bestT);
       return std::move(S.r);
     };

@@ -8,11 +8,13 @@
 // vertex (they never do: a vertex depends on its edge only) the smaller record (position, then
 // normal) wins, so the result is the same whatever the order of the pieces.
 #include "frep/meshing/mesh_merge.h"
+#include "frep/extremum/extremum.h"
 
 #include <malloc.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <stdexcept>
 #include <tuple>
@@ -142,6 +144,69 @@ Mesh mergePiecesReleasing(std::vector<MeshPiece>& pieces, bool trimHeap) {
   });
   if (trimHeap) malloc_trim(0);
   return mesh;
+}
+
+}  // namespace frep
+
+namespace frep {
+
+std::string closureDefect(const std::vector<std::array<uint32_t, 3>>& triangles, size_t numVertices,
+                          uint64_t* unpaired) {
+  std::string first;
+  uint64_t bad = 0;
+  std::vector<uint64_t> edges;  // (a << 32) | b per directed edge
+  edges.reserve(3 * triangles.size());
+  for (size_t t = 0; t < triangles.size(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t a = triangles[t][size_t(c)], b = triangles[t][size_t((c + 1) % 3)];
+      if (a >= numVertices || b >= numVertices || a == b) {
+        if (first.empty())
+          first = "triangle " + std::to_string(t) + (a == b ? " repeats a vertex" : " has a bad index");
+        ++bad;
+        continue;
+      }
+      edges.push_back((uint64_t(a) << 32) | b);
+    }
+  tbb::parallel_sort(edges.begin(), edges.end());
+  for (size_t i = 0; i < edges.size(); ++i) {
+    const uint32_t a = uint32_t(edges[i] >> 32), b = uint32_t(edges[i]);
+    const std::string name = std::to_string(a) + "->" + std::to_string(b);
+    if (i + 1 < edges.size() && edges[i + 1] == edges[i]) {
+      if (first.empty()) first = "directed edge " + name + " occurs twice";
+      ++bad;
+      continue;
+    }
+    if (!std::binary_search(edges.begin(), edges.end(), (uint64_t(b) << 32) | a)) {
+      if (first.empty()) first = "edge " + name + " has no opposite";
+      ++bad;
+    }
+  }
+  if (unpaired) *unpaired = bad;
+  return first;
+}
+
+double rawMeshErrorBound(const Mesh& mesh, const Tape& tape, const GridSpec& grid, double endGuard) {
+  double longest2 = 0;
+  // Triangles a collapse made (a farm brick's own simplification) are the simplifier's to bound.
+  const std::vector<uint8_t>& made = mesh.carry.triangles;
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+    if (made.size() == mesh.triangles.size() && (made[i] & 0x80)) continue;
+    const auto& t = mesh.triangles[i];
+    for (int c = 0; c < 3; ++c) {
+      const auto& a = mesh.positions[t[size_t(c)]];
+      const auto& b = mesh.positions[t[size_t((c + 1) % 3)]];
+      const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+      longest2 = std::max(longest2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    }
+  }
+  double search = 0;
+  for (const ExtremumEntry& e : tape.extrema()) {
+    const ExtremumSpec& s = *e.spec;
+    search = std::max(search, s.method == ExtremumMethod::BranchAndBound
+                                  ? s.tolerance
+                                  : std::sqrt(double(s.numParams())) / 2.0 * s.eps);  // Pasko-Minkowski §4's d
+  }
+  return std::sqrt(longest2 / 3.0) + endGuard * std::sqrt(3.0) * grid.voxel + search;
 }
 
 }  // namespace frep

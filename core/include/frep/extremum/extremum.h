@@ -72,6 +72,7 @@ struct ExtremumResult {
   double value = 0.0;         // the extremum found (a real body value: max: <= true max)
   double lo = 0.0, hi = 0.0;  // interval certified to contain the true extremum (B&B; Grid: -inf/+inf side open)
   bool certified = false;     // B&B stopped with gap <= tolerance
+  bool signDecided = false;   // a sign-only search that stopped once its sign was certain (solveSign)
   std::vector<double> u;      // the arg-extremum (hidden variables)
   std::vector<double> t;      // ... as search parameters (angles for Sphere/Ball): a warm start
   uint64_t pointEvals = 0, intervalEvals = 0;  // body evaluations spent
@@ -108,8 +109,12 @@ class ExtremumSolver {
 };
 
 // Process-wide counters (relaxed atomics, updated once per search) for benches and reports.
+// uncertified counts B&B searches that stopped at maxBoxes before their gap reached the
+// tolerance (widestGap: the widest gap one of them left); signDecided counts sign-only searches
+// that stopped once their sign was certain (their sign is certified, not their value).
 struct ExtremumCounters {
-  std::atomic<uint64_t> searches{0}, pointEvals{0}, intervalEvals{0}, uncertified{0};
+  std::atomic<uint64_t> searches{0}, pointEvals{0}, intervalEvals{0}, uncertified{0}, signDecided{0};
+  std::atomic<double> widestGap{0.0};
   std::atomic<uint64_t> boundCalls{0}, boundIntervalEvals{0};
 };
 ExtremumCounters& extremumCounters();

@@ -20,6 +20,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "frep/sampling/sample.h"
@@ -147,6 +148,21 @@ struct MeshOptions {
 // of the grid never produce a triangle twice.
 MeshPiece meshRegion(const TapePtr& tape, const GridSpec& grid, const std::array<int32_t, 3>& lo,
                      const std::array<int32_t, 3>& hi, const MeshOptions& options = {});
+
+// Every directed edge (a, b) of a triangle occurs exactly once and its reverse (b, a) occurs too:
+// the surface is closed, 2-manifold at its edges and consistently oriented. Returns "" or the
+// first problem found (edges in index order), and counts the unpaired directed edges.
+std::string closureDefect(const std::vector<std::array<uint32_t, 3>>& triangles, size_t numVertices,
+                          uint64_t* unpaired = nullptr);
+
+// A bound on the distance from any point of a mesh as the mesher made it to the model's surface:
+// every point of a triangle is within L / sqrt(3) of one of its corners (L its longest edge: the
+// circumradius bound, half L for an obtuse triangle), and every corner is a root of the model on
+// its grid edge, moved off the edge's end by at most endGuard of the edge (sqrt(3) voxels for the
+// body diagonal) and, for a model with extremum nodes, placed where the search's value is within
+// its tolerance of 0 (a distance where |grad f| >= 1 near the surface, as for distance operands).
+// Triangles that a collapse made (flagged in mesh.carry) are left to the simplifier's bound.
+double rawMeshErrorBound(const Mesh& mesh, const Tape& tape, const GridSpec& grid, double endGuard = 1e-3);
 
 // Stitches pieces by key into one mesh, independent of the pieces' order and of the split.
 // Throws std::invalid_argument for a piece whose vertices are not sorted by key or whose

@@ -16,6 +16,8 @@ enum ExitCode : int {
   kExitPoisoned = 5,    // some bricks failed 3 times (named on stderr); no output, journal kept
   kExitInterrupted = 6, // SIGTERM/SIGINT: journal flushed, continue with --resume
   kExitFarmError = 7,   // the farm could not run (bind failed, no worker alive, CURVE keys, journal)
+  kExitUncertified = 8, // --strict: some extremum searches did not certify their tolerance; no output
+  kExitOpenMesh = 9,    // the merged mesh is not closed (a bug, named edge by edge); no output
 };
 
 // What a user reads after "frep --help".
