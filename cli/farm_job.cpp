@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <algorithm>
+#include <bitset>
 #include <fstream>
 #include <thread>
 #include <spdlog/spdlog.h>
@@ -170,6 +171,31 @@ std::string poisonedMessage(const farm::FarmReport& report) {
   return s + "\nthe other bricks are in the journal; fix the cause and run again with --resume";
 }
 }  // namespace
+
+std::string BoxCut::names() const {
+  std::string s;
+  for (int b = 0; b < 6; ++b)
+    if (faces & (1u << b)) s += std::string(s.empty() ? "" : ", ") + "xyz"[b / 2] + (b % 2 ? "-max" : "-min");
+  return s;
+}
+
+BoxCut findBoxCut(const LoadedModel& m, const GridSpec& grid, int threads, const std::string& what) {
+  BoxCut cut;
+  cut.faces = facesReached(Tape::compile(m.field, 3), grid, {}, threads);
+  if (cut.faces)
+    spdlog::warn("the solid is cut by the box's face{} {}: {}", std::bitset<6>(cut.faces).count() > 1 ? "s" : "",
+                 cut.names(), what);
+  return cut;
+}
+
+void setCutBox(farm::JobSpec& job, const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
+  job.clear_cut_lo();
+  job.clear_cut_hi();
+  for (int a = 0; a < 3; ++a) {
+    job.add_cut_lo(lo[a]);
+    job.add_cut_hi(hi[a]);
+  }
+}
 
 void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report, bool strict) {
   if (report.extremumUncertified > 0) {

@@ -46,6 +46,16 @@ void writeReport(io::AtomicOutput& reportOut, const farm::FarmReport& report);
 
 // An interrupted or poisoned job: writes the report and throws CliError with exit 6 (resume) or
 // 5 (the poisoned bricks named). Returns when the job is complete.
+// The faces of the grid's box that the solid reaches (facesReached), named "x-min, z-max".
+struct BoxCut {
+  unsigned faces = 0;
+  std::string names() const;
+};
+// Finds them and warns naming them (what the output does there: `what`).
+BoxCut findBoxCut(const LoadedModel& m, const GridSpec& grid, int threads, const std::string& what);
+// Sets the job's cut box (JobSpec cut_lo/cut_hi): its field becomes min(f, the box's faces).
+void setCutBox(farm::JobSpec& job, const std::array<double, 3>& lo, const std::array<double, 3>& hi);
+
 void requireComplete(io::AtomicOutput& reportOut, const farm::FarmReport& report, bool strict = false);
 
 // The same without a report or journal (frep render): throws CliError with exit 6 or 5.

@@ -6,7 +6,6 @@
 
 #include <cctype>
 #include <chrono>
-#include <bitset>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -109,14 +108,6 @@ int runMeshVdb(const MeshRequest& request) {
 
 }  // namespace
 
-// "x-min, z-max" for the faces of facesReached's bits.
-std::string faceNames(unsigned faces) {
-  std::string s;
-  for (int b = 0; b < 6; ++b)
-    if (faces & (1u << b)) s += std::string(s.empty() ? "" : ", ") + "xyz"[b / 2] + (b % 2 ? "-max" : "-min");
-  return s;
-}
-
 int runMesh(const MeshRequest& request) {
   if (hasVdbExtension(request.model.path)) return runMeshVdb(request);
   if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj, .stl, .wrl, .pov, .3mf, .glb) is required");
@@ -148,13 +139,10 @@ int runMesh(const MeshRequest& request) {
   // A solid cut by the box is meshed as solid ∩ box, capped on the faces that cut it (the field
   // min(f, box faces) on a grid one voxel larger on every side), unless --open-rim.
   const GridSpec userGrid = grid;
-  const unsigned cutFaces = facesReached(Tape::compile(m.field, 3), grid, {}, request.threads);
-  const bool capped = cutFaces != 0 && !request.openRim;
-  if (cutFaces != 0)
-    spdlog::warn("the solid is cut by the box's face{} {}: {}", std::bitset<6>(cutFaces).count() > 1 ? "s" : "",
-                 faceNames(cutFaces),
-                 capped ? "the mesh is capped there (solid ∩ box); --open-rim leaves it open"
-                        : "the mesh is open there (--open-rim)");
+  const BoxCut cut = findBoxCut(m, grid, request.threads,
+                                request.openRim ? "the mesh is open there (--open-rim)"
+                                                : "the mesh is capped there (solid ∩ box); --open-rim leaves it open");
+  const bool capped = cut.faces != 0 && !request.openRim;
   if (capped) {
     for (int a = 0; a < 3; ++a) {
       grid.origin[a] -= grid.voxel;
@@ -176,11 +164,14 @@ int runMesh(const MeshRequest& request) {
   // then fall inside the edges (not on the faces' grid points, where endGuard would push them
   // out), so every vertex lies in the box.
   const double capInset = 2e-3 * userGrid.voxel;
-  if (capped)
+  if (capped) {
+    std::array<double, 3> lo, hi;
     for (int a = 0; a < 3; ++a) {
-      job.mutable_mesh()->add_cap_lo(userGrid.origin[a] + capInset);
-      job.mutable_mesh()->add_cap_hi(userGrid.origin[a] + userGrid.voxel * (userGrid.dims[a] - 1) - capInset);
+      lo[a] = userGrid.origin[a] + capInset;
+      hi[a] = userGrid.origin[a] + userGrid.voxel * (userGrid.dims[a] - 1) - capInset;
     }
+    setCutBox(job, lo, hi);
+  }
   TapePtr tape = farm::compileJobModel(job);  // the workers' field, capped or not
   SimplifyOptions so;
   so.tolerance = request.tolerance >= 0 ? request.tolerance : tape->hasExtrema() ? 0.0 : 0.1;
@@ -218,14 +209,14 @@ int runMesh(const MeshRequest& request) {
   // simplification, so a fault anywhere in the pipeline is an error, never a silent file.
   uint64_t unpaired = 0;
   const std::string defect = closureDefect(mesh.triangles, mesh.positions.size(), &unpaired);
-  if (!defect.empty() && (capped || cutFaces == 0)) {  // --open-rim: open where the box cuts, by request
+  if (!defect.empty() && (capped || cut.faces == 0)) {  // --open-rim: open where the box cuts, by request
     writeReport(reportOut, report);
     throw CliError(kExitOpenMesh, "internal error: the merged mesh is not closed (" + std::to_string(unpaired) +
                                       " unpaired directed edges; first: " + defect +
                                       "); nothing written. Please report it with the command line");
   }
   report.vertices = mesh.positions.size();
-  report.cutFaces = faceNames(cutFaces);
+  report.cutFaces = cut.names();
   report.capped = capped;
   report.triangles = mesh.triangles.size();
   const double simplifySeconds =

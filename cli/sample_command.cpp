@@ -10,6 +10,7 @@
 #include "allocator_tuning.h"
 #include "arg_parse.h"
 #include "brick.h"
+#include "frep/io/world_lattice.h"
 #include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "curve.h"
@@ -66,8 +67,26 @@ int runSample(const SampleRequest& request) {
 
   io::AtomicOutput out("-O/--out", request.region.out);
   io::AtomicOutput reportOut("-O/--out (report)", request.region.out + ".report.json");
+  // A solid cut by the box is sampled as solid ∩ box: the field min(f, the box's faces) on the
+  // lattice grown by the band (and a voxel) on every side, so the level set closes on the faces.
+  const BoxCut cut = findBoxCut(m, grid, request.threads,
+                                "the level set is that of solid ∩ box, closed on those faces");
+  std::array<double, 3> cutLo{}, cutHi{};
+  if (cut.faces) {
+    Box grown = box;
+    const double margin = (request.band + 1) * grid.voxel;  // band + 1 lattice points more (rounded outward)
+    for (int a = 0; a < 3; ++a) {
+      cutLo[a] = grid.origin[a];
+      cutHi[a] = grid.origin[a] + grid.voxel * (grid.dims[a] - 1);
+      grown.lo[a] = cutLo[a] - margin;
+      grown.hi[a] = cutHi[a] + margin;
+    }
+    grid = io::worldLatticeGrid("-b/--bounds", grown.lo, grown.hi, grid.voxel);
+    checkJobSize(grid, options.brickVoxels);
+  }
   farm::JobSpec job = makeJob(m, request.model.path, grid, "sample");
   job.set_band(request.band);
+  if (cut.faces) setCutBox(job, cutLo, cutHi);
   spdlog::info("sampling '{}' on {}x{}x{} voxels of {}", m.model.objectName, grid.dims[0], grid.dims[1],
                grid.dims[2], grid.voxel);
   // The merge streams into the grid slab by slab as the slabs complete (the master never holds
@@ -78,8 +97,9 @@ int runSample(const SampleRequest& request) {
   options.sampleSink.leaves = [&](const std::vector<LeafBlock>& slab) { builder.addLeaves(slab); };
   jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
-  const farm::FarmReport& report = outcome.report;
+  farm::FarmReport& report = outcome.report;
   requireComplete(reportOut, report, request.farm.strict);
+  report.cutFaces = cut.names();
 
   io::VdbMetadata meta;
   meta.gridName = m.model.objectName;

@@ -1358,13 +1358,6 @@ std::string FarmReport::toJson() const {
   j["operation"] = operation;
   if (operation == "mesh") {
     j["output"] = {{"vertices", vertices}, {"triangles", triangles}, {"capped", capped}};
-    nlohmann::json cut = nlohmann::json::array();
-    for (size_t b = 0; b < cutFaces.size();) {
-      size_t e = cutFaces.find(", ", b);
-      cut.push_back(cutFaces.substr(b, e == std::string::npos ? std::string::npos : e - b));
-      b = e == std::string::npos ? cutFaces.size() : e + 2;
-    }
-    j["output"]["cut_faces"] = cut;
     j["surface_error_bound"] = surfaceErrorBound;
     if (simplifyTolerance > 0)
       j["output"]["simplification"] = {{"tolerance_voxels", simplifyTolerance},
@@ -1380,6 +1373,15 @@ std::string FarmReport::toJson() const {
   }
   else if (operation == "render") j["output"] = {{"pixels_hit", pixelsHit}};
   else j["output"] = {{"leaves", leaves}, {"tiles", tiles}};
+  if (operation != "render") {
+    nlohmann::json cut = nlohmann::json::array();
+    for (size_t b = 0; b < cutFaces.size();) {
+      size_t e = cutFaces.find(", ", b);
+      cut.push_back(cutFaces.substr(b, e == std::string::npos ? std::string::npos : e - b));
+      b = e == std::string::npos ? cutFaces.size() : e + 2;
+    }
+    j["output"]["cut_faces"] = cut;
+  }
   j["faults"] = {{"retries", retries},           {"duplicates", duplicates},
                  {"late_results", lateResults},  {"malformed", malformed},
                  {"oversized", oversized},       {"dead_workers", deadWorkers},

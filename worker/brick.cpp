@@ -114,6 +114,15 @@ Expr jobField(const JobSpec& job, uint32_t* dimsOut) {
 }  // namespace
 
 namespace {
+// min(f, every face of the box) that keeps a NaN of f a NaN (outside): min's operands are
+// reordered when nodes are shared, and min(plane, NaN) is the plane.
+Expr cutByBox(const Expr& f, const Vec3& lo, const Vec3& hi) {
+  Expr e = f;
+  for (uint32_t i = 0; i < 3; ++i)
+    for (const Expr& face : {Expr::x(i) - lo[i], hi[i] - Expr::x(i)}) e = select(ge(e, face), face, e);
+  return e;
+}
+
 Vec3 vec3(const google::protobuf::RepeatedField<double>& v, const char* name) {
   if (v.size() != 3) throw std::invalid_argument(std::string("job: ") + name + " needs 3 values");
   return {v[0], v[1], v[2]};
@@ -129,12 +138,12 @@ TapePtr compileJobModel(const JobSpec& job) {
   uint32_t dims = 0;
   Expr f = jobField(job, &dims);
   if (operationOf(job) == Operation::Render) return viewTape(f, cameraOf(job));
-  if (operationOf(job) == Operation::Mesh && (job.mesh().cap_lo_size() || job.mesh().cap_hi_size())) {
-    const Vec3 lo = vec3(job.mesh().cap_lo(), "cap_lo"), hi = vec3(job.mesh().cap_hi(), "cap_hi");
+  if (job.cut_lo_size() || job.cut_hi_size()) {
+    const Vec3 lo = vec3(job.cut_lo(), "cut_lo"), hi = vec3(job.cut_hi(), "cut_hi");
     for (int a = 0; a < 3; ++a)
       if (!(std::isfinite(lo[a]) && std::isfinite(hi[a]) && lo[a] < hi[a]))
-        throw std::invalid_argument("job: mesh cap box needs finite lo < hi on every axis");
-    f = clipToBox(f, lo, hi);  // solid ∩ box: capped where the box cuts the solid
+        throw std::invalid_argument("job: the cut box needs finite cut_lo < cut_hi on every axis");
+    f = cutByBox(f, lo, hi);  // solid ∩ box: closed where the box cuts the solid
   }
   return Tape::compile(f, std::min(dims, 3u));
 }

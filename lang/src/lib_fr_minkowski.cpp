@@ -140,6 +140,29 @@ const bool registered = registerAll({
 
 }  // namespace
 
+Expr registerHyperFunShape(const Expr& field, const std::vector<Expr>& xs, bool block,
+                           const std::vector<Expr>& place, const std::vector<Expr>& size) {
+  if (!identityCoords(xs) || place.size() < 3) return field;
+  Shape s;
+  s.kind = block ? ShapeKind::Block : ShapeKind::Sphere;
+  for (int i = 0; i < 3; ++i) {
+    if (!place[size_t(i)].isConst() || !std::isfinite(place[size_t(i)].constValue())) return field;
+    s.pos[size_t(i)] = place[size_t(i)].constValue();
+  }
+  for (size_t i = 0; i < size.size() && i < 3; ++i) {
+    // A block of zero edge or a ball of radius 0 is a flat or empty set: left to the search.
+    if (!size[i].isConst() || !(size[i].constValue() > 0) || !std::isfinite(size[i].constValue())) return field;
+    s.size[i] = size[i].constValue();
+  }
+  Sum sum = minkowski::sumOf(s);
+  if (!minkowski::reduce(sum).ok) return field;
+  ExactTerm t;
+  t.sum = sum;
+  t.pieces = 1;
+  minkowski::registerExact(field, t);
+  return field;
+}
+
 bool exactMinkowskiSum(const std::vector<const Arg*>& operands, const std::vector<Expr>& xs, Expr* out) {
   if (xs.size() < 3) return false;
   Sum total;

@@ -16,4 +16,11 @@ bool exactMinkowskiSum(const std::vector<const Arg*>& operands, const std::vecto
 // chain A' ⊖ B') and B an exact sum; false otherwise.
 bool exactMinkowskiDiff(const Arg& A, const Arg& B, const std::vector<Expr>& xs, Expr* out);
 
+// HyperFun's own primitives whose set is a basic set (hfSphere: a ball, hfBlock: a block; their
+// fields are sign-exact, not distances): registers `field` as that shape when it is read at the
+// plain coordinates with constant placement, so Minkowski operations take the exact algebra or
+// the offset path on models written the HyperFun way. Returns field.
+Expr registerHyperFunShape(const Expr& field, const std::vector<Expr>& xs, bool block,
+                           const std::vector<Expr>& place, const std::vector<Expr>& size);
+
 }  // namespace frep::lang

@@ -3,6 +3,7 @@
 #include <array>
 #include <string>
 
+#include "lib_fr_minkowski.h"
 #include "lib_hf_util.h"
 
 namespace frep::lang::hf {
@@ -75,7 +76,9 @@ Expr ellCone(const char* fn, std::vector<Arg>& a, int axis) {
 Expr sphere(std::vector<Arg>& a) {
   auto p = offset("hfSphere", a);
   Expr R = scalarArg("hfSphere", a, 2);
-  return R * R - p[0] * p[0] - p[1] * p[1] - p[2] * p[2];
+  // R^2 - |p|^2 >= 0 exactly on the ball |p| <= R: the exact Minkowski paths apply.
+  return registerHyperFunShape(R * R - p[0] * p[0] - p[1] * p[1] - p[2] * p[2], arrayAtLeast("hfSphere", a, 0, 3, "x"),
+                               false, arrayAtLeast("hfSphere", a, 1, 3, "center"), {R});
 }
 
 Expr ellipsoid(std::vector<Arg>& a) {
@@ -97,7 +100,9 @@ Expr block(std::vector<Arg>& a) {
       throw LibraryError(std::string(fn) + ": edge lengths must be >= 0", 2 + i);
     s[i] = (x[i] - v[i]) * (v[i] + d - x[i]);
   }
-  return rInter0(rInter0(s[0], s[1]), s[2]);
+  // Each slab product is >= 0 exactly on [v, v + d] and &0 is sign-exact: the set is the block.
+  return registerHyperFunShape(rInter0(rInter0(s[0], s[1]), s[2]), x, true, v,
+                               {scalarArg(fn, a, 2), scalarArg(fn, a, 3), scalarArg(fn, a, 4)});
 }
 
 // 1 - (|X|^(2/s2) + |Y|^(2/s2))^(s2/s1) - |Z|^(2/s1), X = dx/a, ...

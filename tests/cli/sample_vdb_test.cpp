@@ -160,8 +160,12 @@ TEST_F(FrepTest, SampleCountsNaNValues) {
   write("n.hf", "my_model(x[3], a[1]) { my_model = 0.5 - x[1]^0.5; }\n");
   RunResult r = run("sample n.hf -b 1 --res 16 -O n.vdb");
   ASSERT_EQ(r.code, 0) << r.err;
-  // Voxels with x < 0 (8 of 17 columns: -1..1 is the lattice of 2/15 from -8 to 8) are NaN; NaN widens every interval, so all are sampled.
-  EXPECT_NE(r.out.find("  NaN values 2312 (domain errors, stored as outside)\n"), std::string::npos) << r.out;
+  // The slab 0 <= x <= 0.25 is cut by the box's y and z faces, so the lattice grows by the band
+  // and a voxel (4 points) on every side: -12..12 in steps of 2/15. Voxels with x < 0 (12 of 25
+  // columns) are NaN, also outside the box (the cut keeps a NaN a NaN); NaN widens every
+  // interval, so all are sampled: 12 * 25 * 25.
+  EXPECT_NE(r.out.find("  NaN values 7500 (domain errors, stored as outside)\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("the solid is cut by the box's faces y-min, y-max, z-min, z-max"), std::string::npos) << r.err;
 }
 
 TEST_F(FrepTest, DefaultBrickKeepsTwoWorkersBusyWithTheSameBytes) {
