@@ -8,6 +8,7 @@
 
 #include "frep/extremum/extremum.h"
 #include "frep/geometry/field.h"
+#include "frep/minkowski_algebra/convex_polytope.h"
 #include "frep/minkowski_algebra/registry.h"
 
 namespace frep::minkowski {
@@ -81,15 +82,27 @@ Expr offsetField(const Expr& f, const Ball& b, bool erosion, ExactTerm t) {
   return r;
 }
 
+
+// An operand that is not an exact distance but an intersection of half-spaces is replaced by
+// its convex polytope's exact signed distance (same set: the sum's set is unchanged).
+Expr exactOperand(const Expr& field, Exactness& x) {
+  x = exactnessOf(field);
+  if (x.outside && x.inside) return field;
+  std::optional<ConvexPolytope> p = convexPolytopeOf(field);
+  if (!p) return field;
+  x = exactnessOf(p->field);
+  return p->field;
+}
+
 }  // namespace
 
 bool distanceBallSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
   if (dims != 3) return false;
   for (int k = 0; k < 2; ++k) {
-    const Expr& field = k == 0 ? a : b;
     std::optional<Ball> ball = ballOf(k == 0 ? b : a);
     if (!ball) continue;
-    Exactness x = exactnessOf(field);
+    Exactness x;
+    const Expr field = exactOperand(k == 0 ? a : b, x);
     if (!x.outside) continue;
     ExactTerm t;
     t.operand = x.what + " + " + ballText(*ball);
@@ -100,11 +113,13 @@ bool distanceBallSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
   return false;
 }
 
-bool distanceBallDifference(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
+bool distanceBallDifference(const Expr& a0, const Expr& b, uint32_t dims, Expr* out) {
   if (dims != 3) return false;
   std::optional<Ball> ball = ballOf(b);
-  Exactness x = exactnessOf(a);
-  if (!ball || !x.inside) return false;
+  if (!ball) return false;
+  Exactness x;
+  const Expr a = exactOperand(a0, x);
+  if (!x.inside) return false;
   ExactTerm t;
   t.operand = x.what + " - " + ballText(*ball);
   t.erosion = true;

@@ -1,0 +1,30 @@
+// A solid written as an intersection of half-spaces, recognised as the convex polytope it is,
+// so that Minkowski sums and differences with a ball take the exact offset path
+// (distance_offset.h) instead of the extremum search, whatever the orientation of its planes.
+//
+// A field is such an intersection when its min/max form (min_max_form.h: R-functions and
+// hfBlock's slab products become min, sign-exactly) is a min of affine functions of x, y, z:
+// min_i (n_i . X + d_i) >= 0. The polytope's vertices are the feasible intersections of three
+// planes; each plane that holds three or more of them is a facet, its vertices ordered around
+// their centroid and fanned into outward triangles. The result is the closed triangle mesh's
+// exact signed distance (MeshField), with the same set as the field: dist to a convex polytope
+// has no closed form from its planes (min_i of the plane distances is exact inside only).
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "frep/expressions/expr.h"
+
+namespace frep::minkowski {
+
+struct ConvexPolytope {
+  Expr field;       // the exact signed distance (positive inside) of the polytope
+  size_t planes = 0, facets = 0, vertices = 0;
+};
+
+// The polytope of `e` over x[0..2], or nothing when e is not (sign-exactly) a min of affine
+// functions, holds more than 64 planes, or is empty, flat or unbounded.
+std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e);
+
+}  // namespace frep::minkowski

@@ -1,0 +1,151 @@
+// Intersections of half-spaces as convex polytopes (convex_polytope.h).
+#include "frep/minkowski_algebra/convex_polytope.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "frep/expressions/min_max_form.h"
+#include "frep/geometry/distance_fields.h"
+
+namespace frep::minkowski {
+namespace {
+
+using Affine = std::array<double, 4>;  // a x + b y + c z + d
+
+// The coefficients of e when it is affine in x[0..2] (constants, coordinates, sums,
+// differences, negation, products and quotients with a constant).
+bool affineOf(const Expr& e, Affine& out) {
+  out = {0, 0, 0, 0};
+  switch (e.op()) {
+    case Op::Const:
+      out[3] = e.constValue();
+      return std::isfinite(out[3]);
+    case Op::Var:
+      if (e.node().index > 2) return false;
+      out[e.node().index] = 1;
+      return true;
+    case Op::Neg: {
+      if (!affineOf(e.arg(0), out)) return false;
+      for (double& c : out) c = -c;
+      return true;
+    }
+    case Op::Add:
+    case Op::Sub: {
+      Affine b;
+      if (!affineOf(e.arg(0), out) || !affineOf(e.arg(1), b)) return false;
+      for (int i = 0; i < 4; ++i) out[size_t(i)] += (e.op() == Op::Add ? 1 : -1) * b[size_t(i)];
+      return true;
+    }
+    case Op::Mul: {
+      const bool firstConst = e.arg(0).isConst();
+      if (!firstConst && !e.arg(1).isConst()) return false;
+      const double k = (firstConst ? e.arg(0) : e.arg(1)).constValue();
+      if (!affineOf(firstConst ? e.arg(1) : e.arg(0), out)) return false;
+      for (double& c : out) c *= k;
+      return std::isfinite(k);
+    }
+    case Op::Div: {
+      if (!e.arg(1).isConst() || !(std::abs(e.arg(1).constValue()) > 0)) return false;
+      if (!affineOf(e.arg(0), out)) return false;
+      for (double& c : out) c /= e.arg(1).constValue();
+      return true;
+    }
+    default:
+      return false;
+  }
+}
+
+// The half-spaces n . X + d >= 0 of a min of affine functions, normals scaled to unit length.
+bool halfSpaces(const Expr& e, std::vector<Affine>& planes) {
+  if (e.op() == Op::Min) return halfSpaces(e.arg(0), planes) && halfSpaces(e.arg(1), planes);
+  Affine a;
+  if (!affineOf(e, a)) return false;
+  const double len = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  if (!(len > 0)) return false;  // a constant: the whole space or nothing, not a polytope
+  for (double& c : a) c /= len;
+  planes.push_back(a);
+  return planes.size() <= 64;
+}
+
+bool solve3(const Affine& p, const Affine& q, const Affine& r, std::array<double, 3>& x) {
+  const double det = p[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (q[0] * r[2] - q[2] * r[0]) +
+                     p[2] * (q[0] * r[1] - q[1] * r[0]);
+  if (std::abs(det) < 1e-12) return false;
+  const double b[3] = {-p[3], -q[3], -r[3]};
+  x[0] = (b[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (b[1] * r[2] - q[2] * b[2]) + p[2] * (b[1] * r[1] - q[1] * b[2])) / det;
+  x[1] = (p[0] * (b[1] * r[2] - q[2] * b[2]) - b[0] * (q[0] * r[2] - q[2] * r[0]) + p[2] * (q[0] * b[2] - b[1] * r[0])) / det;
+  x[2] = (p[0] * (q[1] * b[2] - b[1] * r[1]) - p[1] * (q[0] * b[2] - b[1] * r[0]) + b[0] * (q[0] * r[1] - q[1] * r[0])) / det;
+  return std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
+}
+
+double eval(const Affine& a, const std::array<double, 3>& x) { return a[0] * x[0] + a[1] * x[1] + a[2] * x[2] + a[3]; }
+
+}  // namespace
+
+std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e) {
+  std::vector<Affine> planes;
+  if (!halfSpaces(minMaxForm(e), planes) || planes.size() < 4) return std::nullopt;
+  // Vertices: feasible intersections of three planes, merged within a tolerance of the extent.
+  std::vector<std::array<double, 3>> verts;
+  double scale = 1;
+  for (const Affine& p : planes) scale = std::max(scale, std::abs(p[3]));
+  const double tol = 1e-9 * scale;
+  for (size_t i = 0; i < planes.size(); ++i)
+    for (size_t j = i + 1; j < planes.size(); ++j)
+      for (size_t k = j + 1; k < planes.size(); ++k) {
+        std::array<double, 3> x;
+        if (!solve3(planes[i], planes[j], planes[k], x)) continue;
+        bool feasible = true;
+        for (const Affine& p : planes) feasible = feasible && eval(p, x) >= -tol;
+        if (!feasible) continue;
+        bool known = false;
+        for (const auto& v : verts)
+          known = known || (std::abs(v[0] - x[0]) <= tol && std::abs(v[1] - x[1]) <= tol && std::abs(v[2] - x[2]) <= tol);
+        if (!known) verts.push_back(x);
+      }
+  if (verts.size() < 4) return std::nullopt;
+  // Facets: the vertices on each plane, ordered by angle about their centroid, fanned outward
+  // (the outward normal is -n: inside is n . X + d >= 0).
+  std::vector<double> xyz;
+  for (const auto& v : verts) xyz.insert(xyz.end(), v.begin(), v.end());
+  std::vector<uint32_t> tris;
+  size_t facets = 0;
+  for (const Affine& p : planes) {
+    std::vector<uint32_t> on;
+    for (uint32_t v = 0; v < verts.size(); ++v)
+      if (std::abs(eval(p, verts[v])) <= 1e3 * tol) on.push_back(v);
+    if (on.size() < 3) continue;
+    std::array<double, 3> c{0, 0, 0};
+    for (uint32_t v : on)
+      for (int a = 0; a < 3; ++a) c[size_t(a)] += verts[v][size_t(a)] / double(on.size());
+    // A basis (u, w) of the plane with u x w = -n, so counter-clockwise in it is outward.
+    const std::array<double, 3> n{p[0], p[1], p[2]};
+    std::array<double, 3> u = std::abs(n[0]) < 0.9 ? std::array<double, 3>{0, -n[2], n[1]}
+                                                   : std::array<double, 3>{n[2], 0, -n[0]};
+    const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (double& x : u) x /= ul;
+    const std::array<double, 3> w{-(n[1] * u[2] - n[2] * u[1]), -(n[2] * u[0] - n[0] * u[2]), -(n[0] * u[1] - n[1] * u[0])};
+    std::vector<std::pair<double, uint32_t>> ring;
+    for (uint32_t v : on) {
+      const double dx = verts[v][0] - c[0], dy = verts[v][1] - c[1], dz = verts[v][2] - c[2];
+      ring.push_back({std::atan2(dx * w[0] + dy * w[1] + dz * w[2], dx * u[0] + dy * u[1] + dz * u[2]), v});
+    }
+    std::sort(ring.begin(), ring.end());
+    for (size_t t = 1; t + 1 < ring.size(); ++t) tris.insert(tris.end(), {ring[0].second, ring[t].second, ring[t + 1].second});
+    ++facets;
+  }
+  auto mesh = std::make_shared<MeshField>(xyz, tris, "convex polytope of " + std::to_string(facets) + " facets");
+  // An unbounded or flat intersection leaves open facets: not a polytope.
+  if (!mesh->check().closed() || !(mesh->volume() > 0)) return std::nullopt;
+  ConvexPolytope out;
+  out.field = fieldExpr(mesh, Expr::x(0), Expr::x(1), Expr::x(2));
+  out.planes = planes.size();
+  out.facets = facets;
+  out.vertices = verts.size();
+  return out;
+}
+
+}  // namespace frep::minkowski
