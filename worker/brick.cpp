@@ -282,7 +282,9 @@ std::string describeErrorBounds(const Tape& tape, std::vector<std::string>* line
       line = "grid search (eps " + std::to_string(s.eps) + " over " + std::to_string(s.numParams()) +
              " parameters): set inclusion A_d + B_d in M in A + B with d = " + std::to_string(d);
     } else {
-      line = "branch-and-bound: values within " + std::to_string(s.tolerance) +
+      char tol[32];
+      std::snprintf(tol, sizeof tol, "%g", s.tolerance);
+      line = "branch-and-bound: values within " + std::string(tol) +
              " of the extremum where the search certified it; sign-only searches certify the sign; searches that "
              "ran out of boxes are counted as uncertified, with the widest gap they left";
     }

@@ -152,6 +152,29 @@ TEST_F(FrepTest, MeshOfATwoDimensionalObjectIsItsPrism) {
   EXPECT_NE(mc::checkEdgePairs(o.triangles, o.positions.size()), "");
 }
 
+// A search that cannot certify its tolerance (1e-300: never) is counted, warned about with the
+// widest gap it left, and with --strict fails the job: exit 8, no mesh, the report written
+// (without --strict the same message is a warning and the mesh is written).
+TEST_F(FrepTest, UncertifiedSearchesWarnAndStrictFails) {
+  write("sweep.hf",
+        "ball(x[3], a[1]) { ball = 0.5 - sqrt(x[1]^2 + x[2]^2 + x[3]^2); }\n"
+        "px(x[1], a[1]) { px = -1 + 2 * x[1]; }\n"
+        "py(x[1], a[1]) { py = 0.3 * sin(6 * x[1]); }\n"
+        "pz(x[1], a[1]) { pz = 0; }\n"
+        "m(x[3], a[1]) { array o[2]; o = [0, 1e-300]; m = frSweep(x, ball, px, py, pz, 0, 1, o); }\n");
+  // 5^3 points: a few hundred searches of 20,000 boxes each (~4 CPU-s).
+  RunResult strict = run("mesh sweep.hf -o m -b 1.6 -g 5 --workers 0 --strict -O s.ply");
+  EXPECT_EQ(strict.code, 8) << strict.err;
+  EXPECT_NE(strict.err.find("extremum searches stopped at their box limit before certifying their tolerance; the "
+                            "widest gap left is"),
+            std::string::npos)
+      << strict.err;
+  EXPECT_NE(strict.err.find("--strict: nothing written"), std::string::npos) << strict.err;
+  EXPECT_NE(readText(path("s.ply.report.json")).find("\"widest_uncertified_gap\""), std::string::npos);
+  EXPECT_FALSE(fileExists(path("s.ply")));
+  EXPECT_TRUE(fileExists(path("s.ply.report.json")));
+}
+
 TEST_F(FrepTest, MeshRejectsBadArguments) {
   write("s.hf", kSphere);
   struct Case {
