@@ -11,10 +11,16 @@ Grids: most cases use --res 32, 64, 128 (256 for a few cheap ones). Cases whose 
 on lattice planes use --res 33, 65, 129 (257) over a box whose longest extent is 2: voxels 1/16,
 1/32, 1/64 (1/128), and every such face is a multiple of 1/16 from the box's minimum corner.
 frep mesh puts grid points at lo + i * voxel, voxel = longest extent / (res - 1); the box's
-longest axis (and its minimum faces) are therefore always lattice planes.
+longest axis (and its minimum faces) are therefore always lattice planes. The -b boxes around
+uncut solids leave at least 2.2 voxels of the coarsest grid on every side (margin()).
+
+slow=True: too slow for the suite's 5-minute budget (Minkowski morphs and radius offsets at the
+default search gap, two sweeps); run_suite.py runs them with --slow or when --only names them.
+Their families are covered in the budget by *_tol cases whose models give the search an explicit
+gap of 0.01 (gap=0.01 here), on grids 16-32 only (no 0.5 % check at 128).
 """
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -212,8 +218,10 @@ class Case:
     grids: tuple = (32, 64, 128)
     bbox: tuple = None  # the solid's own box (lo, hi), to check that -b holds it (None: cut cases)
     cut: bool = False   # the solid leaves -b: the expected mesh is solid n box, capped
+    cut_faces: tuple = ()  # the faces of the box it reaches, as frep names them ('x-min', ...)
     family: str = ''
-    tags: tuple = field(default_factory=tuple)
+    slow: bool = False  # too slow for the 5-minute budget: run with --slow (or --only NAME)
+    gap: float = 0.0    # an explicit search gap in the model's options: values may be that much low
 
 
 def pad(lo, hi, m=0.08):
@@ -233,11 +241,18 @@ BOX1 = (-1.0, -1.0, -1.0, 1.0, 1.0, 1.0)
 CASES = []
 
 
+def margin(lo, hi, grids):
+    """A margin m of at least 0.06 and 2.2 voxels of the coarsest grid: m >= 2.2 (L + 2m) / (g - 1)."""
+    L = max(h - l for l, h in zip(lo, hi))
+    g = min(grids)
+    return max(0.06, 2.2 * L / (g - 1 - 4.4))
+
+
 def add(**kw):
     c = Case(**kw)
-    if c.bbox is not None and not c.cut:
+    if c.bbox is not None and not c.cut and c.bounds != BOX1:
         lo, hi = c.bbox
-        c.bounds = c.bounds or pad(lo, hi)
+        c.bounds = pad(lo, hi, margin(lo, hi, c.grids))
     CASES.append(c)
     return c
 
@@ -278,11 +293,11 @@ F = 'steiner.hf'
 _box_case('steiner_frblock_frball', F, 'steiner',
           _shift((-0.43, -0.31, -0.22), (0.05, -0.03, 0.02)), _shift((0.47, 0.39, 0.28), (0.05, -0.03, 0.02)), 0.17,
           'Steiner: 0.9x0.7x0.5 box (+) ball 0.17 (frBlock, frBall at (0.05,-0.03,0.02)): abc + 2(ab+bc+ca)r + pi(a+b+c)r^2 + 4/3 pi r^3',
-          grids=FINE)
+          grids=(32, 64, 128))
 _box_case('steiner_hfblock_frball', F, 'steiner', (-0.37, -0.52, -0.29), (0.24, 0.53, 0.19), 0.22,
-          'Steiner: hfBlock 0.61x1.05x0.48 (+) frBall 0.22 (search)')
+          'Steiner: hfBlock 0.61x1.05x0.48 (+) frBall 0.22')
 _box_case('steiner_planes_hfsphere', F, 'steiner', (-0.2, -0.25, -0.55), (0.55, 0.2, 0.3), 0.2,
-          'Steiner: min/max box 0.75x0.45x0.85 (+) hfSphere 0.2 at (0.1,0,-0.05) (search)')
+          'Steiner: min/max box 0.75x0.45x0.85 (+) hfSphere 0.2 at (0.1,0,-0.05)')
 _R4 = (0.3, -0.2, 0.5)
 _c4 = (-0.2, -0.3, -0.1)
 _s4 = (0.8, 0.5, 0.3)
@@ -294,15 +309,18 @@ add(name='steiner_rotblock_frball', file=F, family='steiner',
     why='Steiner (rotation-invariant): 0.8x0.5x0.3 frBlock turned by Rz(0.5)Ry(-0.2)Rx(0.3) (+) frBall 0.12')
 _box_case('steiner_lines_frball', F, 'steiner', (-0.35, -0.2, -0.3), (0.35, 0.25, 0.3), 0.14,
           'Steiner: xline 0.7 (+) yline 0.45 (+) zline 0.6 = 0.7x0.45x0.6 box, (+) ball 0.14 (frMinkowskiSum)',
-          grids=FINE)
+          grids=(32, 64, 128))
 _ball_case('ballball_frball', F, 'steiner', (0.05, -0.08, 0.15), 0.63,
-           'ball 0.35 (+) ball 0.28 = ball 0.63 at c1 + c2 (frBall): 4/3 pi 0.63^3', grids=FINE)
+           'ball 0.35 (+) ball 0.28 = ball 0.63 at c1 + c2 (frBall): 4/3 pi 0.63^3', grids=(32, 64, 128))
 _ball_case('ballball_hfsphere', F, 'steiner', (0.1, 0.15, 0.02), 0.65,
-           'ball 0.4 (+) ball 0.25 = ball 0.65 at c1 + c2 (hfSphere, search): 4/3 pi 0.65^3')
+           'ball 0.4 (+) ball 0.25 = ball 0.65 at c1 + c2 (hfSphere): 4/3 pi 0.65^3')
 _box_case('offsetr_planes', F, 'steiner', (-0.5, -0.35, -0.2), (0.4, 0.3, 0.25), 0.15,
-          'frOffsetR 0.15 of a 0.9x0.65x0.45 min/max box = box (+) ball 0.15: Steiner')
+          'frOffsetR 0.15 of a 0.9x0.65x0.45 min/max box = box (+) ball 0.15: Steiner').slow = True
 _box_case('offsetr_hfblock', F, 'steiner', (-0.2, -0.25, -0.4), (0.35, 0.15, 0.35), 0.1,
-          'frOffsetR 0.1 of hfBlock 0.55x0.4x0.75 = box (+) ball 0.1: Steiner')
+          'frOffsetR 0.1 of hfBlock 0.55x0.4x0.75 = box (+) ball 0.1: Steiner').slow = True
+_box_case('offsetr_planes_tol', F, 'steiner', (-0.5, -0.35, -0.2), (0.4, 0.3, 0.25), 0.15,
+          'frOffsetR 0.15 (B&B gap 0.01) of a 0.9x0.65x0.45 min/max box = box (+) ball 0.15: Steiner',
+          grids=(16, 24, 32)).gap = 0.01
 
 # --- Sweeps ------------------------------------------------------------------------------------
 F = 'sweeps.hf'
@@ -314,7 +332,7 @@ add(name='sweep_torus', file=F, family='sweep',
     bbox=((-0.73, -0.73, -0.13), (0.73, 0.73, 0.23)), bounds=pad((-0.73, -0.73, -0.13), (0.73, 0.73, 0.23)),
     volume=2 * PI * PI * 0.55 * 0.18 ** 2, sdf=lambda p: sd_torus(p, (0, 0, 0.05), 0.55, 0.18),
     why='ball 0.18 swept around a circle of radius 0.55 (frSweep, cos/sin): torus, Pappus 2 pi^2 R r^2')
-add(name='sweep_halfarc', file=F, family='sweep',
+add(name='sweep_halfarc', file=F, family='sweep', slow=True,
     bbox=((-0.6, -0.35, -0.15), (0.7, 0.45, 0.15)), bounds=pad((-0.6, -0.35, -0.15), (0.7, 0.45, 0.15)),
     volume=PI * 0.5 * PI * 0.15 ** 2 + v_ball(0.15),
     sdf=lambda p: dist_arc(p, (0.05, -0.2, 0.0), 0.5, 0.0, PI) - 0.15,
@@ -322,11 +340,19 @@ add(name='sweep_halfarc', file=F, family='sweep',
 _box_case('sweep_block_line', F, 'sweep', (-0.5, -0.1, -0.15), (0.5, 0.15, 0.05), 0.0,
           'frBlock 0.3x0.25x0.2 swept by 0.7 along x (frSweep): the block 1.0x0.25x0.2')
 _Ro = math.sqrt(0.6 ** 2 + 0.1 ** 2)
-add(name='sweep_turn_annulus', file=F, family='sweep',
+add(name='sweep_turn_annulus', file=F, family='sweep', slow=True,
     bbox=((-_Ro, -_Ro, -0.15), (_Ro, _Ro, 0.2)), bounds=pad((-_Ro, -_Ro, -0.15), (_Ro, _Ro, 0.2)),
     volume=PI * (_Ro ** 2 - 0.25 ** 2) * 0.35,
     sdf=lambda p: sd_annulus_cyl(p, (0, 0, 0), 0.25, _Ro, -0.15, 0.2),
     why='block 0.25..0.6 x -0.1..0.1 x -0.15..0.2 turned a full turn about z (frSweep rotation): annulus pi (Ro^2 - Ri^2) h, Ro^2 = 0.6^2 + 0.1^2')
+_rh = math.sqrt(0.5 ** 2 + 0.1 ** 2)
+_ah = math.atan2(-0.1, 0.5)
+add(name='sweep_rotate_halfturn', file=F, family='sweep',
+    bbox=((-_rh - 0.15, -0.25, -0.15), (_rh + 0.15, _rh + 0.15, 0.15)),
+    bounds=pad((-_rh - 0.15, -0.25, -0.15), (_rh + 0.15, _rh + 0.15, 0.15)),
+    volume=PI * _rh * PI * 0.15 ** 2 + v_ball(0.15),
+    sdf=lambda p: dist_arc(p, (0.0, 0.0, 0.0), _rh, _ah, _ah + PI) - 0.15,
+    why='ball 0.15 at (0.5,-0.1,0) turned by pi about z (frSweep rotation only): Pappus pi rho pi r^2 + 4/3 pi r^3, rho^2 = 0.26')
 
 # --- Projections -------------------------------------------------------------------------------
 F = 'project.hf'
@@ -342,15 +368,15 @@ _ball_case('project_ball5', F, 'project', (-0.08, 0.11, 0.03), 0.4,
 # --- Erosions ----------------------------------------------------------------------------------
 F = 'erosion.hf'
 _box_case('erode_frblock_frball', F, 'erosion', (-0.35, -0.2, -0.25), (0.45, 0.3, 0.15), 0.0,
-          'frBlock 1.2x0.9x0.8 (-) frBall 0.2: (a-2r)(b-2r)(c-2r) = 0.8x0.5x0.4', grids=FINE)
+          'frBlock 1.2x0.9x0.8 (-) frBall 0.2: (a-2r)(b-2r)(c-2r) = 0.8x0.5x0.4', grids=(32, 64, 128))
 _box_case('erode_hfblock_hfsphere', F, 'erosion', (-0.35, -0.3, -0.25), (0.45, 0.2, 0.35), 0.0,
-          'hfBlock 1.1x0.8x0.9 (-) hfSphere 0.15 (search): 0.8x0.5x0.6')
+          'hfBlock 1.1x0.8x0.9 (-) hfSphere 0.15: 0.8x0.5x0.6')
 _box_case('erode_frblock_offball', F, 'erosion', (-0.35, -0.05, -0.43), (0.35, 0.35, 0.17), 0.0,
           'frBlock 1.0x0.7x0.9 (-) frBall 0.15 at c0 = (0.05,-0.1,0.08): the 0.7x0.4x0.6 box moved by -c0')
 _ball_case('erode_frball_frball', F, 'erosion', (0.14, -0.11, 0.1), 0.45,
            'frBall 0.7 (-) frBall 0.25: ball 0.45 at c1 - c2', grids=FINE)
 _ball_case('erode_hfsphere_hfsphere', F, 'erosion', (-0.13, 0.05, 0.05), 0.45,
-           'hfSphere 0.65 (-) hfSphere 0.2 (search): ball 0.45 at c1 - c2')
+           'hfSphere 0.65 (-) hfSphere 0.2: ball 0.45 at c1 - c2')
 
 # --- Minkowski morphs: ((1 - t) A) (+) (t B) ----------------------------------------------------
 F = 'morph.hf'
@@ -362,16 +388,23 @@ def _lerp(a, b, t):
 
 _box_case('morph_frblocks', F, 'morph',
           _lerp((-0.3, -0.2, -0.25), (-0.1, -0.5, -0.2), 0.35), _lerp((0.5, 0.2, 0.25), (0.2, 0.4, 0.4), 0.35), 0.0,
-          'frMorphMinkowski of frBlocks, t = 0.35: the box [(1-t) lo_A + t lo_B, (1-t) hi_A + t hi_B]')
+          'frMorphMinkowski of frBlocks, t = 0.35: the box [(1-t) lo_A + t lo_B, (1-t) hi_A + t hi_B]').slow = True
 _box_case('morph_hfblocks', F, 'morph',
           _lerp((-0.1, -0.4, -0.3), (-0.6, -0.1, -0.35), 0.6), _lerp((0.4, 0.5, 0.1), (0.4, 0.2, 0.45), 0.6), 0.0,
-          'frMorphMinkowski of hfBlocks, t = 0.6: the box of lerped corners')
+          'frMorphMinkowski of hfBlocks, t = 0.6: the box of lerped corners').slow = True
 _box_case('morph_ball_block', F, 'morph',
           _shift((-0.2, -0.15, -0.1), (0.05, 0.0, -0.05)), _shift((0.2, 0.15, 0.1), (0.05, 0.0, -0.05)), 0.25,
-          'frMorphMinkowski(frBall 0.5, frBlock 0.8x0.6x0.4, 0.5) = 0.4x0.3x0.2 box (+) ball 0.25: Steiner')
+          'frMorphMinkowski(frBall 0.5, frBlock 0.8x0.6x0.4, 0.5) = 0.4x0.3x0.2 box (+) ball 0.25: Steiner').slow = True
 _box_case('morph_hfsphere_planes', F, 'morph',
           _shift((-0.15, -0.09, -0.18), (-0.14, 0.07, 0.105)), _shift((0.18, 0.12, 0.06), (-0.14, 0.07, 0.105)), 0.42,
-          'frMorphMinkowski(hfSphere 0.6, min/max box 1.1x0.7x0.8, 0.3) = 0.33x0.21x0.24 box (+) ball 0.42: Steiner')
+          'frMorphMinkowski(hfSphere 0.6, min/max box 1.1x0.7x0.8, 0.3) = 0.33x0.21x0.24 box (+) ball 0.42: Steiner').slow = True
+_box_case('morph_frblocks_tol', F, 'morph',
+          _lerp((-0.3, -0.2, -0.25), (-0.1, -0.5, -0.2), 0.35), _lerp((0.5, 0.2, 0.25), (0.2, 0.4, 0.4), 0.35), 0.0,
+          'frMorphMinkowski of frBlocks, t = 0.35, B&B gap 0.01: the box of lerped corners', grids=(16, 24, 32)).gap = 0.01
+_box_case('morph_ball_block_tol', F, 'morph',
+          _shift((-0.2, -0.15, -0.1), (0.05, 0.0, -0.05)), _shift((0.2, 0.15, 0.1), (0.05, 0.0, -0.05)), 0.25,
+          'frMorphMinkowski(frBall 0.5, frBlock 0.8x0.6x0.4, 0.5), B&B gap 0.01 = 0.4x0.3x0.2 box (+) ball 0.25: Steiner',
+          grids=(16, 24)).gap = 0.01
 
 # --- Roerdink's basic-set sums -----------------------------------------------------------------
 F = 'roerdink.hf'
@@ -380,7 +413,7 @@ add(name='roerdink_block_zdisc', file=F, family='roerdink',
     bbox=((-0.5, -0.55, -0.2), (0.6, 0.35, 0.2)), bounds=pad((-0.5, -0.55, -0.2), (0.6, 0.35, 0.2)),
     volume=v_prism_rounded((0.7, 0.5, 0.4), 0.2),
     sdf=lambda p: sd_rounded_rect_prism(p, (-0.3, -0.35, -0.2), (0.4, 0.15, 0.2), 0.2),
-    why='frBlock 0.7x0.5x0.4 (+) frZDisc 0.2: rounded-rectangle prism lz (lx ly + 2(lx+ly) r + pi r^2)', grids=FINE)
+    why='frBlock 0.7x0.5x0.4 (+) frZDisc 0.2: rounded-rectangle prism lz (lx ly + 2(lx+ly) r + pi r^2)', grids=(32, 64, 128))
 add(name='roerdink_block_zdisc_ball', file=F, family='roerdink',
     bbox=((-0.6, -0.45, -0.25), (0.5, 0.5, 0.25)), bounds=pad((-0.6, -0.45, -0.25), (0.5, 0.5, 0.25)),
     volume=v_prism_rounded((0.6, 0.45, 0.3), 0.15, 0.1),
@@ -399,17 +432,17 @@ add(name='roerdink_discus', file=F, family='roerdink',
 # --- Solids cut by the grid's box (expected: solid n box, capped on the box faces) ---------------
 F = 'cut.hf'
 _k = 0.75 - (0.5 - 0.1)
-add(name='cut_ball_top', file=F, family='cut', cut=True, bounds=(-1.0, -1.0, -1.0, 1.0, 1.0, 0.5), grids=LATTICE,
+add(name='cut_ball_top', file=F, family='cut', cut=True, cut_faces=('z-max',), bounds=(-1.0, -1.0, -1.0, 1.0, 1.0, 0.5), grids=LATTICE,
     volume=v_ball(0.75) - v_cap(0.75, _k),
     sdf=lambda p: sd_ball_cut_top(p, (0.05, -0.1, 0.1), 0.75, 0.5),
     why='hfSphere 0.75 at z 0.1 under the box top z = 0.5: 4/3 pi R^3 - pi k^2 (3R - k)/3, k = 0.35')
-add(name='cut_cylinder_long', file=F, family='cut', cut=True, bounds=(-0.5, -0.6, -0.75, 0.7, 0.5, 0.75),
+add(name='cut_cylinder_long', file=F, family='cut', cut=True, cut_faces=('z-min', 'z-max'), bounds=(-0.5, -0.6, -0.75, 0.7, 0.5, 0.75),
     volume=PI * 0.4 ** 2 * 1.5, sdf=lambda p: sd_cylinder(p, (0.1, -0.05, 0), 0.4, -0.75, 0.75),
     why='hfCylinderZ 0.4 (z in [-2, 2]) in a box 1.5 high (its longest axis): pi R^2 1.5')
-add(name='cut_block_side', file=F, family='cut', cut=True, bounds=(-0.75, -0.5, -0.4, 0.75, 0.5, 0.4),
+add(name='cut_block_side', file=F, family='cut', cut=True, cut_faces=('x-max',), bounds=(-0.75, -0.5, -0.4, 0.75, 0.5, 0.4),
     volume=1.3 * 0.8 * 0.6, sdf=lambda p: sd_box(p, (-0.55, -0.4, -0.3), (0.75, 0.4, 0.3)),
     why='frBlock x from -0.55 to 1.45 in a box ending at x = 0.75 (its longest axis): 1.3 x 0.8 x 0.6')
-add(name='cut_torus_half', file=F, family='cut', cut=True, bounds=(-0.9, -0.9, 0.0, 0.9, 0.9, 0.3),
+add(name='cut_torus_half', file=F, family='cut', cut=True, cut_faces=('z-min',), bounds=(-0.9, -0.9, 0.0, 0.9, 0.9, 0.3),
     volume=PI * PI * 0.6 * 0.2 ** 2, sdf=lambda p: sd_torus_cut_below(p, (0, 0, 0), 0.6, 0.2, 0.0),
     why='hfTorusZ R 0.6 r 0.2 in a box whose bottom z = 0 is its mid-plane: half of 2 pi^2 R r^2')
 
@@ -418,14 +451,14 @@ F = 'primitives.hf'
 _box_case('prim_frblock_lattice', F, 'primitive', (-0.5625, -0.375, -0.25), (0.4375, 0.375, 0.375), 0.0,
           'frBlock 1.0x0.75x0.625, every face on a lattice plane: abc', grids=LATTICE_FINE, bounds=BOX1)
 _box_case('prim_hfblock_lattice', F, 'primitive', (-0.25, -0.6875, -0.4375), (0.625, 0.4375, 0.0625), 0.0,
-          'hfBlock 0.875x1.125x0.5, every face on a lattice plane: abc', grids=LATTICE_FINE, bounds=BOX1)
+          'hfBlock 0.875x1.125x0.5, every face on a lattice plane: abc', grids=LATTICE, bounds=BOX1)
 _box_case('prim_planes_lattice', F, 'primitive', (-0.8125, -0.5, -0.125), (0.3125, 0.5625, 0.75), 0.0,
           'min/max of planes 1.125x1.0625x0.875, every face on a lattice plane: abc', grids=LATTICE, bounds=BOX1)
 add(name='prim_cylinder_lattice', file=F, family='primitive', bounds=BOX1, grids=LATTICE,
     bbox=((-0.36, -0.54, -0.5), (0.5, 0.32, 0.625)),
     volume=PI * 0.43 ** 2 * 1.125, sdf=lambda p: sd_cylinder(p, (0.07, -0.11, 0), 0.43, -0.5, 0.625),
     why='hfCylinderZ 0.43 & slab -0.5 <= z <= 0.625 (caps on lattice planes): pi R^2 h')
-add(name='prim_block_on_boxface', file=F, family='primitive', bounds=BOX1, grids=LATTICE, cut=True,
+add(name='prim_block_on_boxface', file=F, family='primitive', bounds=BOX1, grids=LATTICE, cut=True, cut_faces=('x-min',),
     volume=1.25 * 1.0 * 0.75, sdf=lambda p: sd_box(p, (-1.0, -0.5, -0.375), (0.25, 0.5, 0.375)),
     why='frBlock 1.25x1.0x0.75 whose face x = -1 is the grid box face (f = 0 on those grid points): abc')
 _ball_case('prim_ball', F, 'primitive', (0.13, -0.07, 0.21), 0.61, 'hfSphere 0.61: 4/3 pi R^3', grids=FINE)

@@ -2,33 +2,43 @@
 """Geometry acceptance suite: closed-form solids meshed by `frep mesh`, checked against their
 exact volumes and signed distances (cases.py; models in models/).
 
-Usage: run_suite.py FREP_BINARY [--quick] [--only NAME[,NAME...]] [--jobs N] [--keep DIR]
-                    [--eval-check N]
+Usage: run_suite.py FREP_BINARY [--quick] [--slow] [--only NAME[,NAME...]] [--jobs N]
+                    [--keep DIR] [--eval-check N]
 
 For every case and grid (--res), `frep mesh MODEL -o NAME -b BOUNDS --res N -O out.ply
 --no-progress` runs twice, with --workers 2 and --workers 0; then:
-  - exit code 0, no "warning" on stdout or stderr;
+  - exit code 0; no warning on stdout or stderr, except the expected "the solid is cut by the
+    box's face(s) ...: the mesh is capped" on a cut case, naming exactly its faces (elsewhere, or
+    naming other faces, it fails); "N extremum searches stopped at their box limit" is printed as
+    a note; any other warning fails;
   - the two PLY files are byte-identical;
   - the PLY (binary, header parsed generically) is watertight and consistently oriented:
     every directed edge once and its reverse once; no degenerate (zero-area) triangle;
-    positive signed volume;
+    positive signed volume; the report's cut_faces are the case's;
   - volume error against the closed form <= 0.5 % at the 128 grid (--res 128 or 129), and
-    |error| at the finest grid <= |error| at the coarsest;
+    |error| at the finest grid <= |error| at the coarsest + a slack: the volume of a shell 2e-3
+    voxel thick over the finest mesh, at least 0.01 percentage points (flat-faced solids can mesh
+    exactly at a coarse grid, and the mesher keeps vertices 1e-3 of an edge off grid points);
   - max |exact signed distance| over the vertices and 10 barycentric points per triangle <= the
     report's `surface_error_bound` (out.ply.report.json; a missing key is a failure).
-For a solid cut by the box the exact surface is that of solid n box (capped on the box faces);
-an open mesh's volume is also given with its boundary loops capped on the box faces ("capped").
+For a solid cut by the box the exact surface is that of solid n box, capped on the box's faces;
+an open mesh's volume is judged with its boundary loops capped on the box faces ("capped").
+
+Cases marked slow in cases.py (Minkowski morphs and radius offsets at the default search gap,
+...) are left out unless --slow is given or --only names them; a few cases run on grids below
+128 only (their families are too slow at 128 for the 5-minute budget) and get no 0.5 % check.
+Independent cases run --jobs (2) at a time, the most expensive first.
 
 Prints one table per case and a summary; exits 1 if any check fails (naming case, grid, check).
---quick: grids 32 and 64 only (or 33 and 65), no 0.5 % check. --eval-check N: instead of
-meshing, compare `frep eval` at N points per case with the closed form (sign everywhere, the value
-where the model's field is an exact distance) - a check of the models themselves.
+--quick: the grids below 100 only (no 0.5 % check). --keep DIR: keep the meshes and reports.
+--eval-check N: instead of meshing, compare `frep eval` at N random points and N points 0.004
+either side of the surface per case with the closed form (the sign everywhere; |f + sdf| is
+printed, 0 where the model's field is an exact distance) - a check of the models themselves.
 """
 import argparse
 import concurrent.futures as cf
 import fnmatch
 import json
-import math
 import os
 import re
 import shutil
@@ -41,10 +51,14 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 import cases as C  # noqa: E402
 
 MODELS = os.path.join(HERE, 'models')
 VOLUME_TOL = 0.5  # percent, at the 128 grid
+SLACK = 0.01  # percentage points: |error| at the finest grid <= |error| at the coarsest + SLACK
+FLOOR = 0.1  # percentage points: an error below it at the finest grid always passes that check
+GUARD = 2e-3  # voxels: or + the volume of a shell this thick over the finest mesh, if larger
 BARY = np.array([[1 / 3, 1 / 3, 1 / 3],
                  [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3],
                  [1 / 6, 5 / 12, 5 / 12], [5 / 12, 1 / 6, 5 / 12], [5 / 12, 5 / 12, 1 / 6],
@@ -175,24 +189,58 @@ def sample_points(P, T):
 # Running frep
 
 
+RUN_TIMEOUT = 600  # seconds for one frep run
+
+
 def run_frep(frep, case, res, workers, out):
     cmd = [frep, 'mesh', os.path.join(MODELS, case.file), '-o', case.name,
            '-b', ','.join(repr(float(v)) for v in case.bounds), '--res', str(res), '-O', out,
            '--no-progress', '--workers', str(workers)]
     for attempt in range(6):
         t0 = time.time()
-        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        dt = time.time() - t0
-        text = p.stdout + p.stderr
-        # the binary being rebuilt under us: wait and retry
-        if p.returncode != 0 and ('Text file busy' in text or not os.path.exists(frep)):
+        try:
+            p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               timeout=RUN_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            return 'timeout', 'frep timed out after %d s' % RUN_TIMEOUT, time.time() - t0, cmd
+        except OSError as e:  # the binary being rebuilt under us (text file busy, missing)
+            text = 'cannot run %s: %s' % (frep, e)
             time.sleep(60)
             continue
-        if p.returncode == 126 or p.returncode == 127:
+        dt = time.time() - t0
+        text = p.stdout + p.stderr
+        # frep-worker being rebuilt (local workers cannot start), or a shell's exec failure
+        rebuilt = (p.returncode == 7 and 'worker' in text) or p.returncode in (126, 127) or 'Text file busy' in text
+        if rebuilt and attempt < 5:
             time.sleep(60)
             continue
         return p.returncode, text, dt, cmd
-    return p.returncode, text, dt, cmd
+    return 'not run', text, 0.0, cmd
+
+
+def classify_warnings(text, case):
+    """frep's warnings, each ('fail' | 'note', line). The cut warning ("the solid is cut by the
+    box's face(s) F: the mesh is capped there") is expected on a cut case naming exactly its faces,
+    a failure anywhere else; a warning about open edges or an open mesh is a failure; a search
+    that stopped before its tolerance is a note (also in the report); anything else fails."""
+    out = []
+    for l in text.splitlines():
+        if 'warn' not in l.lower():
+            continue
+        l = l.strip()
+        m = re.search(r"cut by the box's faces? (.*?): the mesh is capped", l)
+        if m:
+            faces = tuple(f.strip() for f in m.group(1).split(','))
+            if case.cut and sorted(faces) == sorted(case.cut_faces):
+                continue
+            out.append(('fail', l + ' [expected: %s]' % (', '.join(case.cut_faces) or 'no cut face')))
+        elif re.search(r'\bopen\b|open edge|not closed|not watertight', l, re.I):
+            out.append(('fail', l))
+        elif 'extremum searches stopped' in l:
+            out.append(('note', l))
+        else:
+            out.append(('fail', l))
+    return out
 
 
 def check_grid(frep, case, res, tmp):
@@ -204,13 +252,16 @@ def check_grid(frep, case, res, tmp):
     rc0, text0, t0, _ = run_frep(frep, case, res, 0, out0)
     row['cmd'] = ' '.join(cmd2)
     row['s2'], row['s0'] = t2, t0
+    row['notes'] = []
     for rc, text, w in ((rc2, text2, 2), (rc0, text0, 0)):
         if rc != 0:
-            msg = ' | '.join(l for l in text.splitlines() if 'error' in l.lower())[:300]
-            row['fail'].append('exit %d with --workers %d: %s' % (rc, w, msg))
-        warn = [l.strip() for l in text.splitlines() if 'warn' in l.lower()]
-        if warn:
-            row['fail'].append('warning with --workers %d: %s' % (w, warn[0][:200]))
+            msg = ' | '.join(l for l in text.splitlines() if 'error' in l.lower() or 'timed out' in l)[:300]
+            row['fail'].append('exit %s with --workers %d: %s' % (rc, w, msg))
+        for kind, line in classify_warnings(text, case):
+            if kind == 'fail':
+                row['fail'].append('warning with --workers %d: %s' % (w, line[:240]))
+            elif w == 2:
+                row['notes'].append(line[:240])
     if rc2 != 0 or not os.path.exists(out2):
         return row
     if os.path.exists(out0) and open(out2, 'rb').read() != open(out0, 'rb').read():
@@ -242,6 +293,7 @@ def check_grid(frep, case, res, tmp):
     repeated = (T[:, 0] == T[:, 1]) | (T[:, 1] == T[:, 2]) | (T[:, 0] == T[:, 2])
     degenerate = int((repeated | (area <= 1e-12 * voxel * voxel)).sum())
     row['min_area_vox'] = float(area.min() / voxel ** 2)
+    row['area'] = float(area.sum())
     if degenerate:
         row['fail'].append('%d degenerate triangles (zero area; smallest %.3g voxel^2)' %
                            (degenerate, row['min_area_vox']))
@@ -265,6 +317,13 @@ def check_grid(frep, case, res, tmp):
         rep = {}
         row['fail'].append('no report: %s' % e)
     row['simp_bound'] = rep.get('output', {}).get('simplification', {}).get('error_bound')
+    faces = tuple(rep.get('output', {}).get('cut_faces', []) or ())
+    if sorted(faces) != sorted(case.cut_faces):
+        row['fail'].append("report's cut_faces %s, expected %s" % (list(faces), list(case.cut_faces)))
+    ext = rep.get('extremum', {})
+    if ext.get('uncertified'):
+        row['notes'].append('report: %d uncertified extremum searches, widest gap %s' %
+                            (ext['uncertified'], ext.get('widest_uncertified_gap')))
     bound = rep.get('surface_error_bound')
     row['bound'] = bound
     if bound is None:
@@ -293,11 +352,20 @@ def run_case(frep, name, grids, keep):
                 r['fail'].append('volume error %+.3f %% > %.1f %%%s' %
                                  (r['eff_err'], VOLUME_TOL, ' (open mesh, rims capped)' if 'err_capped' in r else ''))
         done = [r for r in rows if 'eff_err' in r]
-        # slack of 0.001 percentage points: exact meshes (a block's 12 triangles) differ only by
-        # float32 rounding from grid to grid
-        if len(done) >= 2 and abs(done[-1]['eff_err']) > abs(done[0]['eff_err']) + 1e-3:
-            fails.append('volume error at the finest grid (%d: %+.4f %%) exceeds the coarsest (%d: %+.4f %%)' %
-                         (done[-1]['grid'], done[-1]['eff_err'], done[0]['grid'], done[0]['eff_err']))
+        if len(done) >= 2:
+            # slack: meshes of flat-faced solids can be exact at a coarse grid; at the finest a
+            # vertex may still sit up to GUARD voxel off the surface (the mesher's end guard of
+            # 1e-3 of an edge up to sqrt(3) voxels long, the caps' 2e-3 voxel inset): that shell's
+            # volume, at least SLACK percentage points
+            fine = done[-1]
+            slack = max(SLACK, 100.0 * GUARD * fine['voxel'] * fine['area'] / case.volume)
+            # below FLOOR the error has converged into the mesher's own noise (a crease that
+            # falls within a hundredth of a voxel of lattice points is chamfered up to half a
+            # voxel at one grid and not another): "falling" is judged above it
+            if abs(fine['eff_err']) > max(abs(done[0]['eff_err']) + slack, FLOOR):
+                fails.append('volume error at the finest grid (%d: %+.4f %%) exceeds the coarsest (%d: %+.4f %%) '
+                             'by more than %.4f' % (fine['grid'], fine['eff_err'], done[0]['grid'],
+                                                    done[0]['eff_err'], slack))
         return {'case': case.name, 'rows': rows, 'case_fail': fails}
     finally:
         if keep:
@@ -330,7 +398,9 @@ HEAD = '  %5s %9s %10s %26s %10s %8s %10s %10s %-13s %6s %6s' % (
 
 
 def print_case(case, res):
-    print('\n%s  [%s, %s]  exact V = %.6f' % (case.name, case.family, case.file, case.volume))
+    print('\n%s  [%s, %s]  exact V = %.6f%s' % (case.name, case.family, case.file, case.volume,
+                                                 '' if set(case.grids) & {128, 129} else
+                                                 '  (grids below 128: no 0.5 % volume check)'))
     print('  ' + case.why)
     print('  -b %s' % ','.join(repr(float(v)) for v in case.bounds))
     print(HEAD)
@@ -338,6 +408,10 @@ def print_case(case, res):
         print(fmt_row(r))
         for f in r['fail']:
             print('      FAIL: %s' % f)
+        if r['fail']:
+            print('      (repeat: %s)' % r.get('cmd', ''))
+        for n in r.get('notes', []):
+            print('      note: %s' % n)
     for f in res['case_fail']:
         print('    FAIL: %s' % f)
     sys.stdout.flush()
@@ -357,12 +431,13 @@ def eval_at(frep, case, pt):
 
 
 def eval_check(frep, case, n, rng):
-    """n random points of the box with |sdf| > 0.01, and n points 0.004 either side of the
-    surface (bisected on the closed form between random inside and outside points)."""
+    """n random points of the box with |sdf| > 0.01, and n points 0.004 (plus twice the case's
+    search gap) either side of the surface (bisected on the closed form between random inside and
+    outside points)."""
     lo, hi = np.array(case.bounds[:3]), np.array(case.bounds[3:])
     q = lo + (hi - lo) * rng.random((20000, 3))
     d = case.sdf(q)
-    far = q[np.abs(d) > 0.01][:n]
+    far = q[np.abs(d) > 0.01 + 2 * case.gap][:n]
     ins, outs = q[d < -0.01], q[d > 0.01]
     near = []
     for k in range(4 * n):
@@ -377,9 +452,10 @@ def eval_check(frep, case, n, rng):
                 b = m
         u = (b - a) / max(np.linalg.norm(b - a), 1e-300)
         s = (a + b) / 2
-        cand = [s - 0.004 * u / np.linalg.norm(u), s + 0.004 * u / np.linalg.norm(u)]
+        off = 0.004 + 2 * case.gap  # a search with an explicit gap may read that much low
+        cand = [s - off * u / np.linalg.norm(u), s + off * u / np.linalg.norm(u)]
         for c in cand:
-            if abs(case.sdf(c[None])[0]) > 0.0015:
+            if abs(case.sdf(c[None])[0]) > 0.0015 + case.gap:
                 near.append(c)
     pts = np.array(list(far) + near[:n])
     d = case.sdf(pts)
@@ -404,12 +480,14 @@ def main():
     ap.add_argument('--jobs', type=int, default=2)
     ap.add_argument('--keep', default='')
     ap.add_argument('--eval-check', type=int, default=0)
+    ap.add_argument('--slow', action='store_true', help='also the cases marked slow')
     a = ap.parse_args()
     frep = os.path.abspath(a.frep)
-    selected = C.CASES
+    selected = [c for c in C.CASES if a.slow or not c.slow]
     if a.only:
         pats = a.only.split(',')
-        selected = [c for c in C.CASES if any(fnmatch.fnmatch(c.name, p) for p in pats)]
+        selected = [c for c in C.CASES if any(fnmatch.fnmatch(c.name, p) for p in pats)
+                    and (a.slow or not c.slow or c.name in pats)]
         if not selected:
             print('no case matches %s; cases: %s' % (a.only, ' '.join(c.name for c in C.CASES)))
             return 2
@@ -432,9 +510,9 @@ def main():
     for c in selected:
         grids = [g for g in c.grids if g < 100] if a.quick else list(c.grids)
         jobs.append((c, grids))
-    # longest first (the search-based cases and the fine grids), so the pool's tail is short
+    # longest first, so that the pool's tail is short
     est = {c.name: i for i, c in enumerate(selected)}
-    jobs.sort(key=lambda j: -COST.get(j[0].name, 1.0) * (8 if 256 in j[1] or 257 in j[1] else 1) - est[j[0].name] * 1e-6)
+    jobs.sort(key=lambda j: (-COST.get(j[0].name, 1.0), est[j[0].name]))
     results = {}
     with cf.ProcessPoolExecutor(max_workers=max(1, a.jobs)) as ex:
         futs = {ex.submit(run_case, frep, c.name, g, a.keep): c for c, g in jobs}
@@ -469,9 +547,12 @@ def main():
     return 0
 
 
-# Relative cost of each case (seconds of both runs at all grids, measured), to start the
-# expensive ones first; unlisted cases count 1.
-COST = {}
+# Seconds of both runs at all grids (measured 2026-12-06, 2 cores shared, load ~3), to start the
+# expensive cases first so that the pool's tail is short; unlisted cases count 1.
+COST = {'sweep_torus': 30, 'steiner_planes_hfsphere': 27, 'morph_ball_block_tol': 25, 'sweep_rotate_halfturn': 19,
+        'sweep_halfarc': 16, 'prim_ball': 14, 'prim_torus': 12, 'sweepkeys_capsule': 12.5, 'project_capsule4': 11,
+        'project_ball5': 11, 'erode_frball_frball': 10, 'project_box4': 10, 'project_ball4': 10,
+        'prim_frblock_lattice': 10, 'morph_frblocks_tol': 10, 'offsetr_planes_tol': 8}
 
 if __name__ == '__main__':
     sys.exit(main())

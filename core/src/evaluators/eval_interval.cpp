@@ -68,6 +68,13 @@ Interval IntervalEvaluator::eval(const Tape& tape, const Interval* box) {
       if (e.spec->method == ExtremumMethod::BranchAndBound) {
         if (e.spec->kind == ExtremumKind::Max) b.lo -= e.spec->tolerance;
         else b.hi += e.spec->tolerance;
+      } else {
+        // The grid search's value is a real body value, so it can fall short of a maximum by
+        // any amount the grid misses (L * delta for an L-Lipschitz body, L unknown here): only
+        // the other side decides signs, or a brick whose box said "inside" would disagree with
+        // its neighbour's search at the same point and the mesh would open at the seam.
+        if (e.spec->kind == ExtremumKind::Max) b.lo = -INFINITY;
+        else b.hi = INFINITY;
       }
       r[ins.out] = b;
       continue;
