@@ -25,6 +25,7 @@
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 #include "frep/meshing/mesh.h"
+#include "frep/primitives/ops.h"
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/sampling/sample.h"
 
@@ -47,6 +48,7 @@ struct Model {
   std::vector<double> params;
   double iso = 0;
   TapePtr tape;  // f - iso over the model's coordinates, parameters bound
+  Expr field;    // ... as an expression (mesh() cuts it by its box)
 };
 
 Model compileModel(const std::string& source, const std::string& file, const std::string& object,
@@ -73,7 +75,8 @@ Model compileModel(const std::string& source, const std::string& file, const std
   m.sourceHash = r.model.sourceHash;
   m.params = params;
   m.iso = iso;
-  m.tape = Tape::compile(lang::fieldOf(r.model, spec), uint32_t(std::max(m.dims, 3)));
+  m.field = lang::fieldOf(r.model, spec);
+  m.tape = Tape::compile(m.field, uint32_t(std::max(m.dims, 3)));
   return m;
 }
 
@@ -211,13 +214,28 @@ PyMesh meshModel(const Model& m, std::array<double, 3> lo, std::array<double, 3>
   options.fixedCoords = fixedCoordsOf(m, fixed);
   PyMesh out;
   py::gil_scoped_release unlocked;
-  out.mesh = meshGrid(m.tape, grid, options);
+  // As frep mesh: a solid cut by the box is meshed as solid ∩ box, capped 2e-3 voxel inside the
+  // box's faces on a grid one voxel larger, and the result must be closed.
+  TapePtr tape = m.tape;
+  if (facesReached(m.tape, grid, options.fixedCoords) != 0) {
+    std::array<double, 3> cutLo, cutHi;
+    for (int a = 0; a < 3; ++a) {
+      cutLo[a] = grid.origin[a] + 2e-3 * grid.voxel;
+      cutHi[a] = grid.origin[a] + grid.voxel * (grid.dims[a] - 1) - 2e-3 * grid.voxel;
+      grid.origin[a] -= grid.voxel;
+      grid.dims[a] += 2;
+    }
+    tape = Tape::compile(cutByBox(m.field, cutLo, cutHi), m.tape->numVars());
+  }
+  out.mesh = meshGrid(tape, grid, options);
   if (simplify > 0) {
     SimplifyOptions s;
     s.tolerance = simplify;
     s.fixedCoords = options.fixedCoords;
-    out.errorBound = simplifyMesh(out.mesh, m.tape, grid, s).errorBound;
+    out.errorBound = simplifyMesh(out.mesh, tape, grid, s).errorBound;
   }
+  const std::string defect = closureDefect(out.mesh.triangles, out.mesh.positions.size());
+  if (!defect.empty()) throw std::runtime_error("internal error: the mesh is not closed (" + defect + ")");
   return out;
 }
 

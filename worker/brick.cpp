@@ -11,6 +11,7 @@
 #include "leaf_expand.h"
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/minkowski_algebra/registry.h"
+#include "frep/primitives/ops.h"
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 
@@ -114,15 +115,6 @@ Expr jobField(const JobSpec& job, uint32_t* dimsOut) {
 }  // namespace
 
 namespace {
-// min(f, every face of the box) that keeps a NaN of f a NaN (outside): min's operands are
-// reordered when nodes are shared, and min(plane, NaN) is the plane.
-Expr cutByBox(const Expr& f, const Vec3& lo, const Vec3& hi) {
-  Expr e = f;
-  for (uint32_t i = 0; i < 3; ++i)
-    for (const Expr& face : {Expr::x(i) - lo[i], hi[i] - Expr::x(i)}) e = select(ge(e, face), face, e);
-  return e;
-}
-
 Vec3 vec3(const google::protobuf::RepeatedField<double>& v, const char* name) {
   if (v.size() != 3) throw std::invalid_argument(std::string("job: ") + name + " needs 3 values");
   return {v[0], v[1], v[2]};

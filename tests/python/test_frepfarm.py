@@ -215,6 +215,24 @@ def test_sphere_mesh_is_watertight_and_on_the_surface():
     assert 0 < 4 / 3 * math.pi * R ** 3 - vol < 0.01 * 4 / 3 * math.pi * R ** 3  # chords cut inside
 
 
+def test_a_sphere_cut_by_the_box_is_capped_and_closed():
+    # As frep mesh: the solid cut by the box's top face is meshed as solid ∩ box, capped
+    # just inside that face; closed, every vertex in the box, the volume of the ball minus its cap.
+    m = sphere()
+    top = 0.25 * R
+    lo, hi = (-1.2, -1.2, -1.2), (1.2, 1.2, top)
+    mesh = m.mesh(lo, hi, res=49)
+    v, t = mesh.vertices, mesh.triangles
+    edges = check_closed(t, len(v))
+    assert len(v) - edges + len(t) == 2
+    voxel = 2.4 / 48
+    grid_top = voxel * math.ceil(top / voxel - 1e-9)  # the world lattice, the box rounded outward
+    assert grid_top - 3e-3 * voxel <= v[:, 2].max() <= grid_top
+    h = R - grid_top
+    exact = 4 / 3 * math.pi * R ** 3 - math.pi * h * h * (3 * R - h) / 3
+    assert abs(enclosed_volume(v, t) - exact) < 0.01 * exact
+
+
 def test_block_simplifies_to_twelve_exact_triangles(tmp_path):
     m = frepfarm.compile(BLOCK)
     # The box puts no lattice plane on a face: with faces exactly on grid points (box -1..1,

@@ -352,4 +352,11 @@ Expr morphLinear(const Expr& f1, const Expr& f2, const Expr& beta) {
   return beta * f1 + (1.0 - beta) * f2;  // written out: 1 − (1 − β) would round
 }
 
+Expr cutByBox(const Expr& f, const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
+  Expr e = f;
+  for (uint32_t i = 0; i < 3; ++i)
+    for (const Expr& face : {Expr::x(i) - lo[i], hi[i] - Expr::x(i)}) e = select(ge(e, face), face, e);
+  return e;
+}
+
 }  // namespace frep

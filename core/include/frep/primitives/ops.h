@@ -7,6 +7,8 @@
 // run only when the argument is a constant and throw std::invalid_argument.
 #pragma once
 
+#include <array>
+
 #include <cstdint>
 #include <vector>
 
@@ -29,6 +31,11 @@ Expr rSubtraction(const Expr& f1, const Expr& f2, const Expr& a = 0.0);  // f1 &
 // (The survey notes C^k systems exist; this is the standard member of that family.)
 Expr rUnionSmooth(const Expr& f1, const Expr& f2, double m);
 Expr rIntersectionSmooth(const Expr& f1, const Expr& f2, double m);
+
+// Solid ∩ box: min(f, x - lo, hi - x, ...) over x[0..2], written so that a NaN of f stays a NaN
+// (outside): min's operands are reordered when nodes are shared, and min(face, NaN) is the face.
+// What frep mesh and frep sample compute where the box cuts the solid (JobSpec cut_lo/cut_hi).
+Expr cutByBox(const Expr& f, const std::array<double, 3>& lo, const std::array<double, 3>& hi);
 
 // ---- Blending (Pasko-Survey, blending: B = R(f1, f2) + a0 / (1 + (f1/a1)² + (f2/a2)²)) ----
 // a0 > 0 adds material along the common edge, a0 < 0 removes it; a1, a2 != 0 set its extent.
