@@ -172,10 +172,16 @@ std::string poisonedMessage(const farm::FarmReport& report) {
 }
 }  // namespace
 
-std::string BoxCut::names() const {
-  std::string s;
+std::vector<std::string> BoxCut::names() const {
+  std::vector<std::string> out;
   for (int b = 0; b < 6; ++b)
-    if (faces & (1u << b)) s += std::string(s.empty() ? "" : ", ") + "xyz"[b / 2] + (b % 2 ? "-max" : "-min");
+    if (faces & (1u << b)) out.push_back(std::string(1, "xyz"[b / 2]) + (b % 2 ? "-max" : "-min"));
+  return out;
+}
+
+std::string BoxCut::text() const {
+  std::string s;
+  for (const std::string& n : names()) s += (s.empty() ? "" : ", ") + n;
   return s;
 }
 
@@ -184,7 +190,7 @@ BoxCut findBoxCut(const LoadedModel& m, const GridSpec& grid, int threads, const
   cut.faces = facesReached(Tape::compile(m.field, 3), grid, {}, threads);
   if (cut.faces)
     spdlog::warn("the solid is cut by the box's face{} {}: {}", std::bitset<6>(cut.faces).count() > 1 ? "s" : "",
-                 cut.names(), what);
+                 cut.text(), what);
   return cut;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "frep/io/atomic_output.h"
 #include "commands.h"
@@ -49,7 +50,8 @@ void writeReport(io::AtomicOutput& reportOut, const farm::FarmReport& report);
 // The faces of the grid's box that the solid reaches (facesReached), named "x-min, z-max".
 struct BoxCut {
   unsigned faces = 0;
-  std::string names() const;
+  std::vector<std::string> names() const;  // "x-min", "z-max", ...
+  std::string text() const;                // "x-min, z-max"
 };
 // Finds them and warns naming them (what the output does there: `what`).
 BoxCut findBoxCut(const LoadedModel& m, const GridSpec& grid, int threads, const std::string& what);

@@ -1373,15 +1373,7 @@ std::string FarmReport::toJson() const {
   }
   else if (operation == "render") j["output"] = {{"pixels_hit", pixelsHit}};
   else j["output"] = {{"leaves", leaves}, {"tiles", tiles}};
-  if (operation != "render") {
-    nlohmann::json cut = nlohmann::json::array();
-    for (size_t b = 0; b < cutFaces.size();) {
-      size_t e = cutFaces.find(", ", b);
-      cut.push_back(cutFaces.substr(b, e == std::string::npos ? std::string::npos : e - b));
-      b = e == std::string::npos ? cutFaces.size() : e + 2;
-    }
-    j["output"]["cut_faces"] = cut;
-  }
+  if (operation != "render") j["output"]["cut_faces"] = cutFaces;
   j["faults"] = {{"retries", retries},           {"duplicates", duplicates},
                  {"late_results", lateResults},  {"malformed", malformed},
                  {"oversized", oversized},       {"dead_workers", deadWorkers},

@@ -105,7 +105,7 @@ struct FarmReport {
   double simplifyTolerance = 0;  // voxels; 0: not simplified
   bool sharpFeatures = false;
   SimplifyStats simplify;
-  std::string cutFaces;  // "mesh": the box's faces that cut the solid ("x-min, z-max"; "" none)
+  std::vector<std::string> cutFaces;  // the box's faces that cut the solid ("x-min", "z-max", ...)
   bool capped = false;   // ... and whether the mesh was capped there (solid ∩ box)
   double surfaceErrorBound = 0;  // "mesh": no point of the mesh is further from the surface (world units)
   uint64_t retries = 0, duplicates = 0, lateResults = 0, malformed = 0, oversized = 0;
