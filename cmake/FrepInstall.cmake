@@ -23,8 +23,8 @@ install(DIRECTORY core/include/ lang/include/ io/include/ DESTINATION ${CMAKE_IN
         FILES_MATCHING PATTERN "*.h")
 
 install(EXPORT frepfarmTargets NAMESPACE frepfarm:: DESTINATION ${FREP_CMAKE_DIR})
-# OpenVDB ships a find module, not a package config: the config file looks where it was found.
-set(FREP_OPENVDB_MODULE_DIR /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)
+# OpenVDB ships a find module, not a package config: the config file looks where it was found
+# (FREP_OPENVDB_MODULE_DIR, cmake/FrepOpenVDB.cmake).
 configure_package_config_file(cmake/frepfarmConfig.cmake.in ${CMAKE_CURRENT_BINARY_DIR}/frepfarmConfig.cmake
                               INSTALL_DESTINATION ${FREP_CMAKE_DIR})
 write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/frepfarmConfigVersion.cmake
