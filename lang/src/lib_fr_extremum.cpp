@@ -22,6 +22,7 @@
 #include "frep/evaluators/interval.h"
 #include "frep/expressions/tape.h"
 #include "frep/minkowski_algebra/distance_offset.h"
+#include "frep/minkowski_algebra/mesh_convex_sum.h"
 #include "frep/relations/relations.h"
 #include "lib_fr_minkowski.h"
 #include "lib_hf_util.h"
@@ -235,8 +236,8 @@ Expr objectPair(const char* fn, std::vector<Arg>& a, Build build) {
 
 // Basic-set operands (Roerdink-Minkowski, lib_fr_minkowski.h) take the exact algebra instead of
 // the search, and so does an exact signed distance (a closed mesh, a polygon, Bezier geometry)
-// with a ball (minkowski_algebra/distance_offset.h); the options then do not apply (there is
-// nothing to search).
+// with a ball (minkowski_algebra/distance_offset.h), and a closed mesh or polytope with a convex
+// polytope (mesh_convex_sum.h); the options then do not apply (there is nothing to search).
 bool exactPair(std::vector<Arg>& a, bool diff, Expr* out) {
   if (a.size() < 3 || !a[1].isObject || !a[2].isObject || !a[0].isArray || !a[0].array) return false;
   if (diff ? exactMinkowskiDiff(a[1], a[2], *a[0].array, out) : exactMinkowskiSum({&a[1], &a[2]}, *a[0].array, out))
@@ -245,9 +246,10 @@ bool exactPair(std::vector<Arg>& a, bool diff, Expr* out) {
       a[0].array->size() < 3)
     return false;
   Expr r;
-  if (!(diff ? minkowski::distanceBallDifference(a[1].value, a[2].value, 3, &r)
-             : minkowski::distanceBallSum(a[1].value, a[2].value, 3, &r)))
-    return false;
+  const Expr &A = a[1].value, &B = a[2].value;
+  const bool exact = diff ? minkowski::distanceBallDifference(A, B, 3, &r) || minkowski::meshConvexDifference(A, B, 3, &r)
+                          : minkowski::distanceBallSum(A, B, 3, &r) || minkowski::meshConvexSum(A, B, 3, &r);
+  if (!exact) return false;
   *out = through(r, *a[0].array, 3);
   return true;
 }
@@ -280,7 +282,8 @@ Expr frMinkowskiSum(std::vector<Arg>& a) {
   Expr r = ops[0]->value;
   for (size_t i = 1; i < ops.size(); ++i) {
     Expr offset;
-    if (n == 3 && minkowski::distanceBallSum(r, ops[i]->value, 3, &offset)) {
+    if (n == 3 && (minkowski::distanceBallSum(r, ops[i]->value, 3, &offset) ||
+                   minkowski::meshConvexSum(r, ops[i]->value, 3, &offset))) {
       r = offset;
       continue;
     }

@@ -193,9 +193,10 @@ void MeshField::orientConsistently() {
   }
 }
 
-double MeshField::signedDistance(const double* p, double* q) const {
-  double best2 = INFINITY, bq[3] = {0, 0, 0};
-  int bestRegion = 0;
+int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, double& best2) const {
+  double bq[3] = {0, 0, 0};
+  best2 = INFINITY;
+  bestRegion = 0;
   const int64_t t = bvh_.nearest(p, [&](uint32_t i, double cur) {
     double qq[3];
     int region;
@@ -203,6 +204,14 @@ double MeshField::signedDistance(const double* p, double* q) const {
     if (d2 < cur) bq[0] = qq[0], bq[1] = qq[1], bq[2] = qq[2], bestRegion = region;
     return d2;
   }, best2);
+  if (q) q[0] = bq[0], q[1] = bq[1], q[2] = bq[2];
+  return t;
+}
+
+double MeshField::signedDistance(const double* p, double* q) const {
+  double best2, bq[3];
+  int bestRegion;
+  const int64_t t = nearestTriangle(p, bq, bestRegion, best2);
   if (q) q[0] = bq[0], q[1] = bq[1], q[2] = bq[2];
   const double d = std::sqrt(best2);
   if (d == 0.0) return 0.0;
@@ -239,8 +248,10 @@ Interval MeshField::bound(const Interval box[3]) const {
 }
 
 double MeshField::distance(const double* p, double* q) const {
-  double qq[3];
-  return std::fabs(signedDistance(p, q ? q : qq));
+  double best2;
+  int region;
+  nearestTriangle(p, q, region, best2);  // no sign: an open mesh's would cost a winding number
+  return std::sqrt(best2);
 }
 
 double MeshField::gradient(const double* p, double* g) const {

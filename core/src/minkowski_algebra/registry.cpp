@@ -42,6 +42,9 @@ std::vector<std::string> describeExact(const Expr& f) {
       lines.push_back(std::string("exact Minkowski ") + (t.erosion ? "difference " : "sum ") + t.operand +
                       " as the offset f " + (t.erosion ? "- " : "+ ") +
                       "r of an exact signed distance, error bound 0 (no search)");
+    else if (t.kind == ExactTerm::Kind::MeshPolytope)
+      lines.push_back(std::string("exact Minkowski ") + (t.erosion ? "difference " : "sum ") + t.operand +
+                      ", error bound 0 (no search)");
     else if (t.kind == ExactTerm::Kind::Sum)
       lines.push_back("exact Minkowski algebra (Roerdink): " + t.sum.describe() + " as a union of " +
                       std::to_string(t.pieces) + " primitives, error bound 0 (no search)");

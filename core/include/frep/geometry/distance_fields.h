@@ -34,6 +34,9 @@ class Bvh {
   // than the best squared distance found; returns the nearest primitive (or -1 if none).
   template <typename F>
   int64_t nearest(const double* p, F&& dist2, double& best2) const;
+  // Calls visit(i) for every primitive whose box contains p.
+  template <typename F>
+  void containing(const double* p, F&& visit) const;
   size_t numNodes() const { return nodes_.size(); }
   // A lower bound of the distance between box q and every primitive: the least distance from q
   // to a leaf's box (0 when q touches one).
@@ -129,6 +132,7 @@ class MeshField : public DistanceField {
   uint64_t hash_ = 0;
   std::string name_;
   double signedDistance(const double* p, double* q) const;
+  int64_t nearestTriangle(const double* p, double* q, int& region, double& best2) const;
   void orientConsistently();
   bool sameGeometry(const DistanceField& o) const override {
     const auto& m = static_cast<const MeshField&>(o);
@@ -202,6 +206,24 @@ int64_t Bvh::nearest(const double* p, F&& dist2, double& best2) const {
     }
   }
   return best;
+}
+
+template <typename F>
+void Bvh::containing(const double* p, F&& visit) const {
+  if (nodes_.empty()) return;
+  uint32_t stack[128];
+  int sp = 0;
+  stack[sp++] = 0;
+  while (sp > 0) {
+    const NodeB& n = nodes_[stack[--sp]];
+    if (boxDist2(n.box, p) > 0.0) continue;
+    if (n.count > 0) {
+      for (uint32_t k = n.first; k < n.first + n.count; ++k) visit(order_[k]);
+      continue;
+    }
+    stack[sp++] = n.left;
+    stack[sp++] = n.right;
+  }
 }
 
 }  // namespace frep

@@ -15,12 +15,13 @@
 namespace frep::minkowski {
 
 struct ExactTerm {
-  // BallOffset: a distance-field operand plus or minus a ball (distance_offset.h).
-  enum class Kind { Sum, Erosion, BallOffset } kind = Kind::Sum;
+  // BallOffset: a distance-field operand plus or minus a ball (distance_offset.h);
+  // MeshPolytope: a closed mesh plus or minus a convex polytope (mesh_convex_sum.h).
+  enum class Kind { Sum, Erosion, BallOffset, MeshPolytope } kind = Kind::Sum;
   Sum sum;         // Sum: the secondary object; Erosion: the subtracted sum C1 ⊕ … ⊕ CN; BallOffset: the ball
   Sum c0;          // Erosion: the solid eroded (a block or a sphere)
   int pieces = 0;  // primitives of the union (Sum) or intersection (Erosion)
-  // BallOffset: "A ⊕ ball(...)" for reports, A ⊖ ball (else A ⊕ ball), and where the result
+  // BallOffset, MeshPolytope: "A ⊕ ball(...)" for reports, A ⊖ ball (else A ⊕ ball), and where the result
   // is itself an exact signed distance (so a further ball can take the same path).
   std::string operand;
   bool erosion = false, exactOutside = false, exactInside = false;

@@ -1,0 +1,43 @@
+// Minkowski sum and difference of a closed triangle mesh and a convex polytope, exactly and
+// without a search (issue 30: mesh ⊕ box, mesh ⊕ tetrahedral tool, tetrahedron ⊕ box, ...).
+//
+// The sum (Roerdink-Minkowski eq. 1, A ⊕ B = { a + b }) of a solid A and a connected B splits
+// into the translate of A and the sweep of its boundary: for any b0 in B,
+//
+//   A ⊕ B = (A + b0)  ∪  ⋃_T (T ⊕ B),   T the triangles of ∂A,
+//
+// because x ∈ A ⊕ B iff the connected set x − B meets A, and then either lies inside A (so
+// x − b0 ∈ A) or crosses ∂A. Each T ⊕ B is a convex polytope whose facet normals are among T's
+// normal ±n_T, B's facet normals and the cross products of T's edges with B's edges (the faces
+// of a sum of polytopes are sums of faces with a common normal), so
+//
+//   c_T(x) = min_u ( h_T(u) + h_B(u) − u · x ),   h the support functions,
+//
+// over those candidate unit normals u is T ⊕ B's exact inside distance (a redundant supporting
+// plane is never nearer than a facet). The field is
+//
+//   g(x) = max( f_A(x − b0), max_T c_T(x) ),        f = g where g >= 0, else −dist(x, S),
+//
+// with S the boundary pieces of every T ⊕ B (vertex of T + facet of B, edge ⊕ edge
+// parallelograms, T + vertex of B), a triangle soup inside A ⊕ B that covers its boundary, so
+// dist(x, S) is the exact distance outside. f is sign-exact, the exact signed distance outside,
+// a lower bound of the depth inside, and 1-Lipschitz (each piece is).
+//
+// The difference with frMinkowskiDiff's convention, A ⊖ B = { x : x + B ⊆ A }, is the
+// complement of A^c ⊕ (−B): the same construction on the flipped mesh, negated (exact inside).
+#pragma once
+
+#include <cstdint>
+
+#include "frep/expressions/expr.h"
+
+namespace frep::minkowski {
+
+// A ⊕ B over x[0..3) when one operand is a closed triangle mesh (or a convex polytope, whose
+// boundary mesh is used) and the other a convex polytope: an intersection of half-spaces
+// (convex_polytope.h) or a closed convex mesh. Registers the result for the job report.
+bool meshConvexSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out);
+// A ⊖ B when A is a closed mesh (or a polytope) and B a convex polytope.
+bool meshConvexDifference(const Expr& a, const Expr& b, uint32_t dims, Expr* out);
+
+}  // namespace frep::minkowski

@@ -1,0 +1,246 @@
+// Closed mesh ⊕ / ⊖ convex polytope by the exact construction of mesh_convex_sum.h, against
+// closed forms: the zonotope of two boxes in different orientations (membership from its facet
+// planes, distance from its support function, volume from its generators), a non-convex L prism
+// grown by a box (a union of two boxes: exact signed distance), a tetrahedron eroded by a box (a
+// smaller tetrahedron), and meshes of the results closed with the formulas' volumes.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <memory>
+#include <random>
+
+#include "core/mesh_checks.h"
+#include "core/mesh_models.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/expr.h"
+#include "frep/geometry/distance_fields.h"
+#include "frep/meshing/mesh.h"
+#include "frep/minkowski_algebra/convex_polytope.h"
+#include "frep/minkowski_algebra/mesh_convex_sum.h"
+#include "frep/minkowski_algebra/registry.h"
+#include "frep/primitives/ops.h"
+
+using namespace frep;
+namespace mc = mesh_checks;
+
+namespace {
+
+using V3 = std::array<double, 3>;
+Expr X() { return Expr::x(0); }
+Expr Y() { return Expr::x(1); }
+Expr Z() { return Expr::x(2); }
+
+double eval(const Expr& e, const V3& p) {
+  TapePtr t = Tape::compile(e, 3);
+  PointEvaluator pe;
+  return pe.eval(*t, p.data());
+}
+
+double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+V3 cross(const V3& a, const V3& b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
+
+// The box corner + sum_i t_i g_i (t in [0, 1]^3) written as six planes (a min of affine
+// functions, recognised as a convex polytope).
+Expr parallelepiped(const V3& corner, const std::array<V3, 3>& g) {
+  Expr f;
+  bool first = true;
+  for (int i = 0; i < 3; ++i) {
+    V3 n = cross(g[size_t((i + 1) % 3)], g[size_t((i + 2) % 3)]);
+    if (dot(n, g[size_t(i)]) < 0) n = {-n[0], -n[1], -n[2]};
+    const double l = std::sqrt(dot(n, n));
+    for (double& c : n) c /= l;
+    const double lo = dot(n, corner), hi = lo + dot(n, g[size_t(i)]);
+    const Expr s = n[0] * X() + n[1] * Y() + n[2] * Z();
+    const Expr slab = min(s - lo, hi - s);
+    f = first ? slab : min(f, slab);
+    first = false;
+  }
+  return f;
+}
+
+Expr axisBox(const V3& lo, const V3& hi) {
+  return parallelepiped(lo, {V3{hi[0] - lo[0], 0, 0}, V3{0, hi[1] - lo[1], 0}, V3{0, 0, hi[2] - lo[2]}});
+}
+
+// The exact signed distance of the axis box [lo, hi] (positive inside).
+double boxDistance(const V3& p, const V3& lo, const V3& hi) {
+  double out = 0, in = -INFINITY;
+  for (int i = 0; i < 3; ++i) {
+    const double c = 0.5 * (lo[size_t(i)] + hi[size_t(i)]), h = 0.5 * (hi[size_t(i)] - lo[size_t(i)]);
+    const double q = std::abs(p[size_t(i)] - c) - h;
+    out += q > 0 ? q * q : 0;
+    in = std::max(in, q);
+  }
+  return out > 0 ? -std::sqrt(out) : -in;
+}
+
+// An L-shaped prism [0,2]x[0,1] ∪ [0,1]x[0,2] times [0, h] as a closed mesh: the L hexagon
+// extruded (not convex: the union of the two blocks).
+Expr lPrism(double h) {
+  const double L[6][2] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  std::vector<double> xyz;
+  for (double z : {0.0, h})
+    for (const auto& p : L) xyz.insert(xyz.end(), {p[0], p[1], z});
+  // The hexagon as four triangles (fan from the reflex vertex 3), counter-clockwise from +z.
+  const uint32_t cap[4][3] = {{3, 4, 5}, {3, 5, 0}, {3, 0, 1}, {3, 1, 2}};
+  std::vector<uint32_t> tris;
+  for (const auto& t : cap) {
+    tris.insert(tris.end(), {t[0] + 6, t[1] + 6, t[2] + 6});  // top, outward +z
+    tris.insert(tris.end(), {t[0], t[2], t[1]});              // bottom, outward -z
+  }
+  for (uint32_t i = 0; i < 6; ++i) {
+    const uint32_t j = (i + 1) % 6;
+    tris.insert(tris.end(), {i, j, j + 6});
+    tris.insert(tris.end(), {i, j + 6, i + 6});
+  }
+  auto m = std::make_shared<MeshField>(xyz, tris, "L prism");
+  EXPECT_TRUE(m->check().closed());
+  return fieldExpr(m, X(), Y(), Z());
+}
+
+}  // namespace
+
+TEST(MeshConvexSum, ZonotopeOfTwoBoxesHasExactMembershipAndDistance) {
+  // A rotated parallelepiped ⊕ an axis box: the zonotope of six generators.
+  const double c = std::cos(0.5), s = std::sin(0.5), c2 = std::cos(0.3), s2 = std::sin(0.3);
+  const std::array<V3, 3> ga = {V3{0.8 * c, 0.8 * s * c2, 0.8 * s * s2}, V3{-0.5 * s, 0.5 * c * c2, 0.5 * c * s2},
+                                V3{0, -0.6 * s2, 0.6 * c2}};
+  const V3 ca{-0.4, -0.3, -0.2};
+  const V3 blo{-0.1, -0.15, 0.05}, bhi{0.2, 0.1, 0.3};
+  const std::array<V3, 3> gb = {V3{bhi[0] - blo[0], 0, 0}, V3{0, bhi[1] - blo[1], 0}, V3{0, 0, bhi[2] - blo[2]}};
+  Expr sum;
+  ASSERT_TRUE(minkowski::meshConvexSum(parallelepiped(ca, ga), axisBox(blo, bhi), 3, &sum));
+  const auto described = minkowski::describeExact(sum);
+  ASSERT_EQ(described.size(), 1u);
+  EXPECT_NE(described[0].find("exact Minkowski sum convex polytope"), std::string::npos) << described[0];
+  // The zonotope: centre + sum of [-1/2, 1/2] g_i; facet normals g_i x g_j, support sum |u.g_i|/2.
+  std::vector<V3> gens(ga.begin(), ga.end());
+  gens.insert(gens.end(), gb.begin(), gb.end());
+  V3 centre{0, 0, 0};
+  for (int k = 0; k < 3; ++k) centre[size_t(k)] = ca[size_t(k)] + blo[size_t(k)];
+  for (const V3& g : gens)
+    for (int k = 0; k < 3; ++k) centre[size_t(k)] += 0.5 * g[size_t(k)];
+  auto support = [&](const V3& u) {
+    double h = dot(u, centre);
+    for (const V3& g : gens) h += 0.5 * std::abs(dot(u, g));
+    return h;
+  };
+  std::vector<V3> normals;
+  for (size_t i = 0; i < gens.size(); ++i)
+    for (size_t j = i + 1; j < gens.size(); ++j) {
+      V3 n = cross(gens[i], gens[j]);
+      const double l = std::sqrt(dot(n, n));
+      if (l < 1e-12) continue;
+      for (double& x : n) x /= l;
+      bool known = false;  // three coplanar generators (ga[2], gb[1], gb[2]) give one facet
+      for (const V3& k : normals) known = known || dot(k, n) > 1 - 1e-12;
+      if (known) continue;
+      normals.push_back(n);
+      normals.push_back({-n[0], -n[1], -n[2]});
+    }
+  // Its exact signed distance from the convex polytope of its facet planes (convex_polytope.h).
+  Expr planes;
+  for (size_t i = 0; i < normals.size(); ++i) {
+    const V3& n = normals[i];
+    const Expr e = support(n) - (n[0] * X() + n[1] * Y() + n[2] * Z());
+    planes = i == 0 ? e : min(planes, e);
+  }
+  const auto zonotope = minkowski::convexPolytopeOf(planes);
+  ASSERT_TRUE(zonotope.has_value());
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.6, 1.6);
+  int outside = 0, inside = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const V3 p{u(rng), u(rng), u(rng)};
+    const double exact = eval(zonotope->field, p), f = eval(sum, p);
+    if (std::abs(exact) < 1e-9) continue;
+    ASSERT_EQ(f >= 0, exact > 0) << p[0] << " " << p[1] << " " << p[2];
+    if (exact > 0) {  // inside: a positive lower bound of the depth
+      ++inside;
+      EXPECT_LE(f, exact + 1e-9);
+      EXPECT_GT(f, 0);
+    } else {
+      ++outside;
+      EXPECT_NEAR(f, exact, 1e-9) << p[0] << " " << p[1] << " " << p[2];
+    }
+  }
+  EXPECT_GT(outside, 1000);
+  EXPECT_GT(inside, 50);
+  // Its mesh: closed, the zonotope's volume sum over triples of |det(g_i, g_j, g_k)|.
+  double volume = 0;
+  for (size_t i = 0; i < 6; ++i)
+    for (size_t j = i + 1; j < 6; ++j)
+      for (size_t k = j + 1; k < 6; ++k) volume += std::abs(dot(gens[i], cross(gens[j], gens[k])));
+  Mesh m = meshGrid(Tape::compile(sum, 3), mesh_models::cubeGrid(1.6, 96), {}, 32);
+  EXPECT_EQ(mc::checkEdgePairs(m.triangles, m.positions.size()), "");
+  EXPECT_NEAR(mc::enclosedVolume(m.positions, m.triangles), volume, 0.003 * volume);
+}
+
+TEST(MeshConvexSum, NonConvexMeshGrownByABoxIsTheUnionOfTheGrownBlocks) {
+  // L ⊕ C = ([0,2]x[0,1]x[0,h] ⊕ C) ∪ ([0,1]x[0,2]x[0,h] ⊕ C): outside, the distance to the
+  // nearer grown block exactly; the sign everywhere.
+  const double h = 0.4;
+  const V3 clo{-0.1, -0.2, -0.15}, chi{0.3, 0.05, 0.1};
+  Expr sum;
+  ASSERT_TRUE(minkowski::meshConvexSum(axisBox(clo, chi), lPrism(h), 3, &sum));  // either order
+  const V3 lo1{clo[0], clo[1], clo[2]}, hi1{2 + chi[0], 1 + chi[1], h + chi[2]};
+  const V3 lo2{clo[0], clo[1], clo[2]}, hi2{1 + chi[0], 2 + chi[1], h + chi[2]};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.8, 2.8);
+  int outside = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const V3 p{u(rng), u(rng), 0.5 * u(rng)};
+    const double exact = std::max(boxDistance(p, lo1, hi1), boxDistance(p, lo2, hi2));
+    const double f = eval(sum, p);
+    if (std::abs(exact) < 1e-9) continue;
+    ASSERT_EQ(f >= 0, exact > 0) << p[0] << " " << p[1] << " " << p[2];
+    if (exact < 0) {
+      ++outside;
+      EXPECT_NEAR(f, exact, 1e-9) << p[0] << " " << p[1] << " " << p[2];
+    } else {
+      EXPECT_LE(f, exact + 1e-9);  // inside: a lower bound of the depth
+    }
+  }
+  EXPECT_GT(outside, 1000);
+  const double volume = (hi1[0] - lo1[0]) * (hi1[1] - lo1[1]) * (hi1[2] - lo1[2]) +
+                        (hi2[0] - lo2[0]) * (hi2[1] - lo2[1]) * (hi2[2] - lo2[2]) -
+                        (hi2[0] - lo2[0]) * (hi1[1] - lo1[1]) * (hi1[2] - lo1[2]);
+  Mesh m = meshGrid(Tape::compile(sum, 3), GridSpec::fromBounds({-0.4, -0.4, -0.4}, {2.6, 2.6, 0.8}, 97), {}, 32);
+  EXPECT_EQ(mc::checkEdgePairs(m.triangles, m.positions.size()), "");
+  EXPECT_EQ(mc::eulerCharacteristic(m.triangles, m.positions.size()), 2);
+  EXPECT_NEAR(mc::enclosedVolume(m.positions, m.triangles), volume, 0.003 * volume);
+}
+
+TEST(MeshConvexSum, TetrahedronErodedByABoxIsTheShrunkTetrahedron) {
+  // T = {x, y, z >= -0.3, x + y + z <= 0.6}; T ⊖ C = {x : x + C ⊆ T} moves each plane by C's
+  // support: x >= -0.3 - min_C x, ..., x + y + z <= 0.6 - max_C (x + y + z).
+  const Expr tet = min(min(X() + 0.3, Y() + 0.3), min(Z() + 0.3, (0.6 - X() - Y() - Z()) / std::sqrt(3.0)));
+  const V3 clo{-0.2, -0.1, 0.0}, chi{0.2, 0.2, 0.2};
+  Expr diff;
+  ASSERT_TRUE(minkowski::meshConvexDifference(tet, axisBox(clo, chi), 3, &diff));
+  const double a = -0.3 - clo[0], b = -0.3 - clo[1], c = -0.3 - clo[2], d = 0.6 - (chi[0] + chi[1] + chi[2]);
+  const auto shrunk = minkowski::convexPolytopeOf(min(min(X() - a, Y() - b), min(Z() - c, d - X() - Y() - Z())));
+  ASSERT_TRUE(shrunk.has_value());
+  auto exact = [&](const V3& p) { return eval(shrunk->field, p); };
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-0.5, 0.6);
+  int inside = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const V3 p{u(rng), u(rng), u(rng)};
+    const double e = exact(p), f = eval(diff, p);
+    if (std::abs(e) < 1e-9) continue;
+    ASSERT_EQ(f >= 0, e > 0) << p[0] << " " << p[1] << " " << p[2];
+    if (e > 0) {
+      ++inside;
+      EXPECT_NEAR(f, e, 1e-9);
+    } else {
+      EXPECT_GE(f, e - 1e-9);  // outside: -f is at most the distance (a lower bound of it)
+      EXPECT_LT(f, 0);
+    }
+  }
+  EXPECT_GT(inside, 20);
+  // The mirrored operand is not commuted: B ⊖ A is not A ⊖ B.
+  Expr none;
+  EXPECT_FALSE(minkowski::meshConvexDifference(min(X(), Y()), axisBox(clo, chi), 3, &none));
+}
