@@ -72,10 +72,23 @@ void checkModelFiles(const JobSpec& job) {
 }
 
 namespace {
+std::string& workerDataDir() {
+  static std::string dir;
+  return dir;
+}
+}  // namespace
+
+void setWorkerDataDir(const std::string& dir) { workerDataDir() = dir; }
+
+namespace {
 Expr jobField(const JobSpec& job, uint32_t* dimsOut) {
   checkModelFiles(job);
   lang::CompileOptions opt;
   opt.object = job.object();
+  // Only the job's own files, or the worker's --data-dir: never a path the master names.
+  opt.fileAccess = workerDataDir().empty() ? lang::CompileOptions::FileAccess::JobOnly
+                                           : lang::CompileOptions::FileAccess::DataDir;
+  opt.dataDir = workerDataDir();
   for (const auto& f : job.model_files()) opt.files[f.path()] = f.contents();
   lang::CompileResult r = lang::compile(job.model_source(), job.model_name(), opt);
   if (!r.ok) {

@@ -61,6 +61,12 @@ TapePtr compileJobModel(const JobSpec& job);
 std::vector<std::string> describeExactTerms(const JobSpec& job);
 
 // Compiled models by job id, so a worker compiles each model once.
+// The directory a worker's jobs may read model files from when the job does not ship them
+// (frep-worker --data-dir; empty, the default: none). A job's model is compiled with
+// CompileOptions::FileAccess::JobOnly, or DataDir with this directory: a master can never make
+// a worker (nor itself) open another path it names.
+void setWorkerDataDir(const std::string& dir);
+
 class ModelCache {
  public:
   TapePtr get(const JobSpec& job, uint64_t jobId);

@@ -3,9 +3,12 @@
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
+#include <sys/stat.h>
+
 #include <cstdlib>
 
 #include "allocator_tuning.h"
+#include "brick.h"
 #include "frep/io/geometry_files.h"
 #include "worker.h"
 
@@ -21,6 +24,10 @@ int main(int argc, char** argv) {
   app.add_option("--connect", opt.endpoint, "master endpoint, e.g. tcp://host:5555 (default: $FREP_MASTER)");
   app.add_option("--threads", opt.threads, "threads per brick (default: all cores)");
   app.add_option("--curve", opt.curveDir, "directory with CURVE keys from `frep keygen`");
+  std::string dataDir;
+  app.add_option("--data-dir", dataDir,
+                 "directory whose regular files a job's model may read when the job does not ship them "
+                 "(default: none; a worker opens no other path a job names)");
   app.add_option("--master-timeout", opt.masterTimeoutSec, "seconds without a master before giving up")
       ->capture_default_str();
   app.set_version_flag("--version", "frep-worker " FREP_VERSION);
@@ -36,6 +43,14 @@ int main(int argc, char** argv) {
   if (opt.endpoint.empty()) {
     spdlog::error("--connect: no master endpoint given (or set FREP_MASTER)");
     return frep::farm::kWorkerBadArgs;
+  }
+  if (!dataDir.empty()) {
+    struct stat st {};
+    if (::stat(dataDir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+      spdlog::error("--data-dir: '{}' is not a directory", dataDir);
+      return frep::farm::kWorkerBadArgs;
+    }
+    frep::farm::setWorkerDataDir(dataDir);
   }
   spdlog::set_level(spdlog::level::from_str(level));
   // $SPDLOG_LEVEL (e.g. debug, or warn,frep=debug) unless --log-level is given: the option wins.

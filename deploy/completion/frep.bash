@@ -73,10 +73,10 @@ _frep_worker() {
   local cur="${COMP_WORDS[COMP_CWORD]}" prev="${COMP_WORDS[COMP_CWORD-1]}"
   case "$prev" in
     --log-level) COMPREPLY=($(compgen -W "trace debug info warn error critical off" -- "$cur")); return ;;
-    --curve) COMPREPLY=($(compgen -d -- "$cur")); return ;;
+    --curve|--data-dir) COMPREPLY=($(compgen -d -- "$cur")); return ;;
     --connect|--threads|--master-timeout) return ;;
   esac
-  COMPREPLY=($(compgen -W "-h --help --version --connect --threads --curve --master-timeout --log-level" -- "$cur"))
+  COMPREPLY=($(compgen -W "-h --help --version --connect --threads --curve --master-timeout --data-dir --log-level" -- "$cur"))
 }
 
 shopt -s extglob 2>/dev/null

@@ -76,7 +76,7 @@ Mesh readPly(std::istream& in, const std::string& path) {
   std::getline(in, line);
   if (line != "ply" && line != "ply\r") fail(path, "not a PLY file (no 'ply' magic)");
   std::vector<PlyElement> elements;
-  while (true) {
+  for (int headerLine = 2;; ++headerLine) {
     if (!std::getline(in, line)) fail(path, "truncated header (no end_header)");
     if (!line.empty() && line.back() == '\r') line.pop_back();
     std::istringstream ls(line);
@@ -86,7 +86,7 @@ Mesh readPly(std::istream& in, const std::string& path) {
     if (word == "format") ls >> format;
     else if (word == "element") {
       PlyElement e;
-      if (!(ls >> e.name >> e.count)) fail(path, "bad header line '" + line + "'");
+      if (!(ls >> e.name >> e.count)) fail(path, "header line " + std::to_string(headerLine) + ": bad element line");
       elements.push_back(e);
     } else if (word == "property") {
       if (elements.empty()) fail(path, "property before any element");
@@ -95,12 +95,12 @@ Mesh readPly(std::istream& in, const std::string& path) {
       if (p.type == "list") ls >> p.countType >> p.type;
       ls >> p.name;
       if (!typeSize(p.type) || (!p.countType.empty() && !typeSize(p.countType)))
-        fail(path, "unknown property type in '" + line + "'");
+        fail(path, "header line " + std::to_string(headerLine) + ": unknown property type");
       elements.back().props.push_back(p);
     }
   }
   if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
-    fail(path, "unknown PLY format '" + format + "'");
+    fail(path, "unknown PLY format (ascii, binary_little_endian, binary_big_endian)");
   Mesh m;
   PlyBinary bin(in, format == "binary_big_endian", path);
   std::string token;
@@ -109,7 +109,8 @@ Mesh readPly(std::istream& in, const std::string& path) {
     if (!(in >> token)) fail(path, "truncated ascii data");
     char* end = nullptr;
     const double v = std::strtod(token.c_str(), &end);
-    if (*end) fail(path, "bad number '" + token + "'");
+    if (*end || end == token.c_str())
+      fail(path, "not a number at byte " + std::to_string(int64_t(in.tellg()) - int64_t(token.size()) + 1));
     return v;
   };
   for (const PlyElement& e : elements) {
@@ -161,7 +162,7 @@ Mesh readObj(std::istream& in, const std::string& path) {
       while (ls >> item) {
         char* end = nullptr;
         const long long k = std::strtoll(item.c_str(), &end, 10);
-        if (end == item.c_str() || (*end && *end != '/') || k == 0) fail(path, where + ": bad face vertex '" + item + "'");
+        if (end == item.c_str() || (*end && *end != '/') || k == 0) fail(path, where + ": bad face vertex");
         poly.push_back(k > 0 ? k - 1 : int64_t(m.positions.size()) + k);
       }
       addPolygon(m, poly, path, where);

@@ -57,18 +57,19 @@ CompileResult compile(const std::string& source, const std::string& fileName,
 }
 
 CompileResult compileFile(const std::string& path, const CompileOptions& options) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  std::string source;
+  try {
+    source = readRegularFile(path, options.maxFileBytes);  // never a FIFO, a device or 1 GB of /dev/zero
+  } catch (const std::runtime_error& e) {
     CompileResult r;
     Diagnostic d;
     d.file = path;
-    d.message = "cannot open file";
+    const std::string what = e.what();
+    d.message = what.rfind("cannot open file", 0) == 0 ? "cannot open file" : what;
     r.diagnostics.push_back(d);
     return r;
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return compile(ss.str(), path, options);
+  return compile(source, path, options);
 }
 
 }  // namespace frep::lang

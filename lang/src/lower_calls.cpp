@@ -2,8 +2,8 @@
 // earlier objects.
 #include "frep/lang/lower_object.h"
 
-#include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 namespace frep::lang::detail {
 
@@ -235,16 +235,11 @@ const std::string& ObjectLowering::readModelFile(const AstExpr& path) {
   if (given != sh_.options.files.end()) {
     contents = given->second;
   } else {
-    if (written.empty()) throw CompileError{path.loc, "empty file name"};
-    std::string full = written;
-    const size_t slash = sh_.modelFile.rfind('/');
-    if (written[0] != '/' && slash != std::string::npos) full = sh_.modelFile.substr(0, slash + 1) + written;
-    std::ifstream in(full, std::ios::binary);
-    if (!in) throw CompileError{path.loc, "cannot open file '" + full + "'"};
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) throw CompileError{path.loc, "cannot read file '" + full + "'"};
-    contents = ss.str();
+    try {
+      contents = readModelFileFromDisk(written, sh_.modelFile, sh_.options);
+    } catch (const std::runtime_error& e) {
+      throw CompileError{path.loc, e.what()};
+    }
   }
   sh_.files->emplace_back(written, contents);
   return sh_.fileCache.emplace(written, std::move(contents)).first->second;

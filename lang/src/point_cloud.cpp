@@ -27,21 +27,34 @@ void add(PointCloud& pc, const std::vector<double>& row, int nxAt, int valueAt) 
   if (valueAt >= 0) pc.values.push_back(row[size_t(valueAt)]);
 }
 
+// Text: one point per line, numbers separated by blanks, '#' to the line's end a comment. A
+// message names the line and the byte, never the file's text (a worker's --data-dir file).
 PointCloud parseText(const std::string& contents, const std::string& name) {
   PointCloud pc;
-  std::istringstream in(contents);
-  std::string line;
   size_t columns = 0;
-  for (int lineNo = 1; std::getline(in, line); ++lineNo) {
-    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    std::istringstream ls(line);
-    std::vector<double> row;
-    std::string word;
-    while (ls >> word) {
+  size_t lineStart = 0;
+  std::vector<double> row;
+  for (int lineNo = 1; lineStart < contents.size(); ++lineNo) {
+    size_t lineEnd = contents.find('\n', lineStart);
+    if (lineEnd == std::string::npos) lineEnd = contents.size();
+    const void* hash = std::memchr(contents.data() + lineStart, '#', lineEnd - lineStart);
+    const size_t textEnd = hash ? size_t(static_cast<const char*>(hash) - contents.data()) : lineEnd;
+    row.clear();
+    for (size_t i = lineStart; i < textEnd;) {
+      const unsigned char c = static_cast<unsigned char>(contents[i]);
+      if (c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f') {
+        ++i;
+        continue;
+      }
+      size_t j = i;
+      while (j < textEnd && !std::strchr(" \t\r\v\f", contents[j])) ++j;
       double v;
-      if (!parseDouble(word, v)) fail(name, std::to_string(lineNo), "'" + word + "' is not a finite number");
+      if (!parseDouble(contents.substr(i, j - i), v))
+        fail(name, std::to_string(lineNo), "not a finite number at byte " + std::to_string(i + 1));
       row.push_back(v);
+      i = j;
     }
+    lineStart = lineEnd + 1;
     if (row.empty()) continue;
     if (columns == 0) {
       if (row.size() != 4 && row.size() != 6)
@@ -102,7 +115,7 @@ PointCloud parsePly(const std::string& contents, const std::string& name) {
     if (key == "format") {
       ls >> format;
       if (format != "ascii" && format != "binary_little_endian")
-        fail(name, std::to_string(lineNo), "PLY format '" + format + "' is not supported (ascii, binary_little_endian)");
+        fail(name, std::to_string(lineNo), "this PLY format is not supported (ascii, binary_little_endian)");
     } else if (key == "element") {
       std::string el;
       long count = -1;
@@ -118,7 +131,7 @@ PointCloud parsePly(const std::string& contents, const std::string& name) {
       ls >> type;
       if (type == "list") fail(name, std::to_string(lineNo), "a list property in the vertex element");
       ls >> pname;
-      if (!typeSize(type)) fail(name, std::to_string(lineNo), "unknown PLY type '" + type + "'");
+      if (!typeSize(type)) fail(name, std::to_string(lineNo), "unknown PLY property type");
       props.emplace_back(type, pname);
     } else if (key == "end_header") {
       break;

@@ -1,8 +1,11 @@
 // frVolumeSpline / frVolumeSplineFile: interpolation through the language, the point-file
 // formats (text with values, text with normals, PLY ascii and binary), paths relative to the
 // model file, CompileOptions::files, and the errors.
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -155,6 +158,54 @@ TEST(LibFrVolumeSpline, Errors) {
   EXPECT_NE(errorOf("m(x[3], a[1]) { array c[3], v[1]; c = [0,0,x[1]]; v = [1]; m = frVolumeSpline(x, c, v); }")
                 .find("known at compile time"),
             std::string::npos);
+}
+
+// Messages name the line and byte of a bad number, never the text (a worker's --data-dir file
+// would otherwise come back to the master in the error).
+TEST(LibFrVolumeSpline, ErrorsNeverQuoteTheFile) {
+  CompileOptions opt;
+  opt.files["p.xyz"] = "0 0 0 1\n1 0 0 1 # fine\n  1 SECRET 0 1\n";
+  const std::string err = errorOf("m(x[3], a[1]) { m = frVolumeSplineFile(x, \"p.xyz\", 0); }", opt);
+  EXPECT_NE(err.find("p.xyz:3: not a finite number at byte 28"), std::string::npos) << err;
+  EXPECT_EQ(err.find("SECRET"), std::string::npos) << err;
+  opt.files["p.ply"] = "ply\nformat SECRET 1.0\nelement vertex 1\nproperty SECRET2 x\nend_header\n";
+  const std::string ply = errorOf("m(x[3], a[1]) { m = frVolumeSplineFile(x, \"p.ply\", 0); }", opt);
+  EXPECT_EQ(ply.find("SECRET"), std::string::npos) << ply;
+}
+
+// On the user's own machine (FileAccess::Local, frep) files are read from the disk, but only
+// regular files of bounded size: a FIFO is refused at once instead of parking the compile,
+// /dev/zero instead of read to the end of memory; JobOnly (a farm worker) opens nothing.
+TEST(LibFrVolumeSpline, TheDiskGivesRegularFilesOfBoundedSizeOnly) {
+  const std::string dir = tempDir();
+  const std::string fifo = dir + "/fifo.xyz";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  writeFile(dir + "/p.xyz", "0 0 0 1\n1 0 0 -1\n0 1 0 -1\n0 0 1 -1\n-1 -1 -1 -1\n");
+  auto compileReading = [&](const std::string& path, const CompileOptions& opt) {
+    return compile("m(x[3], a[1]) { m = frVolumeSplineFile(x, \"" + path + "\", 0); }", dir + "/m.hf", opt);
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  CompileResult r = compileReading(fifo, {});
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(allDiagnostics(r).find("is not a regular file"), std::string::npos) << allDiagnostics(r);
+  r = compileReading("/dev/zero", {});
+  EXPECT_NE(allDiagnostics(r).find("is not a regular file"), std::string::npos) << allDiagnostics(r);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+  EXPECT_TRUE(compileReading("p.xyz", {}).ok);
+  CompileOptions small;
+  small.maxFileBytes = 16;
+  r = compileReading("p.xyz", small);
+  EXPECT_NE(allDiagnostics(r).find("more than the 16 bytes a model file may have"), std::string::npos) << allDiagnostics(r);
+  CompileOptions jobOnly;
+  jobOnly.fileAccess = CompileOptions::FileAccess::JobOnly;
+  r = compileReading("p.xyz", jobOnly);
+  EXPECT_NE(allDiagnostics(r).find("'p.xyz': is not among the files the job ships"), std::string::npos) << allDiagnostics(r);
+  jobOnly.files["p.xyz"] = "0 0 0 1\n1 0 0 -1\n0 1 0 -1\n0 0 1 -1\n-1 -1 -1 -1\n";
+  EXPECT_TRUE(compileReading("p.xyz", jobOnly).ok);
+  // compileFile reads the model itself the same way.
+  r = compileFile(fifo);
+  EXPECT_NE(allDiagnostics(r).find("is not a regular file"), std::string::npos) << allDiagnostics(r);
+  std::system(("rm -rf '" + dir + "'").c_str());
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // HyperFun front end: source text -> checked, lowered models (core expressions).
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <utility>
@@ -55,10 +56,33 @@ struct CompileOptions {
   // Values of a[1..]: when given, a[i] is that constant at compile time (so loop conditions and
   // indices may depend on it) instead of Expr::param(i). Missing entries stay parameters.
   std::vector<double> params;
-  // Contents of files the model reads (frVolumeSplineFile), by the path as written in the model:
-  // used instead of the disk (farm workers get them with the job).
+  // Contents of files the model reads (frVolumeSplineFile, frMesh, frVolume), by the path as
+  // written in the model: used instead of the disk (farm workers get them with the job).
   std::map<std::string, std::string> files;
+  // Where a file the model names that is not in `files` may come from (docs/farm.md, "Models
+  // that read files"): Local, the disk relative to the model (frep on the user's own machine);
+  // JobOnly, nowhere (a farm worker: the job ships every file, and a master must not make a
+  // worker read its own files); DataDir, regular files inside `dataDir` only (frep-worker
+  // --data-dir). Every file read from the disk is a regular file of at most maxFileBytes,
+  // checked before anything is allocated; a FIFO or a device is refused, never waited on.
+  enum class FileAccess { Local, JobOnly, DataDir };
+  FileAccess fileAccess = FileAccess::Local;
+  std::string dataDir;
+  uint64_t maxFileBytes = uint64_t(1) << 30;
 };
+
+// Reads a model's file from the disk under `options`' policy (the rule above): `written` is the
+// path as the model writes it, `modelFile` the model's own path (relative paths are relative to
+// its directory for Local). Throws std::runtime_error with a message that names the path and
+// never quotes the file's bytes.
+std::string readModelFileFromDisk(const std::string& written, const std::string& modelFile,
+                                  const CompileOptions& options);
+
+// Reads a regular file of at most maxBytes bytes: opened without blocking (a FIFO never parks
+// the caller), refused unless it is a regular file (devices, FIFOs, directories), its size
+// checked before the buffer is allocated; noFollow: a symbolic link as the last component is
+// refused. Throws std::runtime_error naming `path`.
+std::string readRegularFile(const std::string& path, uint64_t maxBytes, bool noFollow = false);
 
 CompileResult compile(const std::string& source, const std::string& fileName,
                       const CompileOptions& options = {});

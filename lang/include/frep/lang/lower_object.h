@@ -79,8 +79,8 @@ class ObjectLowering {
 
   // ---- diagnostics ------------------------------------------------------------------------
   void error(Loc loc, const std::string& message);
-  // The contents of a file argument (a String node): CompileOptions::files, else the disk,
-  // relative to the model file's directory.
+  // The contents of a file argument (a String node): CompileOptions::files, else the disk as
+  // CompileOptions::fileAccess allows (readModelFileFromDisk).
   const std::string& readModelFile(const AstExpr& path);
   std::vector<std::string> knownNames(bool functionsOnly) const;
   std::string suggestion(const std::string& spelling, bool functionsOnly) const;
