@@ -20,6 +20,7 @@ packages=(
 )
 test_packages=(
   python3-pytest  # tests/python
+  clang-format  # ctest clang_format (tests/format/check_format.py): clang-format 14 on Debian 12
   python3-yaml python3-jsonschema docker-compose  # tests/deploy: Compose v1 (docker-compose 1.29) and schemas
   slurm-wlm munge  # tests/deploy/slurm_e2e.sh: a real single-node Slurm (about 16 s to install)
 )
