@@ -76,6 +76,14 @@ constexpr size_t kMaxHelloBytes = 64 << 10;
 constexpr size_t kMaxBanned = 1024;     // banned routing ids remembered (oldest forgotten)
 constexpr size_t kMaxPeers = 4096;      // welcomed workers at once; a hello beyond is refused
 constexpr size_t kMaxAliases = 4096;    // routing ids of workers that reconnected
+// Failing peers (docs/farm.md, "Failing peers"): a brick is poisoned only when kIndependentFailures
+// workers (distinct worker ids) failed it; a worker that failed a brick is not given it again
+// while another could take it (Master::mayTake); a worker whose failures other workers refuted
+// (they computed the brick it failed) reach kBanAfterRefuted and more than twice the lower median
+// of the other peers' refuted failures is banned: told bye, its worker id refused from then on.
+constexpr size_t kIndependentFailures = 2;
+constexpr uint64_t kBanAfterRefuted = 3;
+constexpr size_t kMaxSkippedForPeer = 64;  // bricks a peer failed passed over per dispatch (bounded scan)
 constexpr int kRouterRcvHwm = 64;       // queued messages per connection (ZMQ_RCVHWM)
 // Results received in a row are verified and decoded together on the decode threads; a batch
 // ends at a message of another kind, at the end of a turn's drain, or at these bounds.
@@ -130,6 +138,8 @@ struct Brick {
   std::array<int32_t, 3> lo{}, hi{};
   BrickPhase phase = BrickPhase::Pending;
   int failures = 0;  // failed attempts reported by its holder (and corrupt results from it)
+  std::set<std::string> failedBy;  // worker ids of those holders (not banned ones: unban on ban)
+  Clock::time_point lastFailure{};
   // Worker deaths (docs/farm.md, "Faults"): the first death of a worker computing it makes it
   // suspect; a suspect is leased only alone to a worker that has shown it is alive, and each
   // such worker that dies with it counts; killers.size() >= maxAttempts poisons it.
@@ -187,6 +197,9 @@ struct Peer {
   bool proven = false;          // sent something after its hello (it lives past a task)
   bool unreachable = false;     // no route to it: no more tasks (sendTask)
   uint64_t finished = 0;        // bricks it computed that were merged
+  uint64_t failures = 0;        // bricks it reported failed (not handed back)
+  uint64_t refuted = 0;         // ... of which another worker then computed
+  std::vector<uint64_t> failedBricks;  // the bricks it failed, to clear them if it is banned
 };
 
 int decodeThreadsFor(int requested) { return requested > 0 ? requested : defaultDecodeThreads(); }
@@ -549,6 +562,13 @@ class Master {
     auto it = peers_.find(in.routingId);
     if (e.body_case() == Envelope::kHello) {
       const std::string wid = e.hello().worker_id().empty() ? printable(in.routingId) : e.hello().worker_id();
+      if (bannedWorkers_.count(wid)) {
+        ++report_.refused;
+        Envelope r;
+        r.mutable_reject()->set_reason("worker " + wid + " was banned from this job: it failed bricks that other workers computed");
+        send(router, in.routingId, r);
+        return;
+      }
       if (it == peers_.end() && !adoptReconnected(wid, in.routingId, e.hello()) && peers_.size() >= kMaxPeers) {
         ++report_.refused;
         Envelope r;
@@ -756,7 +776,7 @@ class Master {
       ++report_.malformed;
       std::string why = "corrupt result from " + a.workerId + ": " + (a.error.empty() ? "crc or bounds" : a.error);
       spdlog::warn("dropped a {}", why);
-      if (b.holders.empty()) requeue(b, why, true);
+      if (b.holders.empty()) requeue(b, why, true, a.workerId);
       ban(router, a.routingId, "corrupt result for brick " + std::to_string(id));
       return;
     }
@@ -781,6 +801,45 @@ class Master {
       send(router, rid, c);
     }
     commit(id, std::move(out), a.workerId, true, std::move(a.kept));
+    // Every other worker that failed this brick was refuted: the computation is deterministic.
+    for (const std::string& w : std::vector<std::string>(b.failedBy.begin(), b.failedBy.end()))
+      if (w != a.workerId) refute(router, w, id);
+  }
+
+  // Worker `workerId` failed brick `id`, which another worker then computed. A worker refuted
+  // kBanAfterRefuted times and more than twice the lower median of the other peers' refuted
+  // failures fails what others compute: it is banned (told bye, its worker id refused, its
+  // failures no longer count against any brick). Honest workers are almost never refuted, and a
+  // model that fails everywhere refutes no one (no one computes its bricks).
+  void refute(zmq::socket_t& router, const std::string& workerId, uint64_t id) {
+    ++report_.refutedFailures;
+    auto it = std::find_if(peers_.begin(), peers_.end(), [&](auto& kv) { return kv.second.workerId == workerId; });
+    if (it == peers_.end()) return;  // gone already
+    Peer& p = it->second;
+    ++p.refuted;
+    std::vector<uint64_t> others;
+    for (auto& [rid, q] : peers_)
+      if (&q != &p) others.push_back(q.refuted);
+    std::sort(others.begin(), others.end());
+    const uint64_t median = others.empty() ? 0 : others[(others.size() - 1) / 2];
+    if (p.refuted < kBanAfterRefuted || p.refuted <= 2 * median) return;
+    const std::string rid = it->first;
+    spdlog::warn("worker {} banned: {} of its {} failures were computed by other workers (brick {} last)", workerId,
+                 p.refuted, p.failures, id);
+    ++report_.failingPeersBanned;
+    // Its failures no longer count against the bricks: it was wrong about those others did.
+    for (uint64_t f : p.failedBricks) {
+      Brick& b = bricks_[f];
+      if (b.failedBy.erase(workerId) && b.failures > 0) --b.failures;
+    }
+    if (bannedWorkers_.insert(workerId).second) {
+      bannedWorkerOrder_.push_back(workerId);
+      if (bannedWorkerOrder_.size() > kMaxBanned) {
+        bannedWorkers_.erase(bannedWorkerOrder_.front());
+        bannedWorkerOrder_.pop_front();
+      }
+    }
+    ban(router, rid, "it failed " + std::to_string(p.refuted) + " bricks that other workers computed");
   }
 
   // A verified payload: appended to the journal if there is one, and for "sample" kept until
@@ -848,7 +907,9 @@ class Master {
       requeue(b, e.failed().error(), false);
     } else {
       spdlog::warn("brick {} failed on {}: {}", id, p.workerId, e.failed().error());
-      requeue(b, e.failed().error(), true);
+      ++p.failures;
+      p.failedBricks.push_back(id);
+      requeue(b, e.failed().error(), true, p.workerId);
     }
   }
 
@@ -860,11 +921,20 @@ class Master {
                   b.hi[1], b.hi[2], count, why);
   }
 
-  // Back to the queue; `counts`: a failure its holder reported (poisons at maxAttempts).
-  void requeue(Brick& b, const std::string& why, bool counts) {
+  // Back to the queue; `counts`: a failure its holder (worker id `by`) reported: poisons when
+  // kIndependentFailures workers failed it, or maxAttempts failures came from workers that had
+  // no other to hand it to (mayTake).
+  void requeue(Brick& b, const std::string& why, bool counts, const std::string& by = {}) {
     b.lastError = why;
     leased_.erase(b.id);
-    if (counts && ++b.failures >= opt_.maxAttempts) return poison(b, why, std::to_string(b.failures) + " failures");
+    if (counts) {
+      ++b.failures;
+      if (!by.empty()) b.failedBy.insert(by);
+      b.lastFailure = Clock::now();
+      if (b.failedBy.size() >= kIndependentFailures)
+        return poison(b, why, std::to_string(b.failedBy.size()) + " workers failed it");
+      if (b.failures >= opt_.maxAttempts) return poison(b, why, std::to_string(b.failures) + " failures");
+    }
     ++report_.retries;
     b.phase = BrickPhase::Pending;
     b.backupIssued = b.leaseReissued = false;
@@ -996,6 +1066,21 @@ class Master {
     p.everHeld.insert(b.id);
   }
 
+  // Whether `cand` may be leased pending brick `b`. A worker that failed it gets it again only
+  // when no other worker could take it (every peer failed it, or is unreachable), and only
+  // after a wait: two liveness windows for a worker that has computed other bricks (its word
+  // is credible: a brick that fails on the only worker is poisoned after maxAttempts), the
+  // no-worker timeout for one that has computed none (a peer that fails everything must not
+  // poison bricks before an honest worker joins).
+  bool mayTake(const Peer& cand, const Brick& b, Clock::time_point now) const {
+    if (!b.failedBy.count(cand.workerId)) return true;
+    for (auto& [rid, q] : peers_)
+      if (&q != &cand && !q.unreachable && !b.failedBy.count(q.workerId)) return false;
+    const Clock::duration wait =
+        cand.finished > 0 ? 2 * liveWindow() : Clock::duration(std::chrono::seconds(opt_.noWorkerTimeoutSec));
+    return now - b.lastFailure > wait;
+  }
+
   void dispatch(zmq::socket_t& router, Clock::time_point now) {
     // Cluster mode: give the expected workers a short grace period to join, so that the first
     // bricks spread over the whole farm instead of queuing on the earliest worker.
@@ -1010,6 +1095,19 @@ class Master {
     auto holdsSuspect = [&](const Peer& p) {
       return std::any_of(p.inflight.begin(), p.inflight.end(), [&](uint64_t id) { return bricks_[id].suspect; });
     };
+    // Takes the first brick of `queue` that `cand` may take (its phase `phase`), passing over at
+    // most kMaxSkippedForPeer that it failed before (they stay at the front, in order).
+    auto takeFrom = [&](std::deque<uint64_t>& queue, const Peer& cand, std::optional<uint64_t>& next) {
+      std::vector<uint64_t> skipped;
+      while (!queue.empty() && !next && skipped.size() < kMaxSkippedForPeer) {
+        uint64_t id = queue.front();
+        queue.pop_front();
+        if (bricks_[id].phase != BrickPhase::Pending) continue;
+        if (mayTake(cand, bricks_[id], now)) next = id;
+        else skipped.push_back(id);
+      }
+      queue.insert(queue.begin(), skipped.begin(), skipped.end());
+    };
     for (int round = 0; round < kCredit; ++round)
       for (auto& rid : rids) {
         auto it = peers_.find(rid);
@@ -1023,25 +1121,17 @@ class Master {
                               (cand.finished == 0 || suspects_.empty() ||
                                now - bricks_[suspects_.front()].suspectSince > 2 * liveWindow());
         std::optional<uint64_t> next;
-        while (isolates && !suspects_.empty() && !next) {
-          uint64_t id = suspects_.front();
-          suspects_.pop_front();
-          if (bricks_[id].phase == BrickPhase::Pending) next = id;
-        }
+        if (isolates) takeFrom(suspects_, cand, next);
         std::vector<uint64_t> notHere;  // suspect copies due again, for an isolating worker
         while (!reissue_.empty() && !next) {
           uint64_t id = reissue_.front();
           reissue_.pop_front();
           if (bricks_[id].phase != BrickPhase::Leased || bricks_[id].holders.count(rid)) continue;
-          if (bricks_[id].suspect && !isolates) notHere.push_back(id);
+          if ((bricks_[id].suspect && !isolates) || bricks_[id].failedBy.count(cand.workerId)) notHere.push_back(id);
           else next = id;
         }
         reissue_.insert(reissue_.begin(), notHere.begin(), notHere.end());
-        while (!pending_.empty() && !next) {
-          uint64_t id = pending_.front();
-          pending_.pop_front();
-          if (bricks_[id].phase == BrickPhase::Pending) next = id;
-        }
+        if (!next) takeFrom(pending_, cand, next);
         if (!next) continue;
         sendTask(router, rid, it->second, bricks_[*next], now);
       }
@@ -1054,6 +1144,7 @@ class Master {
       Brick* oldest = nullptr;
       for (uint64_t id : leased_)
         if (Brick& b = bricks_[id]; !b.backupIssued && !b.suspect && !b.holders.count(rid) &&
+            !b.failedBy.count(it->second.workerId) &&
             std::chrono::duration<double>(now - b.firstLease).count() > threshold &&
             (!oldest || b.firstLease < oldest->firstLease))
           oldest = &b;
@@ -1298,6 +1389,8 @@ class Master {
   std::deque<uint64_t> suspects_;  // pending suspect bricks (onDeath), leased only alone
   std::set<std::string> banned_;   // routing ids that sent garbage
   std::deque<std::string> bannedOrder_;
+  std::set<std::string> bannedWorkers_;  // worker ids banned for failing what others computed
+  std::deque<std::string> bannedWorkerOrder_;
   std::map<std::string, std::string> aliases_;  // old routing id -> new, of reconnected workers
   std::vector<BrickOutput> outputs_;  // "mesh", "render": the merged bricks' results, by brick
   PayloadArena arena_;                // "sample": the kept payloads (before kept_ and arrivals_, which hold pieces of it)
@@ -1381,7 +1474,8 @@ std::string FarmReport::toJson() const {
                  {"lease_reissues", leaseReissues}, {"refused", refused},
                  {"curve_rejected", curveRejected}, {"foreign_results", foreignResults},
                  {"banned_peers", bannedPeers},  {"suspect_bricks", suspectBricks},
-                 {"reconnects", reconnects},     {"master_stalls", masterStalls}};
+                 {"reconnects", reconnects},     {"master_stalls", masterStalls},
+                 {"refuted_failures", refutedFailures}, {"failing_peers_banned", failingPeersBanned}};
   j["workers_seen"] = workersSeen;
   nlohmann::json w = nlohmann::json::object();
   for (auto& [id, s] : perWorker)

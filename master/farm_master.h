@@ -113,7 +113,9 @@ struct FarmReport {
   uint64_t curveRejected = 0;
   // Hostile or broken peers and faults (docs/farm.md, "Threat model" and "Faults"):
   uint64_t foreignResults = 0;  // results or failures for a brick the sender does not hold
-  uint64_t bannedPeers = 0;     // peers dropped for garbage (their bricks not charged)
+  uint64_t bannedPeers = 0;     // peers dropped for garbage or failing peers (their bricks not charged)
+  uint64_t refutedFailures = 0;     // failures of a brick that another worker then computed
+  uint64_t failingPeersBanned = 0;  // peers banned for them (docs/farm.md, "Failing peers")
   uint64_t suspectBricks = 0;   // bricks whose worker died computing them (then retried alone)
   uint64_t reconnects = 0;      // workers back under a new connection, leases kept
   uint64_t masterStalls = 0;    // the master's own loop stopped longer than the liveness window

@@ -375,3 +375,101 @@ TEST(HostilePeer, AReconnectedWorkerGetsBackTheBricksItNoLongerHas) {
   EXPECT_TRUE(master.outcome.report.poisoned.empty());
   expectSameLeaves(ref, master.outcome.result);
 }
+
+namespace {
+// A peer that answers `failed` to every task it is leased, on its own thread, until the master
+// says bye (or `stop`). Then, when `helloAgain`, it says hello once more under a new connection
+// and the same worker id, and records whether the master rejected it.
+struct FailingPeer {
+  std::atomic<bool> stop{false};
+  std::atomic<int> failed{0};
+  std::atomic<bool> gotBye{false}, rejectedAgain{false};
+  std::thread thread;
+  FailingPeer(const std::string& ep, const std::string& id, bool helloAgain) {
+    thread = std::thread([this, ep, id, helloAgain] {
+      zmq::context_t ctx(1);
+      {
+        ScriptedPeer p(ctx, ep, id);
+        auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        while (!stop && !gotBye && std::chrono::steady_clock::now() < deadline) {
+          zmq::pollitem_t item{static_cast<void*>(p.s), 0, ZMQ_POLLIN, 0};
+          zmq::poll(&item, 1, std::chrono::milliseconds(20));
+          Incoming in;
+          std::string err;
+          while (receive(p.s, false, in, &err)) {
+            if (!err.empty()) continue;
+            if (in.envelope.body_case() == Envelope::kTask) {
+              p.fail(in.envelope.job_id(), in.envelope.task().brick_id(), false);
+              ++failed;
+            } else if (in.envelope.body_case() == Envelope::kBye) {
+              gotBye = true;
+            }
+          }
+          Envelope hb;
+          hb.mutable_heartbeat();
+          send(p.s, "", hb);
+        }
+      }
+      if (!helloAgain || !gotBye) return;
+      ScriptedPeer again(ctx, ep, id + "-again", false);
+      again.sayHello(id);
+      rejectedAgain = !again.collect(Envelope::kReject, 1, 3000).empty();
+    });
+  }
+  ~FailingPeer() {
+    stop = true;
+    if (thread.joinable()) thread.join();
+  }
+};
+}  // namespace
+
+// Issue 31: one leased peer that answered `failed` to every task ended the whole job (its bricks
+// came back to it, 13 poisoned in 1.4 s, exit 5). Now a brick it failed goes to another worker,
+// it is banned once three of its failures are computed elsewhere (its worker id refused when it
+// says hello again), nothing is poisoned and the output is the clean run's.
+TEST(HostilePeer, APeerThatFailsEverythingIsBannedAndTheJobCompletes) {
+  JobSpec j = sphereJob();
+  SampleResult ref = reference(j);
+  FarmOptions o = clusterOptions();
+  o.brickVoxels = 16;  // 64 bricks
+  const auto t0 = std::chrono::steady_clock::now();
+  MasterThread master(j, o);
+  const std::string ep = master.endpoint();
+  FailingPeer failer(ep, "failer", /*helloAgain=*/true);
+  // It fails bricks before the honest worker joins: those wait for another worker.
+  for (int i = 0; i < 250 && failer.failed < 8; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_GE(failer.failed, 8);
+  WorkerProcess honest(ep, {"FREP_TEST_SLOW_MS=20"});
+  master.join();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(honest.wait(30), 0);
+  failer.stop = true;
+  failer.thread.join();
+  ASSERT_EQ(master.error, "");
+  const FarmReport& r = master.outcome.report;
+  EXPECT_TRUE(r.poisoned.empty());
+  EXPECT_EQ(r.failingPeersBanned, 1u);
+  EXPECT_GE(r.refutedFailures, 3u);
+  EXPECT_TRUE(failer.gotBye);
+  EXPECT_TRUE(failer.rejectedAgain) << "the banned worker id was welcomed again";
+  EXPECT_EQ(r.bricksComputed, 64u);
+  expectSameLeaves(ref, master.outcome.result);
+  std::printf("[ failing  ] the failing peer failed %d bricks; %llu refuted, banned; job %.2f s, 0 poisoned\n",
+              failer.failed.load(), static_cast<unsigned long long>(r.refutedFailures), seconds);
+}
+
+// The job fails a brick only when two independent workers fail it: two peers that fail
+// everything (and no honest worker) poison every brick, each failed by both, none by one alone.
+TEST(HostilePeer, ABrickIsPoisonedWhenTwoWorkersFailIt) {
+  JobSpec j = sphereJob();
+  MasterThread master(j, clusterOptions());
+  const std::string ep = master.endpoint();
+  FailingPeer a(ep, "fails-a", false), b(ep, "fails-b", false);
+  master.join();
+  ASSERT_EQ(master.error, "");
+  const FarmReport& r = master.outcome.report;
+  EXPECT_EQ(r.poisoned.size(), 8u);
+  for (const PoisonedBrick& p : r.poisoned) EXPECT_NE(p.error.find("forged failure"), std::string::npos);
+  EXPECT_EQ(a.failed + b.failed, 16);  // each brick once by each
+  EXPECT_EQ(r.failingPeersBanned, 0u);
+}
