@@ -251,8 +251,14 @@ TEST(MeshSimplify, SameResultWhateverTheSplit) {
   SimplifyOptions so;
   so.tolerance = 0.1;
   Mesh a = meshGrid(tape, g, {}, 0), b = meshGrid(tape, g, {}, 16);
-  simplifyMesh(a, tape, g, so);
-  simplifyMesh(b, tape, g, so);
+  const size_t raw = a.triangles.size();
+  const SimplifyStats sa = simplifyMesh(a, tape, g, so), sb = simplifyMesh(b, tape, g, so);
+  // Something was simplified (equal meshes would prove nothing otherwise), the same work both ways.
+  EXPECT_EQ(sa.trianglesBefore, raw);
+  EXPECT_EQ(sa.trianglesAfter, a.triangles.size());
+  EXPECT_GT(sa.collapses, 1000u);
+  EXPECT_LT(a.triangles.size() * 2, raw) << "simplified from " << raw << " to " << a.triangles.size() << " triangles";
+  EXPECT_EQ(sa.collapses, sb.collapses);
   expectSameMesh(a, b);
 }
 
