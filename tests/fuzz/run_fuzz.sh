@@ -6,10 +6,17 @@
 # over 30 s count as findings. Exit 0: no findings; otherwise the failing input is kept as
 # BUILD/findings/<target>-crash-* (add it to corpus/<target>/ with its fix).
 # FUZZ_SCALE=N multiplies every iteration count (a longer local run).
+# Then the process fuzz loops (tests/cli/process_fuzz: the frep binary run once per damaged
+# input, about a minute), built in the Release build RELEASE (FREP_BUILD, default build/).
 set -eu
 HERE=$(cd "$(dirname "$0")" && pwd)
 REPO=$(cd "$HERE/../.." && pwd)
 BUILD=${1:-$REPO/build-fuzz}
+RELEASE=${FREP_BUILD:-$REPO/build}
+if [ ! -f "$RELEASE/CMakeCache.txt" ]; then
+  echo "run_fuzz: no Release build at $RELEASE for the process fuzz loops (deploy/build.sh makes it; FREP_BUILD=DIR names another)"
+  exit 2
+fi
 SCALE=${FUZZ_SCALE:-1}
 cmake -S "$HERE" -B "$BUILD" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug >/dev/null
 cmake --build "$BUILD" -j"$(nproc)"
@@ -42,3 +49,13 @@ run journal 20000 "" "$seeds/journal"
 # few hundred KiB in a process that then exits 3): leaks are not findings for this target.
 export ASAN_OPTIONS=detect_leaks=0
 run vdb 8000 "-detect_leaks=0" "$seeds/vdb"
+unset ASAN_OPTIONS
+# The process fuzz loops (GoogleTest; frep itself is the Release binary, as users run it).
+start=$(date +%s)
+cmake --build "$RELEASE" -j"$(nproc)" --target cli_process_fuzz >/dev/null
+"$RELEASE/bin/cli_process_fuzz" >"$BUILD/findings/process.log" 2>&1 || {
+  tail -40 "$BUILD/findings/process.log"
+  echo "run_fuzz: process fuzz loops: FAILED (log: $BUILD/findings/process.log)"
+  exit 1
+}
+echo "run_fuzz: process fuzz loops: $(grep -c '^\[       OK \]' "$BUILD/findings/process.log") passed, $(( $(date +%s) - start )) s"
