@@ -12,17 +12,22 @@
 
 #include "arg_parse.h"
 #include "exit_codes.h"
+#include "frep/io/input_file.h"
 
 namespace frep::cli {
 namespace {
 
+// The model: a regular file of at most 1 GiB (a FIFO or /dev/zero is refused at once, exit 3).
 std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ioError("cannot read model '" + path + "': " + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ioError("cannot read model '" + path + "': read error");
-  return text.str();
+  try {
+    return io::readInputFile(path);
+  } catch (const io::Error& e) {
+    // "cannot read model 'm.hf': No such file or directory", "… '/dev/zero': is not a regular file …"
+    const std::string what = e.what(), open = "cannot open file '" + path + "' (";
+    if (what.rfind(open, 0) == 0 && what.back() == ')')
+      throw ioError("cannot read model '" + path + "': " + what.substr(open.size(), what.size() - open.size() - 1));
+    throw ioError("cannot read model " + what);
+  }
 }
 
 std::vector<double> parseParameters(const lang::Model& model, const std::string& text) {

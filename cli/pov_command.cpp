@@ -10,6 +10,7 @@
 #include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "exit_codes.h"
+#include "frep/io/input_file.h"
 #include "frep/io/pov_scene.h"
 
 namespace frep::cli {
@@ -19,13 +20,8 @@ bool endsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ioError("cannot read '" + path + "'");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+// A regular file of at most 1 GiB (a FIFO or a device is refused at once, exit 3).
+std::string readFile(const std::string& path) { return io::readInputFile(path); }
 
 // file:line:column of the object whose field is `part` (the first operand that is not a
 // basic-set term), else of the selected object.

@@ -12,6 +12,7 @@
 
 #include "frep/geometry/distance_fields.h"
 #include "frep/io/error.h"
+#include "frep/io/input_file.h"
 #include "frep/io/mesh_reader.h"
 #include "frep/lang/library.h"
 
@@ -24,14 +25,7 @@ uint64_t contentHash(const std::string& bytes) {
 }
 
 namespace {
-std::string readAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ioError(path + ": cannot open the file (" + std::strerror(errno) + ")");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw ioError(path + ": cannot read the file");
-  return ss.str();
-}
+std::string readAll(const std::string& path) { return readInputFile(path); }
 
 std::string edgeList(const MeshCheck& c) {
   std::string s;

@@ -1,18 +1,27 @@
+// Mesh files for frep render and frMesh (mesh_reader.h). Every count a file states is checked
+// against the bytes the file really has before anything is allocated or looped over, every
+// coordinate and index must be a finite number, and a message names the file and the line or
+// byte at fault, never the file's text (a worker's --data-dir file must not travel back to its
+// master in an error).
 #include "frep/io/mesh_reader.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 
 #include "frep/io/error.h"
+#include "frep/io/input_file.h"
 
 namespace frep::io {
 namespace {
 
-
 [[noreturn]] void fail(const std::string& path, const std::string& why) { throw ioError(path + ": " + why); }
+
+std::string byteText(size_t at) { return "byte " + std::to_string(at + 1); }
+
+bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
 
 void addPolygon(Mesh& m, const std::vector<int64_t>& poly, const std::string& path, const std::string& where) {
   if (poly.size() < 3) fail(path, where + ": a face with fewer than 3 vertices");
@@ -25,6 +34,13 @@ void addPolygon(Mesh& m, const std::vector<int64_t>& poly, const std::string& pa
 void checkPosition(const std::array<double, 3>& p, const std::string& path, const std::string& where) {
   for (double c : p)
     if (!std::isfinite(c)) fail(path, where + ": non-finite coordinate");
+}
+
+// A number token: the whole token, finite.
+bool parseNumber(const char* b, const char* e, double& v) {
+  if (b < e && *b == '+') ++b;
+  const auto r = std::from_chars(b, e, v);
+  return r.ec == std::errc() && r.ptr == e && std::isfinite(v);
 }
 
 // ---- PLY ----
@@ -46,15 +62,29 @@ size_t typeSize(const std::string& t) {
   return 0;
 }
 
-class PlyBinary {
+// How a message names an element: its name if it is one this reader knows, else its rank.
+std::string elementText(const PlyElement& e, size_t rank) {
+  if (e.name == "vertex" || e.name == "face") return "element '" + e.name + "'";
+  return "element " + std::to_string(rank + 1);
+}
+
+class PlyData {
  public:
-  PlyBinary(std::istream& in, bool bigEndian, const std::string& path) : in_(in), big_(bigEndian), path_(path) {}
-  double read(const std::string& type) {
+  PlyData(const std::string& bytes, size_t pos, int format, const std::string& path)
+      : b_(bytes), pos_(pos), format_(format), path_(path) {}
+
+  double value(const std::string& type) {
+    if (format_ == 0) return asciiValue();
     unsigned char b[8];
     const size_t n = typeSize(type);
-    if (!in_.read(reinterpret_cast<char*>(b), std::streamsize(n))) fail(path_, "truncated binary data");
-    if (big_) std::reverse(b, b + n);
-    auto as = [&](auto v) { std::memcpy(&v, b, sizeof v); return double(v); };
+    if (b_.size() - pos_ < n) fail(path_, "truncated binary data at " + byteText(pos_));
+    std::memcpy(b, b_.data() + pos_, n);
+    pos_ += n;
+    if (format_ == 2) std::reverse(b, b + n);
+    auto as = [&](auto v) {
+      std::memcpy(&v, b, sizeof v);
+      return double(v);
+    };
     if (type == "char" || type == "int8") return as(int8_t());
     if (type == "uchar" || type == "uint8") return as(uint8_t());
     if (type == "short" || type == "int16") return as(int16_t());
@@ -64,72 +94,129 @@ class PlyBinary {
     if (type == "float" || type == "float32") return as(float());
     return as(double());
   }
+  size_t pos() const { return pos_; }
+  size_t left() const { return b_.size() - pos_; }
 
  private:
-  std::istream& in_;
-  bool big_;
+  double asciiValue() {
+    while (pos_ < b_.size() && isBlank(b_[pos_])) ++pos_;
+    if (pos_ >= b_.size()) fail(path_, "truncated ascii data (the file ends at " + byteText(b_.size() - 1) + ")");
+    const size_t start = pos_;
+    while (pos_ < b_.size() && !isBlank(b_[pos_])) ++pos_;
+    double v;
+    if (!parseNumber(b_.data() + start, b_.data() + pos_, v)) fail(path_, "not a finite number at " + byteText(start));
+    return v;
+  }
+
+  const std::string& b_;
+  size_t pos_;
+  int format_;  // 0 ascii, 1 binary little endian, 2 binary big endian
   const std::string& path_;
 };
 
-Mesh readPly(std::istream& in, const std::string& path) {
-  std::string line, format;
-  std::getline(in, line);
-  if (line != "ply" && line != "ply\r") fail(path, "not a PLY file (no 'ply' magic)");
-  std::vector<PlyElement> elements;
-  for (int headerLine = 2;; ++headerLine) {
-    if (!std::getline(in, line)) fail(path, "truncated header (no end_header)");
+Mesh readPly(const std::string& bytes, const std::string& path) {
+  size_t pos = 0;
+  int lineNo = 0;
+  std::string line;
+  auto nextLine = [&]() {
+    if (pos >= bytes.size()) return false;
+    size_t e = bytes.find('\n', pos);
+    if (e == std::string::npos) e = bytes.size();
+    line.assign(bytes, pos, e - pos);
+    pos = std::min(bytes.size(), e + 1);
+    ++lineNo;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  };
+  if (!nextLine() || line != "ply") fail(path, "not a PLY file (no 'ply' magic)");
+  std::vector<PlyElement> elements;
+  int format = -1;
+  for (;;) {
+    if (!nextLine()) fail(path, "truncated header (no end_header)");
+    const std::string where = "header line " + std::to_string(lineNo);
     std::istringstream ls(line);
     std::string word;
     ls >> word;
     if (word == "end_header") break;
-    if (word == "format") ls >> format;
-    else if (word == "element") {
+    if (word == "format") {
+      std::string f;
+      ls >> f;
+      format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -2;
+      if (format == -2) fail(path, where + ": unknown PLY format (ascii, binary_little_endian, binary_big_endian)");
+    } else if (word == "element") {
       PlyElement e;
-      if (!(ls >> e.name >> e.count)) fail(path, "header line " + std::to_string(headerLine) + ": bad element line");
+      std::string count;
+      if (!(ls >> e.name >> count)) fail(path, where + ": expected 'element NAME COUNT'");
+      const auto r = std::from_chars(count.data(), count.data() + count.size(), e.count);
+      if (r.ec != std::errc() || r.ptr != count.data() + count.size())
+        fail(path, where + ": the element count is not a whole number of at most 2^64 - 1");
       elements.push_back(e);
     } else if (word == "property") {
-      if (elements.empty()) fail(path, "property before any element");
+      if (elements.empty()) fail(path, where + ": property before any element");
       PlyProperty p;
       ls >> p.type;
       if (p.type == "list") ls >> p.countType >> p.type;
       ls >> p.name;
-      if (!typeSize(p.type) || (!p.countType.empty() && !typeSize(p.countType)))
-        fail(path, "header line " + std::to_string(headerLine) + ": unknown property type");
+      if (!typeSize(p.type) || (p.type == "list") || (!p.countType.empty() && !typeSize(p.countType)))
+        fail(path, where + ": unknown property type");
+      if (p.name.empty()) fail(path, where + ": a property without a name");
       elements.back().props.push_back(p);
+    } else if (word != "comment" && word != "obj_info" && !word.empty()) {
+      fail(path, where + ": not a PLY header line (format, element, property, comment, end_header)");
     }
   }
-  if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
-    fail(path, "unknown PLY format (ascii, binary_little_endian, binary_big_endian)");
+  if (format < 0) fail(path, "no format line in the header");
+  // Every element's entries must fit in what follows the header, at their smallest: a binary
+  // entry takes its scalars' and list counts' bytes, an ascii value at least a character and a
+  // blank. Checked before anything is read or allocated, so a header that states 2^31 or 2^64
+  // entries fails here at once (before: a 48 GB allocation, or 2.2 s spinning a header line).
+  const size_t left = bytes.size() - pos;
+  unsigned __int128 need = 0;
+  for (size_t k = 0; k < elements.size(); ++k) {
+    const PlyElement& e = elements[k];
+    uint64_t least = 0;
+    for (const PlyProperty& p : e.props) least += format == 0 ? 2 : typeSize(p.countType.empty() ? p.type : p.countType);
+    if (e.name == "vertex") {
+      for (const char* axis : {"x", "y", "z"})
+        if (std::none_of(e.props.begin(), e.props.end(), [&](const PlyProperty& p) { return p.name == axis && p.countType.empty(); }))
+          fail(path, "the vertex element has no scalar property '" + std::string(axis) + "'");
+    }
+    if (e.count > 0 && least == 0)
+      fail(path, elementText(e, k) + " has " + std::to_string(e.count) + " entries but no properties");
+    need += static_cast<unsigned __int128>(e.count) * least;
+    if (need > static_cast<unsigned __int128>(left) + 1)
+      fail(path, elementText(e, k) + " states " + std::to_string(e.count) + " entries of at least " +
+                     std::to_string(least) + " bytes each, more than the " + std::to_string(left) +
+                     " bytes after the header (truncated or damaged)");
+  }
   Mesh m;
-  PlyBinary bin(in, format == "binary_big_endian", path);
-  std::string token;
-  auto value = [&](const std::string& type) -> double {
-    if (format != "ascii") return bin.read(type);
-    if (!(in >> token)) fail(path, "truncated ascii data");
-    char* end = nullptr;
-    const double v = std::strtod(token.c_str(), &end);
-    if (*end || end == token.c_str())
-      fail(path, "not a number at byte " + std::to_string(int64_t(in.tellg()) - int64_t(token.size()) + 1));
-    return v;
-  };
+  PlyData data(bytes, pos, format, path);
   for (const PlyElement& e : elements) {
     const bool vertex = e.name == "vertex", face = e.name == "face";
-    // Counts beyond what the file can hold are refused before allocating.
-    if (e.count > (uint64_t(1) << 31)) fail(path, "element " + e.name + " count too large");
+    if (vertex) m.positions.reserve(m.positions.size() + size_t(std::min<uint64_t>(e.count, 1 << 20)));
     for (uint64_t i = 0; i < e.count; ++i) {
       std::array<double, 3> p{0, 0, 0};
       for (const PlyProperty& pr : e.props) {
         if (!pr.countType.empty()) {
-          const double n = value(pr.countType);
-          if (!(n >= 0 && n <= 1e6)) fail(path, e.name + " " + std::to_string(i) + ": bad list length");
+          const size_t at = data.pos();
+          const double n = data.value(pr.countType);
+          // A list's entries take at least a byte each (two in ascii): its length is bounded by
+          // what is left before it is allocated.
+          if (!(n >= 0 && n == std::floor(n) && n <= double(data.left())))
+            fail(path, e.name == "face" ? "face " + std::to_string(i) + ": bad list length at " + byteText(at)
+                                        : "bad list length at " + byteText(at));
           std::vector<int64_t> poly(static_cast<size_t>(n));
-          for (int64_t& k : poly) k = int64_t(value(pr.type));
+          for (int64_t& k : poly) {
+            const size_t vat = data.pos();
+            const double v = data.value(pr.type);
+            if (!(v == std::floor(v) && std::fabs(v) <= 9.0e15)) fail(path, "not a whole number at " + byteText(vat));
+            k = int64_t(v);
+          }
           if (face && (pr.name == "vertex_indices" || pr.name == "vertex_index"))
             addPolygon(m, poly, path, "face " + std::to_string(i));
           continue;
         }
-        const double v = value(pr.type);
+        const double v = data.value(pr.type);
         if (vertex && pr.name.size() == 1 && pr.name[0] >= 'x' && pr.name[0] <= 'z') p[size_t(pr.name[0] - 'x')] = v;
       }
       if (vertex) {
@@ -143,26 +230,43 @@ Mesh readPly(std::istream& in, const std::string& path) {
 
 // ---- OBJ ----
 
-Mesh readObj(std::istream& in, const std::string& path) {
+Mesh readObj(const std::string& bytes, const std::string& path) {
   Mesh m;
-  std::string line;
-  for (size_t lineNo = 1; std::getline(in, line); ++lineNo) {
-    std::istringstream ls(line);
-    std::string word;
-    ls >> word;
+  size_t pos = 0;
+  std::vector<int64_t> poly;
+  for (size_t lineNo = 1; pos < bytes.size(); ++lineNo) {
+    size_t end = bytes.find('\n', pos);
+    if (end == std::string::npos) end = bytes.size();
+    const size_t lineStart = pos;
+    pos = end + 1;
+    // The line's blank-separated tokens, one at a time.
+    size_t at = lineStart;
+    auto token = [&](const char*& b, const char*& e) {
+      while (at < end && isBlank(bytes[at])) ++at;
+      if (at >= end) return false;
+      b = bytes.data() + at;
+      while (at < end && !isBlank(bytes[at])) ++at;
+      e = bytes.data() + at;
+      return true;
+    };
     const std::string where = "line " + std::to_string(lineNo);
+    const char *b, *e;
+    if (!token(b, e)) continue;
+    const std::string word(b, e);
     if (word == "v") {
       std::array<double, 3> p{};
-      if (!(ls >> p[0] >> p[1] >> p[2])) fail(path, where + ": expected v x y z");
-      checkPosition(p, path, where);
+      for (double& c : p) {
+        if (!token(b, e)) fail(path, where + ": expected v x y z");
+        if (!parseNumber(b, e, c)) fail(path, where + ": not a finite number at " + byteText(size_t(b - bytes.data())));
+      }
       m.positions.push_back(p);
     } else if (word == "f") {
-      std::vector<int64_t> poly;
-      std::string item;
-      while (ls >> item) {
-        char* end = nullptr;
-        const long long k = std::strtoll(item.c_str(), &end, 10);
-        if (end == item.c_str() || (*end && *end != '/') || k == 0) fail(path, where + ": bad face vertex");
+      poly.clear();
+      while (token(b, e)) {
+        int64_t k = 0;
+        const auto r = std::from_chars(b, e, k);
+        if (r.ec != std::errc() || (r.ptr != e && *r.ptr != '/') || k == 0)
+          fail(path, where + ": bad face vertex at " + byteText(size_t(b - bytes.data())));
         poly.push_back(k > 0 ? k - 1 : int64_t(m.positions.size()) + k);
       }
       addPolygon(m, poly, path, where);
@@ -173,35 +277,89 @@ Mesh readObj(std::istream& in, const std::string& path) {
 
 // ---- STL ----
 
-Mesh readStl(const std::string& bytes, const std::string& path) {
+// ASCII STL, strictly: solid NAME, then facets (facet normal nx ny nz / outer loop / three
+// vertex x y z / endloop / endfacet), then endsolid; several solids may follow one another. A
+// file that ends before endsolid is truncated and refused, naming its last line (before: it was
+// accepted, its open edges only warned about).
+Mesh readAsciiStl(const std::string& bytes, const std::string& path) {
   Mesh m;
-  auto addTriangle = [&](const std::array<std::array<double, 3>, 3>& t, const std::string& where) {
-    for (const auto& p : t) {
-      checkPosition(p, path, where);
-      m.positions.push_back(p);
-    }
-    const uint32_t b = uint32_t(m.positions.size() - 3);
-    m.triangles.push_back({b, b + 1, b + 2});
+  size_t pos = 0;
+  size_t lineNo = 1, tokenLine = 1;  // the line of the last token read
+  const char *b = nullptr, *e = nullptr;
+  auto token = [&]() {
+    for (; pos < bytes.size() && isBlank(bytes[pos]); ++pos)
+      if (bytes[pos] == '\n') ++lineNo;
+    if (pos >= bytes.size()) return false;
+    tokenLine = lineNo;
+    b = bytes.data() + pos;
+    while (pos < bytes.size() && !isBlank(bytes[pos])) ++pos;
+    e = bytes.data() + pos;
+    return true;
   };
-  const bool ascii = bytes.compare(0, 5, "solid") == 0 && bytes.find("facet") != std::string::npos;
-  if (ascii) {
-    std::istringstream ls(bytes);
-    std::string word;
-    std::array<std::array<double, 3>, 3> t{};
-    int k = 0;
-    size_t facet = 0;
-    while (ls >> word) {
-      if (word != "vertex") continue;
-      if (!(ls >> t[size_t(k)][0] >> t[size_t(k)][1] >> t[size_t(k)][2])) fail(path, "facet " + std::to_string(facet) + ": bad vertex");
-      if (++k == 3) addTriangle(t, "facet " + std::to_string(facet++)), k = 0;
+  auto where = [&]() { return path + ":" + std::to_string(tokenLine); };
+  auto is = [&](const char* w) { return size_t(e - b) == std::strlen(w) && std::memcmp(b, w, size_t(e - b)) == 0; };
+  auto expect = [&](const char* w, const char* inside) {
+    if (!token()) throw ioError(where() + ": truncated ASCII STL (the file ends inside " + inside + ")");
+    if (!is(w)) throw ioError(where() + ": expected '" + w + "' in " + inside);
+  };
+  auto number = [&](const char* inside) {
+    if (!token()) throw ioError(where() + ": truncated ASCII STL (the file ends inside " + inside + ")");
+    double v;
+    if (!parseNumber(b, e, v)) throw ioError(where() + ": not a finite number in " + inside);
+    return v;
+  };
+  bool inSolid = false;
+  while (token()) {
+    if (!inSolid) {
+      if (!is("solid")) throw ioError(where() + ": expected 'solid'");
+      inSolid = true;
+      // The solid's name: the rest of the line.
+      while (pos < bytes.size() && bytes[pos] != '\n') ++pos;
+      continue;
     }
-    if (k != 0) fail(path, "a facet with fewer than 3 vertices");
-    return m;
+    if (is("endsolid")) {
+      inSolid = false;
+      while (pos < bytes.size() && bytes[pos] != '\n') ++pos;  // its name
+      continue;
+    }
+    if (!is("facet")) throw ioError(where() + ": expected 'facet' or 'endsolid'");
+    expect("normal", "a facet");
+    for (int k = 0; k < 3; ++k) number("a facet's normal");
+    expect("outer", "a facet");
+    expect("loop", "a facet");
+    std::array<std::array<double, 3>, 3> t{};
+    for (int v = 0; v < 3; ++v) {
+      if (!token()) throw ioError(where() + ": truncated ASCII STL (the file ends inside a facet)");
+      if (is("endloop")) throw ioError(where() + ": a facet with fewer than 3 vertices");
+      if (!is("vertex")) throw ioError(where() + ": expected 'vertex' in a facet");
+      for (double& c : t[size_t(v)]) c = number("a vertex");
+    }
+    if (!token()) throw ioError(where() + ": truncated ASCII STL (the file ends inside a facet)");
+    if (is("vertex")) throw ioError(where() + ": a facet with more than 3 vertices");
+    if (!is("endloop")) throw ioError(where() + ": expected 'endloop' in a facet");
+    expect("endfacet", "a facet");
+    for (const auto& p : t) m.positions.push_back(p);
+    const uint32_t first = uint32_t(m.positions.size() - 3);
+    m.triangles.push_back({first, first + 1, first + 2});
   }
-  if (bytes.size() < 84) fail(path, "truncated binary STL (no header)");
+  if (inSolid) throw ioError(where() + ": truncated ASCII STL (no endsolid)");
+  return m;
+}
+
+Mesh readStl(const std::string& bytes, const std::string& path) {
+  // Binary when the size is exactly what its facet count says (a binary header may well start
+  // with "solid"), ASCII when it starts with "solid" otherwise.
   uint32_t n = 0;
-  std::memcpy(&n, bytes.data() + 80, 4);
-  if (bytes.size() < 84 + uint64_t(n) * 50) fail(path, "truncated binary STL (" + std::to_string(n) + " facets announced)");
+  if (bytes.size() >= 84) std::memcpy(&n, bytes.data() + 80, 4);
+  const bool binarySize = bytes.size() >= 84 && bytes.size() == 84 + uint64_t(n) * 50;
+  if (!binarySize && bytes.compare(0, 5, "solid") == 0) return readAsciiStl(bytes, path);
+  if (bytes.size() < 84) fail(path, "truncated binary STL (no header)");
+  if (bytes.size() < 84 + uint64_t(n) * 50)
+    fail(path, "truncated binary STL (" + std::to_string(n) + " facets announced, " +
+                   std::to_string((bytes.size() - 84) / 50) + " in the file)");
+  Mesh m;
+  m.positions.reserve(size_t(n) * 3);
+  m.triangles.reserve(n);
   for (uint32_t i = 0; i < n; ++i) {
     std::array<std::array<double, 3>, 3> t{};
     for (int v = 0; v < 3; ++v)
@@ -210,7 +368,12 @@ Mesh readStl(const std::string& bytes, const std::string& path) {
         std::memcpy(&f, bytes.data() + 84 + size_t(i) * 50 + 12 + size_t(v) * 12 + size_t(c) * 4, 4);
         t[size_t(v)][size_t(c)] = f;
       }
-    addTriangle(t, "facet " + std::to_string(i));
+    for (const auto& p : t) {
+      checkPosition(p, path, "facet " + std::to_string(i));
+      m.positions.push_back(p);
+    }
+    const uint32_t first = uint32_t(m.positions.size() - 3);
+    m.triangles.push_back({first, first + 1, first + 2});
   }
   return m;
 }
@@ -228,13 +391,7 @@ std::string lowerExtension(const std::string& path) {
 Mesh parseMesh(const std::string& path, const std::string& bytes) {
   const std::string ext = lowerExtension(path);
   if (ext != "ply" && ext != "obj" && ext != "stl") throw ioError(path + ": not a mesh file (expected .ply, .obj or .stl)");
-  Mesh m;
-  if (ext == "stl") {
-    m = readStl(bytes, path);
-  } else {
-    std::istringstream in(bytes, std::ios::binary);
-    m = ext == "ply" ? readPly(in, path) : readObj(in, path);
-  }
+  Mesh m = ext == "stl" ? readStl(bytes, path) : ext == "ply" ? readPly(bytes, path) : readObj(bytes, path);
   if (m.triangles.empty()) fail(path, "no triangles");
   return m;
 }
@@ -242,11 +399,7 @@ Mesh parseMesh(const std::string& path, const std::string& bytes) {
 Mesh readMesh(const std::string& path) {
   const std::string ext = lowerExtension(path);
   if (ext != "ply" && ext != "obj" && ext != "stl") throw ioError(path + ": not a mesh file (expected .ply, .obj or .stl)");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open the file");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) fail(path, "cannot read the file");
-  return parseMesh(path, bytes);
+  return parseMesh(path, readInputFile(path));
 }
 
 }  // namespace frep::io

@@ -48,8 +48,7 @@ std::string readOpened(int fd, const std::string& path, uint64_t maxBytes) {
   if (!S_ISREG(st.st_mode))
     refuse(path, "is not a regular file (a device, FIFO or socket); refusing to read it");
   if (uint64_t(st.st_size) > maxBytes)
-    refuse(path, "is " + std::to_string(uint64_t(st.st_size)) + " bytes, more than the " + sizeText(maxBytes) +
-                     " a model file may have");
+    refuse(path, "is " + std::to_string(uint64_t(st.st_size)) + " bytes, more than the limit of " + sizeText(maxBytes));
   std::string bytes(size_t(st.st_size), '\0');
   size_t got = 0;
   while (got < bytes.size()) {

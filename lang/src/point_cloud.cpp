@@ -154,6 +154,15 @@ PointCloud parsePly(const std::string& contents, const std::string& name) {
   const std::streamoff dataStart = in.tellg();
   size_t stride = 0;
   for (const auto& p : props) stride += size_t(typeSize(p.first));
+  // The vertices must fit in what follows the header (a binary vertex takes `stride` bytes, an
+  // ascii value at least a character and a blank): checked before any is read.
+  const uint64_t left = dataStart < 0 ? 0 : contents.size() - uint64_t(dataStart);
+  const uint64_t least = format == "ascii" ? 2 * props.size() : stride;
+  if (uint64_t(vertices) > (left + 1) / least)
+    fail(name, "",
+         "the header states " + std::to_string(vertices) + " vertices of at least " + std::to_string(least) +
+             " bytes each, more than the " + std::to_string(left) + " bytes after it (truncated or damaged)");
+  pc.points.reserve(size_t(vertices));
   for (long v = 0; v < vertices; ++v) {
     if (format == "ascii") {
       if (!std::getline(in, line)) fail(name, "", "the file ends at vertex " + std::to_string(v + 1));

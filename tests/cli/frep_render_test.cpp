@@ -283,7 +283,7 @@ TEST_F(FrepTest, RenderOfMeshesAndVdbMatchesTheModel) {
   write("bad.stl", "solid x\n facet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n endloop\n endfacet\nendsolid\n");
   RunResult bad = run("render bad.stl -O b.png");
   EXPECT_EQ(bad.code, 3) << bad.err;
-  EXPECT_TRUE(contains(bad.err, "bad.stl: a facet with fewer than 3 vertices")) << bad.err;
+  EXPECT_TRUE(contains(bad.err, "bad.stl:6: a facet with fewer than 3 vertices")) << bad.err;
   RunResult opt = run("render s.ply -b 2 -O b.png");
   EXPECT_EQ(opt.code, 2);
   EXPECT_TRUE(contains(opt.err, "-b/--bounds: 's.ply' is a mesh or grid")) << opt.err;

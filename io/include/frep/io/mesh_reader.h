@@ -1,7 +1,10 @@
 // Reading triangle meshes for frep render and frMesh: PLY (ascii, binary little or big endian; vertex x, y,
 // z of any scalar type, other properties skipped; faces as lists, polygons fanned), OBJ (v and f
-// lines, negative indices, v/vt/vn forms; polygons fanned; other lines ignored) and STL (binary,
-// or ASCII when it starts with "solid" and has facets). Only positions and triangles are read.
+// lines, negative indices, v/vt/vn forms; polygons fanned; other lines ignored) and STL (binary
+// when its size is what its facet count says, else ASCII when it starts with "solid"; ASCII
+// must end with endsolid). Only positions and triangles are read. Every count is checked
+// against the file's size before anything is allocated; coordinates must be finite; messages
+// name the line or byte, never quote the file.
 #pragma once
 
 #include <string>
