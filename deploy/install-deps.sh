@@ -10,7 +10,7 @@ packages=(
   cppzmq-dev libzmq3-dev
   libprotobuf-dev protobuf-compiler
   libspdlog-dev libtbb-dev libcli11-dev nlohmann-json3-dev libeigen3-dev
-  libboost-dev  # header-only: boost::container::small_vector (core/src/meshing/mesh_simplify.cpp)
+  libboost-dev  # header-only: boost::container::small_vector (core/src/meshing/simplifier.h)
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
   povray  # frep pov scenes are rendered in tests (docs/pov.md)
   lib3mf-dev libtinygltf-dev  # the .3mf and .glb mesh writers (io/)

@@ -1,0 +1,202 @@
+// The simplifier's error against the model: sample points of a triangle, error levels, and the
+// error check of a collapse or a contraction (simplifier.h).
+#include "meshing/simplifier.h"
+
+namespace frep {
+
+using simplify_detail::kMaxSamplesPerSide;
+using simplify_detail::kProbes;
+
+// The error check's samples of a triangle split m x m (withinLevel): the upright sub-triangles
+// (i, j), i + j < m, each standing for its centroid a + (i + 1/3) u + (j + 1/3) v (u, v: the
+// edges from a over m), probes first. Not the corners or edges: on a crease of the model the
+// sign test along the normal is ill-posed. The centroids form a lattice of spacing longest/m
+// (<= half a voxel); the upside-down sub-triangles' centroids would bring no point of the
+// triangle nearer to a sample (its farthest points are at the corners and edges, next to
+// upright ones; tested: ErrorSamplesCoverTheTriangleAsTheFullSubdivisionDoes) and are left out.
+// Probes: the upright sub-triangles at (or, from an upside-down one, next to) the centroid and
+// the midpoints between it and the corners, where a chord is deepest.
+const std::vector<std::array<int32_t, 2>>& errorSampleCells(int m) {
+  static const std::vector<std::vector<std::array<int32_t, 2>>> table = [] {
+    std::vector<std::vector<std::array<int32_t, 2>>> t(kMaxSamplesPerSide + 1);
+    for (int m = 1; m <= kMaxSamplesPerSide; ++m) {
+      std::vector<std::array<int32_t, 2>>& cells = t[m];
+      const double targets[kProbes][2] = {{m / 3.0, m / 3.0}, {m / 6.0, m / 6.0}, {2 * m / 3.0, m / 6.0}, {m / 6.0, 2 * m / 3.0}};
+      for (const auto& tg : targets) {
+        const int i = std::min(int(tg[0]), m - 1), j = std::min(int(tg[1]), m - 1 - i);
+        if (std::find(cells.begin(), cells.end(), std::array<int32_t, 2>{i, j}) == cells.end()) cells.push_back({i, j});
+      }
+      const auto probes = std::ptrdiff_t(cells.size());
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; i + j < m; ++j)
+          if (std::find(cells.begin(), cells.begin() + probes, std::array<int32_t, 2>{i, j}) == cells.begin() + probes)
+            cells.push_back({i, j});
+    }
+    return t;
+  }();
+  return table.at(size_t(m));
+}
+
+namespace simplify_detail {
+
+// Answers every query. A level is checked in full only once its probes (kProbes points spread
+// over the triangle, where a chord is deepest) pass, and a failing level moves on to the next
+// one's probes: the answer is the same as checking every level in full, for far fewer
+// evaluations. All queries advance together, so each round is one batch of the evaluator
+// over every query's points. stopAbove: return false as soon as some query exceeds maxK.
+// resume: qs were answered by a call with a smaller maxK that failed; the queries that went
+// past it go on from where they stopped (the same answers as a fresh call, without checking
+// the lower levels again).
+bool Simplifier::levels(std::vector<LevelQuery>& qs, int maxK, bool stopAbove, bool resume) {
+  if (resume) {
+    for (LevelQuery& q : qs)
+      if (q.d == V3{0, 0, 0})
+        q.level = maxK + 1;  // as a fresh call answers
+      else if (q.done && q.level == q.limit + 1)
+        q.done = false;
+  }
+  for (LevelQuery& q : qs) q.limit = maxK;
+  if (!resume)
+    for (LevelQuery& q : qs) {  // a fresh call: every query from level 0
+      auto unit = [](V3 d) {
+        double l = norm(d);
+        return l > 0 && std::isfinite(l) ? scale(d, 1 / l) : V3{0, 0, 0};
+      };
+      q.d = q.primary != V3{0, 0, 0} ? unit(q.primary) : unit(cross(sub(q.b, q.a), sub(q.c, q.a)));
+      const double longest = std::max({norm(sub(q.b, q.a)), norm(sub(q.c, q.b)), norm(sub(q.a, q.c))});
+      q.m = std::clamp(int(std::ceil(2 * longest / grid_.voxel)), 1, kMaxSamplesPerSide);  // <= half a voxel apart
+      q.cells = &errorSampleCells(q.m);
+      q.level = 0;
+      q.probed = false;
+      q.done = q.d == V3{0, 0, 0};  // no direction: no level passes
+      if (q.done) q.level = maxK + 1;
+    }
+  const uint32_t nvars = tape_->numVars();
+  batch_.reserve(*tape_);
+  inputs_.resize(nvars);
+  for (uint32_t k = 0; k < nvars; ++k) inputs_[k] = batch_.in(k);
+  const uint32_t spatial = std::min(nvars, 3u);  // a 2D model (a prism) has no x[3]
+  for (;;) {
+    bool any = false;
+    failed_.assign(qs.size(), 0);
+    for (uint32_t i = 0; i < qs.size(); ++i) {
+      LevelQuery& q = qs[i];
+      if (q.done) continue;
+      any = true;
+      const std::vector<std::array<int32_t, 2>>& cells = *q.cells;
+      const size_t from = q.probed ? kProbes : 0, to = q.probed ? cells.size() : std::min(kProbes, cells.size());
+      const double e = 0.8 * levelTol_[size_t(q.level)];
+      const V3 u = scale(sub(q.b, q.a), 1.0 / q.m), v = scale(sub(q.c, q.a), 1.0 / q.m), de = scale(q.d, e);
+      // Straight into the evaluator's lanes, as many as fit before the batch is evaluated; a
+      // query that already failed this round stops.
+      for (size_t k = from; k < to && !failed_[i];) {
+        const size_t n = std::min(to - k, kPairsPerCall - lanes_);
+        double* const* in = inputs_.data();
+        for (size_t j = 0; j < n; ++j, ++k) {
+          const double s = cells[k][0] + 1.0 / 3, t = cells[k][1] + 1.0 / 3;
+          const size_t lane = 2 * (lanes_ + j);
+          for (uint32_t c = 0; c < spatial; ++c) {
+            const double pc = q.a[c] + (u[c] * s + v[c] * t);  // a + s u + t v
+            in[c][lane] = pc - de[c], in[c][lane + 1] = pc + de[c];
+          }
+          laneQuery_[lanes_ + j] = i;
+        }
+        lanes_ += n;
+        if (lanes_ == kPairsPerCall && crossed() && stopAbove && endsAbove(qs, maxK)) return false;
+      }
+    }
+    if (!any) return true;
+    if (crossed() && stopAbove && endsAbove(qs, maxK)) return false;
+    for (uint32_t i = 0; i < qs.size(); ++i) {
+      LevelQuery& q = qs[i];
+      if (q.done) continue;
+      if (!failed_[i]) {
+        // the probes passed: now the rest (none left: done); the rest passed: done
+        if (q.probed || q.cells->size() <= kProbes)
+          q.done = true;
+        else
+          q.probed = true;
+      } else {
+        q.probed = false;
+        if (++q.level > maxK) {
+          q.done = true;
+          if (stopAbove) return false;
+        }
+      }
+    }
+  }
+}
+
+// With stopAbove: some query failed its last level maxK, so the call's answer (false) is known
+// without the rest of the round. That query is answered (above maxK); the others keep the
+// state they began the round with, and a resume redoes the round for them (the same answers).
+bool Simplifier::endsAbove(std::vector<LevelQuery>& qs, int maxK) {
+  for (uint32_t i = 0; i < qs.size(); ++i)
+    if (failed_[i] && !qs[i].done && qs[i].level == maxK) {
+      qs[i].level = maxK + 1, qs[i].probed = false, qs[i].done = true;
+      return true;
+    }
+  return false;
+}
+
+// Evaluates the pending lanes (pairs: f(p - e d) must be inside, f(p + e d) outside) and marks
+// failed_[query] where a pair is not. True if some pair failed.
+bool Simplifier::crossed() {
+  if (lanes_ == 0) return false;
+  const uint32_t nvars = tape_->numVars();
+  for (uint32_t k = 3; k < nvars; ++k) std::fill_n(inputs_[k], 2 * lanes_, opt_.fixedCoords[k - 3]);
+  const double* f = batch_.eval(*tape_, 2 * lanes_);
+  stats_.modelEvals += 2 * lanes_;
+  bool any = false;
+  for (size_t i = 0; i < lanes_; ++i)
+    if (!insideValue(f[2 * i]) || insideValue(f[2 * i + 1])) failed_[laneQuery_[i]] = 1, any = true;
+  lanes_ = 0;
+  return any;
+}
+
+int Simplifier::levelOf(uint32_t t) {
+  if (w_.level[t] < 0) {
+    const Tri& tr = w_.tris[t];
+    std::vector<LevelQuery>& qs = scratch_.ownLevel;  // not queries: errorPasses holds those
+    qs.assign(1, {});
+    LevelQuery& q = qs[0];
+    q.a = w_.pos[tr[0]], q.b = w_.pos[tr[1]], q.c = w_.pos[tr[2]];
+    const V3 along = add(w_.normal[tr[0]], add(w_.normal[tr[1]], w_.normal[tr[2]]));
+    if (quality(q.a, q.b, q.c) < opt_.minQuality && norm(along) > 0) q.primary = along;
+    levels(qs, maxLevel_, false);
+    w_.level[t] = int8_t(std::min(qs[0].level, maxLevel_));  // beyond the last level: no more allowance
+  }
+  return w_.level[t];
+}
+
+// The error check of a collapse or a contraction, whose new triangles are qs: the removed
+// vertices (gone) lie within e of the new triangles and every new triangle within e of the
+// surface (levels), e = tolerance * 2^allowed, allowed the worst level of the replaced
+// triangles (at least 0: the mesher's chords across a crease may be deeper than the
+// tolerance). That worst level is measured only when the tolerance alone does not pass: the
+// same outcome and the same levels, and most of the mesher's triangles never need theirs.
+bool Simplifier::errorPasses(std::vector<LevelQuery>& qs, const std::vector<V3>& gone, const std::vector<uint32_t>& replaced) {
+  int allowed = 0;
+  bool started = false;  // levels() ran: the second round resumes it
+  for (bool measured = false;; measured = true) {
+    const double e = levelTol_[size_t(allowed)];
+    bool near = true;  // every removed vertex within e of some new triangle
+    for (size_t i = 0; i < gone.size() && near; ++i) {
+      near = false;
+      for (size_t k = 0; k < qs.size() && !near; ++k) near = pointTriangleDistance(gone[i], qs[k].a, qs[k].b, qs[k].c) <= e;
+    }
+    if (near) {
+      const bool pass = levels(qs, allowed, true, started);
+      started = true;
+      if (pass) return true;
+    }
+    if (measured) return false;
+    int worst = 0;
+    for (uint32_t t : replaced) worst = std::max(worst, levelOf(t));
+    if (worst == allowed) return false;
+    allowed = worst;
+  }
+}
+
+}  // namespace simplify_detail
+}  // namespace frep
