@@ -229,6 +229,8 @@ class Simplifier {
   // leaves slivers where the surface grazes grid points; they go first).
   bool worstGotWorse(double before, double after) const { return after < opt_.minQuality && after < 0.9 * before; }
   bool keepsFacing(const Tri& tr, const V3& c0, const V3& c1, const V3& c2, double& worstBefore, double& worstAfter) const;
+  bool acceptsChange(std::vector<LevelQuery>& qs, const std::vector<Tri>& before, const std::vector<uint32_t>& dropped,
+                     const std::vector<V3>& gone, const std::vector<uint32_t>& replaced);
 
   // ---- one collapse ---------------------------------------------------------------------------
   void tryCollapse(uint32_t a, uint32_t b);
@@ -262,6 +264,7 @@ class Simplifier {
     std::vector<uint32_t> opposite, changed, removed, ring;
     std::vector<int8_t> newLevel;
     std::vector<LevelQuery> queries, ownLevel;
+    std::vector<Tri> before;  // acceptsChange: the changed triangles as they are
     std::vector<uint64_t> cells;  // hash cells of the self-intersection check
     std::vector<std::pair<uint64_t, uint32_t>> filed;  // embedded(): (cell, triangle)
     std::vector<Entry> boxes;                          // embedded(): per triangle

@@ -28,6 +28,33 @@ bool Simplifier::keepsFacing(const Tri& tr, const V3& c0, const V3& c1, const V3
   return l1 > 1e-12 * grid_.voxel * grid_.voxel && dot(n0, n1) > 0.2 * norm(n0) * l1;
 }
 
+// The checks an edge collapse and a cell contraction share once their topology passed. The
+// new triangles qs (corners a, b, c) are what the triangles before[i] (vertex ids, as they are)
+// become; `dropped` go, the points `gone` leave the mesh, `replaced` are all the triangles the
+// new ones replace. Shape: no new triangle turns over or degenerates (keepsFacing), and below
+// the quality bound the worst of before and dropped does not get more than 10% worse
+// (worstGotWorse). Error: within the tolerance, or within the worst level of the replaced
+// triangles (errorPasses); qs[i].level is then the new triangle's level. Counts a rejection.
+bool Simplifier::acceptsChange(std::vector<LevelQuery>& qs, const std::vector<Tri>& before,
+                               const std::vector<uint32_t>& dropped, const std::vector<V3>& gone,
+                               const std::vector<uint32_t>& replaced) {
+  double worstBefore = worstQuality(dropped), worstAfter = 1;
+  for (size_t i = 0; i < qs.size(); ++i)
+    if (!keepsFacing(before[i], qs[i].a, qs[i].b, qs[i].c, worstBefore, worstAfter)) {
+      ++stats_.rejectedShape;
+      return false;
+    }
+  if (worstGotWorse(worstBefore, worstAfter)) {
+    ++stats_.rejectedShape;
+    return false;
+  }
+  if (!errorPasses(qs, gone, replaced)) {
+    ++stats_.rejectedError;
+    return false;
+  }
+  return true;
+}
+
 void Simplifier::tryCollapse(uint32_t a, uint32_t b) {
   // Link condition: exactly two triangles hold the edge, and a and b have no other common
   // neighbour; neither opposite vertex may drop below valence 3.
@@ -73,25 +100,14 @@ void Simplifier::tryCollapse(uint32_t a, uint32_t b) {
     }
   auto corner = [&](uint32_t v) { return v == a || v == b ? p : w_.pos[v]; };
 
-  // Shape: no flip or fold, no sliver made worse (keepsFacing, worstGotWorse).
-  double worstBefore = worstQuality(removed), worstAfter = 1;
-  for (uint32_t t : changed) {
-    const Tri& tr = w_.tris[t];
-    if (!keepsFacing(tr, corner(tr[0]), corner(tr[1]), corner(tr[2]), worstBefore, worstAfter)) {
-      ++stats_.rejectedShape;
-      return;
-    }
-  }
-  if (worstGotWorse(worstBefore, worstAfter)) {
-    ++stats_.rejectedShape;
-    return;
-  }
-
-  // Error: within the tolerance, or within the worst of the replaced triangles (errorPasses).
+  // Shape and error (acceptsChange): the changed triangles with a and b at p; the two removed.
   std::vector<LevelQuery>& qs = scratch_.queries;
+  std::vector<Tri>& before = scratch_.before;
   qs.assign(changed.size(), {});
+  before.resize(changed.size());
   for (size_t i = 0; i < changed.size(); ++i) {
     const Tri& tr = w_.tris[changed[i]];
+    before[i] = tr;
     qs[i].a = corner(tr[0]), qs[i].b = corner(tr[1]), qs[i].c = corner(tr[2]);
   }
   std::vector<V3>& gonePoints = scratch_.gonePoints;
@@ -99,10 +115,7 @@ void Simplifier::tryCollapse(uint32_t a, uint32_t b) {
   std::vector<uint32_t>& replaced = scratch_.replaced;
   replaced = changed;
   replaced.insert(replaced.end(), removed.begin(), removed.end());
-  if (!errorPasses(qs, gonePoints, replaced)) {
-    ++stats_.rejectedError;
-    return;
-  }
+  if (!acceptsChange(qs, before, removed, gonePoints, replaced)) return;
   std::vector<int8_t>& newLevel = scratch_.newLevel;
   newLevel.resize(changed.size());
   for (size_t i = 0; i < changed.size(); ++i) newLevel[i] = int8_t(qs[i].level);
@@ -313,33 +326,23 @@ void Simplifier::tryContract(const std::vector<uint32_t>& C) {
     return;
   }
 
-  // Shape, as for an edge collapse: no fan triangle turns over or degenerates, and below the
-  // quality bound the worst of the star does not get more than 10% worse.
-  double worstBefore = worstQuality(gone), worstAfter = 1;
-  for (const Fan& f : fan)
-    if (!keepsFacing({f.c, f.u, f.w}, p, w_.pos[f.u], w_.pos[f.w], worstBefore, worstAfter)) {
-      ++stats_.rejectedShape;
-      return;
-    }
-  if (worstGotWorse(worstBefore, worstAfter)) {
-    ++stats_.rejectedShape;
-    return;
-  }
-
-  // Error: within the tolerance, or within the worst of the star's triangles (errorPasses).
+  // Shape and error, as for an edge collapse (acceptsChange): the fan's triangles with C at p
+  // (each as it is, from its corner in C); the star's others dropped.
   std::vector<LevelQuery>& qs = scratch_.queries;
+  std::vector<Tri>& before = scratch_.before;
   qs.assign(nf, {});
-  for (size_t i = 0; i < nf; ++i) qs[i].a = p, qs[i].b = w_.pos[fan[i].u], qs[i].c = w_.pos[fan[i].w];
+  before.resize(nf);
+  for (size_t i = 0; i < nf; ++i) {
+    before[i] = {fan[i].c, fan[i].u, fan[i].w};
+    qs[i].a = p, qs[i].b = w_.pos[fan[i].u], qs[i].c = w_.pos[fan[i].w];
+  }
   std::vector<V3>& gonePoints = scratch_.gonePoints;
   gonePoints.clear();
   for (uint32_t c : C) gonePoints.push_back(w_.pos[c]);
   std::vector<uint32_t>& replaced = scratch_.replaced;
   replaced = gone;
   for (const Fan& f : fan) replaced.push_back(f.t);
-  if (!errorPasses(qs, gonePoints, replaced)) {
-    ++stats_.rejectedError;
-    return;
-  }
+  if (!acceptsChange(qs, before, gone, gonePoints, replaced)) return;
 
   // Apply: the survivor keeps its key (and normal) when the point is its own position.
   for (uint32_t t : gone) {
