@@ -1,7 +1,7 @@
-// Internal to the core (interval.cpp, eval_interval.cpp, extremum_terms.cpp): outward rounding
-// by one ulp, and the inlined fast path of the common interval ops on finite operands. The fast
-// path is bit-identical to applyOp (interval.cpp): the same IEEE operations and the same
-// one-ulp outward steps.
+// Internal to the core (interval.cpp, eval_interval.cpp, extremum/term_intervals.h): outward
+// rounding by one ulp, and the inlined fast path of the common interval ops on finite operands.
+// The fast path is bit-identical to applyOp (interval.cpp): the same IEEE operations and the
+// same one-ulp outward steps.
 #pragma once
 
 #include <algorithm>
