@@ -1,5 +1,5 @@
-// The simplifier's geometry (mesh_simplify.cpp and the simplifier_*.cpp files): 3-vectors as
-// arrays, the quadric error metric, point-triangle distance and triangle quality.
+// The simplifier's geometry (mesh_simplify.cpp and the simplifier_*.cpp files): 3-vectors
+// (frep/geometry/vec3.h), the quadric error metric, point-triangle distance and triangle quality.
 #pragma once
 
 #include <Eigen/Eigenvalues>
@@ -8,19 +8,19 @@
 #include <cmath>
 #include <cstdint>
 
+#include "frep/geometry/vec3.h"
+
 namespace frep::simplify_detail {
 
-using V3 = std::array<double, 3>;
+using V3 = Vec3;
 using Tri = std::array<uint32_t, 3>;
 
-inline V3 add(const V3& a, const V3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-inline V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-inline V3 scale(const V3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-inline double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-inline V3 cross(const V3& a, const V3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-inline double norm(const V3& a) { return std::sqrt(dot(a, a)); }
+using vec3::add;
+using vec3::cross;
+using vec3::dot;
+using vec3::norm;
+using vec3::scale;
+using vec3::sub;
 
 // Sum of squared distances to planes n.x = n.p (Garland & Heckbert's quadric), here the model's
 // tangent planes at surface points.

@@ -27,15 +27,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kLeaf = 0.25, kMinWidth = 1.0 / 64, kRootWidth = 1e-4, kConfirm = 1.0 / 4;
 constexpr int kConfirmBudget = 64;  // confirming evaluations per pixel
 
-Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Vec3 normalized(const Vec3& a) {
-  const double n = std::sqrt(dot(a, a));
-  return {a[0] / n, a[1] / n, a[2] / n};
-}
+using vec3::cross;
+using vec3::dot;
+using vec3::normalized;
+using vec3::sub;
 
 // Model coordinates X(u, v, d) as expressions of vars 0, 1, 2 (see raycast.h).
 std::vector<Expr> cameraMap(const Camera& cam, const std::vector<double>& fixed) {

@@ -7,7 +7,7 @@
 namespace frep {
 namespace {
 
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+using vec3::dot;
 
 uint8_t toByte(double x) { return uint8_t(std::lround(std::clamp(x, 0.0, 1.0) * 255.0)); }
 

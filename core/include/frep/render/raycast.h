@@ -24,10 +24,9 @@
 
 #include "frep/expressions/expr.h"
 #include "frep/expressions/tape.h"
+#include "frep/geometry/vec3.h"
 
 namespace frep {
-
-using Vec3 = std::array<double, 3>;
 
 struct Camera {
   Vec3 eye{0, 0, 0};
