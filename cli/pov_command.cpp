@@ -72,6 +72,9 @@ int runPov(const PovRequest& req) {
     try {
       text = "// frep pov " + req.input + ": Roerdink-Minkowski reduction, exact (no search)\n#declare frep_model =\n" +
              io::povFromField(m.field, req.thin, &part) + ";\n";
+    } catch (const io::PovNonFinite& e) {
+      std::cerr << req.input << ": " << e.what() << "\n";
+      return kExitModelError;
     } catch (const io::PovError&) {
       std::cerr << locate(m, req.input, part)
                 << " is not reducible to POV primitives: it is not a basic-set term (fr*Line, fr*Disc, frBall, "

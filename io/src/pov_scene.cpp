@@ -26,6 +26,9 @@ using minkowski::Sum;
 using minkowski::Vec3;
 
 std::string num(double v) {
+  if (!std::isfinite(v))
+    throw PovNonFinite("a size or placement is not a finite number once the terms are summed (" +
+                       std::string(std::isnan(v) ? "nan" : "inf") + "): POV-Ray cannot read it; use smaller values");
   char b[40];
   std::snprintf(b, sizeof b, "%.12g", std::fabs(v) < 1e-15 ? 0.0 : v);
   return b;
@@ -100,6 +103,7 @@ constexpr int kTridiscsphereVoxels = 40;
 std::string tridiscsphereDeclaration(const Piece& p) {
   Vec3 ext;
   for (int i = 0; i < 3; ++i) ext[i] = p.discs[0] + p.discs[1] + p.discs[2] - p.discs[i] + p.ball;
+  for (double e : ext) num(4 * e);  // its grid's bounds must be finite (throws PovNonFinite)
   const double margin = 2.0 * std::max({ext[0], ext[1], ext[2]}) / kTridiscsphereVoxels;
   const auto field = std::make_shared<minkowski::DiscSumField>(Vec3{0, 0, 0}, p.discs, p.ball);
   const TapePtr tape = Tape::compile(fieldExpr(field, Expr::x(0), Expr::x(1), Expr::x(2)), 3);
@@ -251,11 +255,22 @@ std::string translateTerm(Cursor& c, double thin) {
                               "; export a mesh instead (frep mesh model.hf -O model.inc)");
   }
   Reduction r = minkowski::reduce(sum);
-  if (op != 2) return povUnion(r, thin);
+  if (op != 2) {
+    try {
+      return povUnion(r, thin);
+    } catch (const PovNonFinite& e) {
+      c.fail(terms[0].at, e.what());
+    }
+  }
   Sum c0 = minkowski::sumOf(terms[0].shape);
   if (terms[0].shape.kind != ShapeKind::Block && terms[0].shape.kind != ShapeKind::Segment)
     c.fail(terms[0].at, terms[0].text + " <-> ...: only a block can be eroded into POV primitives (a box)");
-  std::string box = erodedBlock(c0, r);
+  std::string box;
+  try {
+    box = erodedBlock(c0, r);
+  } catch (const PovNonFinite& e) {
+    c.fail(terms[0].at, e.what());
+  }
   if (box.empty()) c.fail(terms[0].at, terms[0].text + " <-> ...: the erosion is empty");
   return box;
 }

@@ -201,6 +201,21 @@ TEST_F(FrepPov, SceneTermsAreTranslatedAndErrorsNamed) {
   r = run("pov bad2.pov -O bad_out.pov");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("bad2.pov:1:16: 'cone' is not in the basic set"), std::string::npos) << r.err;
+  // Sizes that overflow once summed (1e308 + 1e308) were written as `inf` with exit 0: refused,
+  // naming the term, nothing written.
+  write("big.pov", "object { $ block(1e308, 1, 1) <+> block(1e308, 1, 1) $ }\n");
+  r = run("pov big.pov -O big_out.pov");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("big.pov:1:12: a size or placement is not a finite number once the terms are summed (inf)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fileExists(path("big_out.pov")));
+  write("big.hf", "blk(x[3], a[1]) { blk = frBlock(x, 1e308, 1, 1); }\n"
+                  "my_model(x[3], a[1]) { my_model = frMinkowskiSum(x, blk, blk); }\n");
+  r = run("pov big.hf -O big.inc");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("big.hf: a size or placement is not a finite number"), std::string::npos) << r.err;
+  EXPECT_FALSE(fileExists(path("big.inc")));
   // A .hf model with a part outside the basic set: named by its object.
   write("m.hf", "ball(x[3], a[1]) { ball = frBall(x, 1); }\nother(x[3], a[1]) { other = 1 - x[1]^2; }\n"
                 "my_model(x[3], a[1]) { my_model = ball(x, a) | other(x, a); }\n");

@@ -16,6 +16,12 @@ namespace frep::io {
 struct PovError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+// A number to write is not finite (sizes of 1e308 summed overflow): POV-Ray would read `inf` as
+// an identifier. translateScene turns it into a PovError naming the term; from povFromField it
+// comes as it is (no place in a scene to name).
+struct PovNonFinite : PovError {
+  using PovError::PovError;
+};
 
 // POV text of the union (one object, in world coordinates). Pieces without interior (the sum is
 // a segment, a disc, a rectangle: Remark 6) are drawn `thin` thick.
