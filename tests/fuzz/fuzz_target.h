@@ -29,4 +29,6 @@ void hf(const uint8_t* data, size_t size);
 void payload(const uint8_t* data, size_t size);
 void journal(const uint8_t* data, size_t size);
 void vdb(const uint8_t* data, size_t size);
+void mesh(const uint8_t* data, size_t size);
+void pov(const uint8_t* data, size_t size);
 }  // namespace frep::fuzz

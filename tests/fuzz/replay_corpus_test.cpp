@@ -31,6 +31,8 @@ size_t replay(const std::string& target, void (*entry)(const uint8_t*, size_t)) 
 TEST(FuzzCorpus, HfFrontEnd) { EXPECT_GT(replay("hf", frep::fuzz::hf), 0u); }
 TEST(FuzzCorpus, PayloadCodec) { EXPECT_GT(replay("payload", frep::fuzz::payload), 0u); }
 TEST(FuzzCorpus, JournalReader) { EXPECT_GT(replay("journal", frep::fuzz::journal), 0u); }
+TEST(FuzzCorpus, MeshReaders) { EXPECT_GT(replay("mesh", frep::fuzz::mesh), 0u); }
+TEST(FuzzCorpus, PovScene) { EXPECT_GT(replay("pov", frep::fuzz::pov), 0u); }
 // Crafted files too (re-sealed after damage, fuzz_vdb.cpp): the kept finding is one.
 TEST(FuzzCorpus, VdbReader) {
   ::setenv("FREP_FUZZ_VDB_CRAFTED", "1", 1);

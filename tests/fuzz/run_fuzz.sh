@@ -45,6 +45,10 @@ run() {
 run hf 4000 "-max_len=4096" "$REPO/examples"
 run payload 30000 "" "$seeds/payload"
 run journal 20000 "" "$seeds/journal"
+# The mesh readers (the first byte picks .stl/.obj/.ply) and frep pov's scene preprocessor: small
+# hand-made seeds in corpus/mesh and corpus/pov, and the POV scenes of examples/roerdink.
+run mesh 100000 "-max_len=2048"
+run pov 40000 "-max_len=4096" "$REPO/examples/roerdink"
 # OpenVDB's readers leak the node they were building when a refused size throws (their bug, a
 # few hundred KiB in a process that then exits 3): leaks are not findings for this target.
 export ASAN_OPTIONS=detect_leaks=0

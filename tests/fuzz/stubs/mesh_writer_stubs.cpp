@@ -1,0 +1,12 @@
+// The fuzz build compiles io/src/mesh_writer.cpp for povMesh2 (frep pov declares a tridiscsphere
+// as a POV mesh2) without lib3mf and tinygltf: the writers it dispatches to but the targets never
+// call are stubs here (in a folder of its own: the normal build's fuzz_corpus_tests links frep_io).
+#include <stdexcept>
+
+#include "mesh_writers.h"
+
+namespace frep::io::detail {
+void writeVrml(const std::string&, const Mesh&, const MeshWriteOptions&) { throw std::logic_error("not in the fuzz build"); }
+void write3mf(const std::string&, const Mesh&, const MeshWriteOptions&) { throw std::logic_error("not in the fuzz build"); }
+void writeGlb(const std::string&, const Mesh&, const MeshWriteOptions&) { throw std::logic_error("not in the fuzz build"); }
+}  // namespace frep::io::detail
