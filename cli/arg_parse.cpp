@@ -59,9 +59,15 @@ Box parseBounds(const std::string& field, const std::string& text) {
     default: throw badArgs(expectedMessage(field, text, expected, "numbers"));
   }
   static const char* names = "xyz";
-  for (int a = 0; a < 3; ++a)
+  for (int a = 0; a < 3; ++a) {
     if (!(box.hi[a] > box.lo[a]))
       throw badArgs(field + ": the " + names[a] + " range is empty (max must exceed min), got '" + text + "'");
+    // Every size derived from the box (its width, the voxel) must be a finite number: a width of
+    // 2e308 is inf, and `-b 1e308` wrote a grid of one voxel of size inf.
+    if (!std::isfinite(box.hi[a] - box.lo[a]))
+      throw badArgs(field + ": the " + names[a] + " range is wider than the largest finite number (its width " +
+                    "overflows to inf), got '" + text + "'");
+  }
   return box;
 }
 

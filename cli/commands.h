@@ -125,7 +125,7 @@ int runRender(const RenderRequest& request);
 bool isMeshOrVdb(const std::string& path);
 int runRenderMesh(const RenderRequest& request);
 
-int runKeygen(const std::string& dir);
+int runKeygen(const std::string& dir, bool force);  // force: replace existing keys
 
 // frep pov: a scene with `$ ... <+> ... $` Minkowski terms, or a .hf model built from the basic
 // set, as POV-Ray text (Roerdink's preprocessor; docs/pov.md).

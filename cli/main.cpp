@@ -237,6 +237,8 @@ int main(int argc, char** argv) {
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
   keygenCmd->add_option("dir", keygenDir, "Directory for the keys")->required();
+  bool keygenForce = false;
+  keygenCmd->add_flag("--force", keygenForce, "Replace the keys DIR already has (workers holding the old ones are locked out)");
 
   for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, povCmd, renderCmd}) sub->fallthrough();
 
@@ -266,7 +268,7 @@ int main(int argc, char** argv) {
       checkObjectIsNotAFile(slice.model);
       return runSlice(slice);
     }
-    if (keygenCmd->parsed()) return runKeygen(keygenDir);
+    if (keygenCmd->parsed()) return runKeygen(keygenDir, keygenForce);
     if (povCmd->parsed()) return runPov(pov);
     if (relateCmd->parsed()) return runRelate(relate);
     if (renderCmd->parsed()) {

@@ -133,9 +133,11 @@ int runSample(const SampleRequest& request) {
   return kExitOk;
 }
 
-int runKeygen(const std::string& dir) {
+int runKeygen(const std::string& dir, bool force) {
   try {
-    farm::generateCurveKeys(dir);
+    farm::generateCurveKeys(dir, force);
+  } catch (const farm::CurveKeysExist& e) {
+    throw badArgs(std::string("keygen: ") + e.what());  // exit 2: nothing written
   } catch (const std::exception& e) {
     throw ioError(std::string("keygen: ") + e.what());
   }

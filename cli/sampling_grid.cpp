@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
 
 #include "exit_codes.h"
 
@@ -17,6 +19,11 @@ double voxelOf(const Box& box, int axes, const Resolution& r) {
     double extent = box.hi[a] - box.lo[a];
     voxel = std::max(voxel, r.res > 0 ? extent / double(r.res - 1) : extent / double(r.cells[a]));
   }
+  // A derived size must be a positive, finite, normal number (parseBounds keeps the widths
+  // finite; a box of 1e-310 divided into voxels underflows).
+  if (!(std::isfinite(voxel) && voxel >= std::numeric_limits<double>::min()))
+    throw badArgs("-b/--bounds: the box and the resolution give a voxel size of " + std::to_string(voxel) +
+                  ", not a positive finite number; choose a larger box or fewer points");
   return voxel;
 }
 

@@ -1,10 +1,14 @@
 #include "curve.h"
 
 #include <spdlog/spdlog.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <zmq_addon.hpp>
 
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -15,15 +19,28 @@ namespace frep::farm {
 namespace fs = std::filesystem;
 
 namespace {
+const char* const kKeyFiles[] = {"master.pub", "master.key", "worker.pub", "worker.key", "authorized"};
+
+// Written to a temporary created here (O_EXCL | O_NOFOLLOW: never through a planted link, never
+// an existing file), with its final mode from the start (a secret key is never readable by others,
+// not even for a moment), then renamed over the key.
 void writeKey(const fs::path& p, const std::string& key, bool secret) {
   fs::path tmp = p;
-  tmp += ".tmp";
-  {
-    std::ofstream f(tmp);
-    if (!(f << key << "\n")) throw std::runtime_error("cannot write " + tmp.string());
+  tmp += ".tmp" + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, secret ? 0600 : 0644);
+  if (fd < 0) throw std::runtime_error("cannot create " + tmp.string() + ": " + std::strerror(errno));
+  const std::string line = key + "\n";
+  const bool ok = ::write(fd, line.data(), line.size()) == ssize_t(line.size()) && ::fsync(fd) == 0;
+  if (::close(fd) != 0 || !ok) {
+    ::unlink(tmp.c_str());
+    throw std::runtime_error("cannot write " + tmp.string() + ": " + std::strerror(errno));
   }
-  if (secret) ::chmod(tmp.c_str(), 0600);
-  fs::rename(tmp, p);
+  std::error_code ec;
+  fs::rename(tmp, p, ec);
+  if (ec) {
+    ::unlink(tmp.c_str());
+    throw std::runtime_error("cannot write " + p.string() + ": " + ec.message());
+  }
 }
 
 std::string readKey(const fs::path& p) {
@@ -35,7 +52,25 @@ std::string readKey(const fs::path& p) {
 }
 }  // namespace
 
-void generateCurveKeys(const std::string& dir) {
+std::vector<std::string> existingCurveKeys(const std::string& dir) {
+  std::vector<std::string> found;
+  for (const char* f : kKeyFiles) {
+    std::error_code ec;
+    if (fs::symlink_status(fs::path(dir) / f, ec).type() != fs::file_type::not_found && !ec) found.push_back(f);
+  }
+  return found;
+}
+
+void generateCurveKeys(const std::string& dir, bool replace) {
+  if (!replace) {
+    const std::vector<std::string> found = existingCurveKeys(dir);
+    if (!found.empty()) {
+      std::string list;
+      for (const std::string& f : found) list += (list.empty() ? "" : ", ") + f;
+      throw CurveKeysExist(dir + " already has CURVE keys (" + list +
+                           "): new ones would lock out every worker holding the old ones; add --force to replace them");
+    }
+  }
   fs::create_directories(dir);
   char pub[41], sec[41];
   if (zmq_curve_keypair(pub, sec) != 0) throw std::runtime_error("this libzmq has no CURVE support");

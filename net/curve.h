@@ -8,6 +8,7 @@
 #pragma once
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 #include <zmq.hpp>
@@ -20,8 +21,16 @@ struct CurveKeys {
   std::vector<std::string> authorized;     // on the master
 };
 
-// Writes a fresh set of keys into dir (created if missing). Throws std::runtime_error.
-void generateCurveKeys(const std::string& dir);
+// Thrown by generateCurveKeys when dir already has keys and `replace` is false.
+struct CurveKeysExist : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// The key files (master.pub, master.key, worker.pub, worker.key, authorized) present in dir.
+std::vector<std::string> existingCurveKeys(const std::string& dir);
+// Writes a fresh set of keys into dir (created if missing). Refuses (CurveKeysExist, nothing
+// written) when dir has any of them already, unless `replace`: new keys lock out every worker
+// that holds the old ones. Throws std::runtime_error when a file cannot be written.
+void generateCurveKeys(const std::string& dir, bool replace = false);
 // Reads the keys a master (server = true) or a worker needs. Throws std::runtime_error naming
 // the missing or malformed file.
 CurveKeys loadCurveKeys(const std::string& dir, bool server);

@@ -16,7 +16,7 @@ _frep_options() {
     render) echo "-h --help $model -b --bounds -O --out --size --azimuth --elevation --distance --zoom --eye --target --up --perspective --fov --background --colour --color --frames --no-footprint $geometric $farm" ;;
     pov) echo "-h --help -o --object -O --out --thin" ;;
     relate) echo "-h --help --object-a --object-b -b --bounds --min-size --at" ;;
-    keygen) echo "-h --help" ;;
+    keygen) echo "-h --help --force" ;;
   esac
 }
 

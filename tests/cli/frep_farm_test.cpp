@@ -1,6 +1,7 @@
 // `frep sample` on the farm, end to end through the built binaries: identical bytes for any
 // worker count and brick size, a master killed and resumed, SIGTERM, poisoned bricks, CURVE.
 #include <signal.h>
+#include <sys/stat.h>
 
 #include <chrono>
 #include <cstring>
@@ -103,6 +104,30 @@ TEST_F(FarmCli, CurveKeysProtectTheLocalFarm) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(readText(path("curve.vdb")) == readText(path("plain.vdb")));
   EXPECT_EQ(run(sampleArgs("x.vdb") + " --workers 2 --curve missing").code, 7);
+}
+
+// frep keygen replaced a directory's keys without a word, locking out every worker that held the
+// old ones (issue 31): now it refuses (exit 2, nothing changed) unless --force. Secret keys are
+// created 0600 (never readable by others, even for a moment), public ones 0644.
+TEST_F(FarmCli, KeygenKeepsExistingKeysUnlessForced) {
+  ASSERT_EQ(run("keygen keys").code, 0);
+  const std::string before = readText(path("keys/master.key"));
+  struct stat st {};
+  ASSERT_EQ(::stat(path("keys/master.key").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
+  ASSERT_EQ(::stat(path("keys/worker.key").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
+  ASSERT_EQ(::stat(path("keys/master.pub").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0644u);
+  RunResult r = run("keygen keys");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("already has CURVE keys (master.pub, master.key, worker.pub, worker.key, authorized)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("--force"), std::string::npos) << r.err;
+  EXPECT_EQ(readText(path("keys/master.key")), before);
+  ASSERT_EQ(run("keygen keys --force").code, 0);
+  EXPECT_NE(readText(path("keys/master.key")), before);
 }
 
 TEST_F(FarmCli, BadFarmArgumentsAreNamed) {

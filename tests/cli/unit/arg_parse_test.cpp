@@ -55,6 +55,12 @@ TEST(ArgParse, BoundsErrorsNameTheFieldAndQuoteTheInput) {
   EXPECT_EQ(badArgsMessage([] { parseBounds("--bounds", "0,0,0,1,-1,1"); }),
             "--bounds: the y range is empty (max must exceed min), got '0,0,0,1,-1,1'");
   EXPECT_NE(badArgsMessage([] { parseBounds("--bounds", "inf"); }).find("'inf' is not a number"), std::string::npos);
+  // Issue 31: `-b 1e308` gave a grid of one voxel of size inf (exit 0).
+  EXPECT_EQ(badArgsMessage([] { parseBounds("-b", "1e308"); }),
+            "-b: the x range is wider than the largest finite number (its width overflows to inf), got '1e308'");
+  EXPECT_NE(badArgsMessage([] { parseBounds("-b", "0,0,-1e308,1,1,1e308"); }).find("the z range is wider"),
+            std::string::npos);
+  EXPECT_NO_THROW(parseBounds("-b", "8e307"));
 }
 
 TEST(ArgParse, Cells) {

@@ -84,3 +84,17 @@ TEST(SamplingGrid, SampleRoundsTheBoxOutwardToTheWorldLattice) {
     EXPECT_NE(std::string(e.what()).find("-b/--bounds"), std::string::npos) << e.what();
   }
 }
+
+// Derived sizes must be finite and positive: a box of 1e-310 underflows the voxel (exit 2), and
+// the widest finite box gives a finite voxel.
+TEST(SamplingGrid, DerivedVoxelSizesAreFiniteAndPositive) {
+  try {
+    makeGrid(parseBounds("-b", "1e-310"), 3, resolutionFrom(0, "", 128));
+    ADD_FAILURE() << "a voxel that underflows was accepted";
+  } catch (const CliError& e) {
+    EXPECT_EQ(e.code, kExitBadArgs);
+    EXPECT_NE(std::string(e.what()).find("not a positive finite number"), std::string::npos) << e.what();
+  }
+  frep::GridSpec g = makeGrid(parseBounds("-b", "8e307"), 3, resolutionFrom(0, "", 128));
+  EXPECT_TRUE(std::isfinite(g.voxel) && g.voxel > 0);
+}
