@@ -5,8 +5,14 @@
 // The package is a ZIP; lib3mf stamps its entries with a constant date (1980, no clock), so the
 // same mesh gives the same bytes (tested).
 #include <Model/COM/NMR_DLLInterfaces.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <cstdio>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -51,9 +57,33 @@ std::string uuidOf(const Mesh& m, uint64_t salt) {
   return s;
 }
 
+// lib3mf's write and seek callbacks (NMR_ExportStream_Callback.h: nfUint32 (nfByte*, nfUint32,
+// void*), nfUint32 (nfUint64, void*); 0 is success) onto a file descriptor: they always succeed and
+// keep the first error (errno) instead (see write3mfOrThrow).
+struct FileSink {
+  int fd = -1;
+  int error = 0;
+  static unsigned int write(unsigned char* data, unsigned int bytes, void* user) {
+    auto* s = static_cast<FileSink*>(user);
+    for (size_t done = 0; s->error == 0 && done < bytes;) {
+      const ssize_t n = ::write(s->fd, data + done, bytes - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) s->error = n < 0 ? errno : EIO;
+      else done += size_t(n);
+    }
+    return 0;
+  }
+  static unsigned int seek(unsigned long long position, void* user) {
+    auto* s = static_cast<FileSink*>(user);
+    if (s->error == 0 && ::lseek(s->fd, off_t(position), SEEK_SET) < 0) s->error = errno;
+    return 0;
+  }
+};
+
 }  // namespace
 
-void write3mf(const std::string& path, const Mesh& m, const MeshWriteOptions& options) {
+namespace {
+void write3mfOrThrow(const std::string& path, const Mesh& m, const MeshWriteOptions& options) {
   using namespace NMR;
   Handle model, mesh, writer, build;
   check(lib3mf_createmodel(&model.p), path, "createmodel");
@@ -92,7 +122,35 @@ void write3mf(const std::string& path, const Mesh& m, const MeshWriteOptions& op
   if (!options.comment.empty())
     check(lib3mf_model_addmetadatautf8(model.p, "Description", oneLine(options.comment).c_str()), path, "addmetadata");
   check(lib3mf_model_querywriter(model.p, "3mf", &writer.p), path, "querywriter");
-  check(lib3mf_writer_writetofileutf8(writer.p, path.c_str()), path, "writetofile");
+  // Through callbacks, not lib3mf's own file writer: when a write of that one fails (a full disk)
+  // lib3mf throws, and throws again from its package writer's destructor while unwinding, which
+  // ends the process (std::terminate: exit 134, the temporary left behind). The callbacks never
+  // fail: they keep the first error, drop what follows, and the error is thrown here once lib3mf
+  // has returned.
+  FileSink sink;
+  sink.fd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_NOFOLLOW | O_CLOEXEC);
+  if (sink.fd < 0) throw ioError("cannot write " + path + ": " + std::strerror(errno));
+  const LIB3MFRESULT r = lib3mf_writer_writetocallback(writer.p, reinterpret_cast<void*>(&FileSink::write),
+                                                       reinterpret_cast<void*>(&FileSink::seek), &sink);
+  const int closed = ::close(sink.fd);
+  if (sink.error == 0 && closed != 0) sink.error = errno;
+  if (sink.error != 0) throw ioError("cannot write " + path + ": " + std::strerror(sink.error));
+  check(r, path, "writetocallback");
+}
+}  // namespace
+
+// lib3mf 1.8 lets some of its own C++ exceptions out through its C interface: any that does
+// becomes an I/O error (exit 3), so the output's temporary is removed as for any other writer.
+void write3mf(const std::string& path, const Mesh& m, const MeshWriteOptions& options) {
+  try {
+    write3mfOrThrow(path, m, options);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw ioError("cannot write " + path + ": lib3mf: " + e.what() + " (a full disk?)");
+  } catch (...) {
+    throw ioError("cannot write " + path + ": lib3mf failed");
+  }
 }
 
 }  // namespace frep::io::detail

@@ -324,5 +324,26 @@ TEST_F(MeshFormatsTest, HfpCommandLine) {
   EXPECT_NE(r.err.find("--up: expected z or y"), std::string::npos) << r.err;
 }
 
+// A full disk under every output kind (issue 31: .3mf ended in std::terminate, exit 134, its
+// temporary left behind: lib3mf threw from its own destructor). `ulimit -f` makes every write
+// past 8 KiB fail (EFBIG) as a full disk does; meshing a .vdb writes no journal, so the output
+// is the first file to hit it. Each kind: exit 3 naming the write, no output, no temporary.
+TEST_F(MeshFormatsTest, AFullDiskUnderEveryOutputKindIsAnIoError) {
+  write("ball.hf", "my_model(x[3], a[1]) { my_model = 1 - x[1]^2 - x[2]^2 - x[3]^2; }\n");
+  ASSERT_EQ(run("sample ball.hf -b 1.5 --res 64 --workers 0 --no-progress -O s.vdb").code, 0);
+  for (const char* ext : {"ply", "obj", "stl", "wrl", "inc", "3mf", "glb", "cli"}) {
+    const std::string out = std::string("full.") + ext;
+    RunResult r = capture("(trap '' XFSZ; ulimit -f 8; '" FREP_BINARY "' mesh s.vdb -O " + out + ")");
+    EXPECT_EQ(r.code, 3) << ext << ": " << r.err;
+    EXPECT_NE(r.err.find("cannot write"), std::string::npos) << ext << ": " << r.err;
+    EXPECT_FALSE(fileExists(path(out))) << ext;
+    EXPECT_EQ(listing().find(".tmp"), std::string::npos) << ext << ": " << listing();
+  }
+  // Without the limit the same .3mf is written (through lib3mf's callbacks, the same bytes as
+  // before: Lib3mfReadsThe3mf and ColouredBytesAreTheSameForAnyWorkerCount read it).
+  ASSERT_EQ(run("mesh s.vdb -O ok.3mf").code, 0);
+  EXPECT_GT(readText(path("ok.3mf")).size(), 8u * 1024);
+}
+
 }  // namespace
 }  // namespace frep_cli_test
