@@ -325,6 +325,11 @@ Expr frMorphMinkowski(std::vector<Arg>& a) {
   double t = constArg(fn, a, 3, "the time t");
   if (!(t >= 0.0 && t <= 1.0)) throw LibraryError("frMorphMinkowski: t must be in [0, 1]", 3);
   Options o = parseOptions(fn, a, 4, n);
+  if (n == 3 && t > 0.0 && t < 1.0 && numParams(A.value) == 0 && numParams(B.value) == 0) {
+    // (1 - t) A ⊕ t B (eq. 4.5) without a search where the sum has an exact form.
+    Expr r;
+    if (minkowski::meshConvexMorph(A.value, B.value, t, &r)) return through(r, xs, n);
+  }
   Bounds bb = (t == 0.0 || t == 1.0) ? Bounds{} : boxOf(fn, o, B, 2);
   Expr r = guarded(fn, -1, [&] {
     return morphMinkowski(A.value, B.value, static_cast<uint32_t>(n), t, bb, minkowskiOptions(o));

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -33,16 +34,36 @@ struct Mesh {
   std::string what;
 };
 
-// x_i + k, k + x_i, x_i - k or x_i: the shift k (the field reads the mesh at x + k, so the
-// solid is the mesh moved by -k).
-bool coordinateShift(const Expr& e, uint32_t i, double& k) {
-  auto isXi = [i](const Expr& v) { return v.op() == Op::Var && v.node().index == i; };
-  k = 0;
-  if (isXi(e)) return true;
-  if (e.op() == Op::Add && isXi(e.arg(0)) && e.arg(1).isConst()) return k = e.arg(1).constValue(), true;
-  if (e.op() == Op::Add && e.arg(0).isConst() && isXi(e.arg(1))) return k = e.arg(0).constValue(), true;
-  if (e.op() == Op::Sub && isXi(e.arg(0)) && e.arg(1).isConst()) return k = -e.arg(1).constValue(), true;
-  return false;
+// e = s x_i + k with constants s != 0 and k (translations and scalings: a morph's (1 - t) A
+// reads A at x / (1 - t)); the field reads the mesh at s x + k, so the solid is (mesh - k) / s.
+bool axisMap(const Expr& e, uint32_t i, double& s, double& k) {
+  if (e.op() == Op::Var) return e.node().index == i ? (s = 1, k = 0, true) : false;
+  double s0, k0;
+  switch (e.op()) {
+    case Op::Add:
+    case Op::Sub: {
+      const bool constFirst = e.arg(0).isConst();
+      if (!constFirst && !e.arg(1).isConst()) return false;
+      if (!axisMap(e.arg(constFirst ? 1 : 0), i, s0, k0)) return false;
+      const double c = e.arg(constFirst ? 0 : 1).constValue();
+      if (e.op() == Op::Add) s = s0, k = k0 + c;
+      else if (constFirst) s = -s0, k = c - k0;
+      else s = s0, k = k0 - c;
+      return true;
+    }
+    case Op::Mul:
+    case Op::Div: {
+      if (!e.arg(1).isConst() && !(e.op() == Op::Mul && e.arg(0).isConst())) return false;
+      const bool constFirst = e.op() == Op::Mul && e.arg(0).isConst();
+      if (!axisMap(e.arg(constFirst ? 1 : 0), i, s0, k0)) return false;
+      double c = e.arg(constFirst ? 0 : 1).constValue();
+      if (e.op() == Op::Div) c = 1 / c;
+      s = s0 * c, k = k0 * c;
+      return std::isfinite(s) && std::isfinite(k) && s != 0;
+    }
+    default:
+      return false;
+  }
 }
 
 std::optional<Mesh> closedMeshOf(const Expr& e, bool* isPolytope) {
@@ -57,14 +78,17 @@ std::optional<Mesh> closedMeshOf(const Expr& e, bool* isPolytope) {
   }
   const auto* m = dynamic_cast<const MeshField*>(field->node().fn.get());
   if (!m || !m->check().closed()) return std::nullopt;
-  V3 shift{0, 0, 0};
+  V3 scale{1, 1, 1}, shift{0, 0, 0};
   for (uint32_t i = 0; i < 3; ++i)
-    if (!coordinateShift(field->arg(i), i, shift[i])) return std::nullopt;
+    if (!axisMap(field->arg(i), i, scale[i], shift[i])) return std::nullopt;
   Mesh out;
   const std::vector<double>& xyz = m->vertices();
-  for (size_t i = 0; i + 2 < xyz.size(); i += 3) out.v.push_back({xyz[i] - shift[0], xyz[i + 1] - shift[1], xyz[i + 2] - shift[2]});
+  for (size_t i = 0; i + 2 < xyz.size(); i += 3)
+    out.v.push_back({(xyz[i] - shift[0]) / scale[0], (xyz[i + 1] - shift[1]) / scale[1], (xyz[i + 2] - shift[2]) / scale[2]});
   const std::vector<uint32_t>& tr = m->triangles();
-  for (size_t i = 0; i + 2 < tr.size(); i += 3) out.t.push_back({tr[i], tr[i + 1], tr[i + 2]});
+  const bool mirrored = scale[0] * scale[1] * scale[2] < 0;  // keep the triangles outward
+  for (size_t i = 0; i + 2 < tr.size(); i += 3)
+    out.t.push_back(mirrored ? std::array<uint32_t, 3>{tr[i], tr[i + 2], tr[i + 1]} : std::array<uint32_t, 3>{tr[i], tr[i + 1], tr[i + 2]});
   out.what = *isPolytope ? "convex polytope (" + std::to_string(p->planes) + " planes)"
                          : m->describe() + " (" + std::to_string(out.t.size()) + " triangles)";
   return out;
@@ -119,6 +143,36 @@ std::optional<Convex> convexOf(const Mesh& m, double scale) {
   return c;
 }
 
+// The convex hull of points on a plane with unit normal u, fanned into triangles (emit(p, q, r));
+// nothing when they span no area (the face of a sum in a direction that is not a facet's).
+template <typename Emit>
+void facetTriangles(const V3& u, const std::vector<V3>& pts, double tol, Emit&& emit) {
+  if (pts.size() < 3) return;
+  const V3 e1 = std::abs(u[0]) < 0.9 ? cross(u, V3{1, 0, 0}) : cross(u, V3{0, 1, 0});
+  const double l1 = norm(e1);
+  const V3 a{e1[0] / l1, e1[1] / l1, e1[2] / l1}, b = cross(u, a);
+  std::vector<std::pair<std::array<double, 2>, size_t>> q;
+  for (size_t i = 0; i < pts.size(); ++i) q.push_back({{dot(a, pts[i]), dot(b, pts[i])}, i});
+  std::sort(q.begin(), q.end());
+  auto turn = [](const std::array<double, 2>& o, const std::array<double, 2>& p, const std::array<double, 2>& r) {
+    return (p[0] - o[0]) * (r[1] - o[1]) - (p[1] - o[1]) * (r[0] - o[0]);
+  };
+  // Andrew's monotone chain; turns within tol * extent count as straight.
+  std::vector<size_t> hull(2 * q.size());
+  size_t k = 0;
+  const double eps = tol * std::max(1.0, std::abs(q.back().first[0] - q.front().first[0]));
+  for (size_t i = 0; i < q.size(); ++i) {
+    while (k >= 2 && turn(q[hull[k - 2]].first, q[hull[k - 1]].first, q[i].first) <= eps) --k;
+    hull[k++] = i;
+  }
+  for (size_t i = q.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && turn(q[hull[k - 2]].first, q[hull[k - 1]].first, q[i].first) <= eps) --k;
+    hull[k++] = i;
+  }
+  if (k < 4) return;  // fewer than three distinct corners (the chain repeats the first)
+  for (size_t i = 1; i + 2 < k; ++i) emit(pts[q[hull[0]].second], pts[q[hull[i]].second], pts[q[hull[i + 1]].second]);
+}
+
 // See mesh_convex_sum.h. complement: the field of A^c ⊕ B (for the difference, B = -B).
 class MeshConvexSumField : public DistanceField {
  public:
@@ -150,52 +204,43 @@ class MeshConvexSumField : public DistanceField {
     std::vector<V3> bLo(1, {INFINITY, INFINITY, INFINITY}), bHi(1, {-INFINITY, -INFINITY, -INFINITY});
     for (const V3& p : b.v)
       for (int k = 0; k < 3; ++k) bLo[0][size_t(k)] = std::min(bLo[0][size_t(k)], p[size_t(k)]), bHi[0][size_t(k)] = std::max(bHi[0][size_t(k)], p[size_t(k)]);
+    // B's facet normals, one per plane (a triangulated face gives several triangles).
+    std::vector<V3> bNormals;
+    for (const V3& n : b.faceN) {
+      bool known = false;
+      for (const V3& k : bNormals) known = known || dot(k, n) > 1 - 1e-12;
+      if (!known) bNormals.push_back(n);
+    }
+    std::vector<V3> normals;
     for (const auto& t : a.t) {
       const V3 tv[3] = {a.v[t[0]], a.v[t[1]], a.v[t[2]]};
-      auto hT = [&](const V3& u) { return std::max({dot(u, tv[0]), dot(u, tv[1]), dot(u, tv[2])}); };
-      const uint32_t first = uint32_t(planes_.size());
-      auto plane = [&](const V3& u) { planes_.push_back({u[0], u[1], u[2], hT(u) + b.support(u)}); };
-      V3 n = cross(sub(tv[1], tv[0]), sub(tv[2], tv[0]));
-      const double nl = norm(n);
-      if (nl > 0) {
-        for (double& x : n) x /= nl;
-        for (double s : {1.0, -1.0}) {
-          const V3 u{s * n[0], s * n[1], s * n[2]};
-          plane(u);
-          const double h = b.support(u);
-          for (const V3& p : b.v)  // T + the face of B in direction u (every tied vertex)
-            if (dot(u, p) >= h - tol) tri(add(tv[0], p), add(tv[1], p), add(tv[2], p));
-        }
-      }
-      for (size_t f = 0; f < b.faces.size(); ++f) {
-        const V3& u = b.faceN[f];
-        plane(u);
-        const double h = hT(u);
-        for (const V3& p : tv)
-          if (dot(u, p) >= h - tol) tri(add(b.faces[f][0], p), add(b.faces[f][1], p), add(b.faces[f][2], p));
-      }
+      // The candidate facet normals of T ⊕ B, each once.
+      normals.clear();
+      auto candidate = [&](V3 u) {
+        const double l = norm(u);
+        if (!(l > 0)) return;
+        for (double& x : u) x /= l;
+        for (const V3& k : normals)
+          if (dot(k, u) > 1 - 1e-12) return;
+        normals.push_back(u);
+      };
+      const V3 n = cross(sub(tv[1], tv[0]), sub(tv[2], tv[0]));
+      candidate(n);
+      candidate({-n[0], -n[1], -n[2]});
+      for (const V3& u : bNormals) candidate(u);
       for (int k = 0; k < 3; ++k) {
-        const V3 &p0 = tv[k], &p1 = tv[(k + 1) % 3];
-        const V3 eT = sub(p1, p0);
+        const V3 eT = sub(tv[(k + 1) % 3], tv[k]);
         for (const V3& d : bDirs) {
-          V3 u = cross(eT, d);
-          const double l = norm(u);
-          if (!(l > 1e-12 * norm(eT))) continue;  // parallel: the sum of the edges is a segment
-          for (double& x : u) x /= l;
-          for (double s : {1.0, -1.0}) {
-            const V3 us{s * u[0], s * u[1], s * u[2]};
-            plane(us);
-            const double h = hT(us);
-            if (dot(us, p0) < h - tol || dot(us, p1) < h - tol) continue;
-            const double hb = b.support(us);
-            for (const auto& e : b.edges) {  // the parallelograms edge ⊕ edge of the face in direction us
-              const V3 &q0 = b.v[e[0]], &q1 = b.v[e[1]];
-              if (dot(us, q0) < hb - tol || dot(us, q1) < hb - tol) continue;
-              tri(add(p0, q0), add(p1, q0), add(p1, q1));
-              tri(add(p0, q0), add(p1, q1), add(p0, q1));
-            }
-          }
+          const V3 u = cross(eT, d);
+          if (!(norm(u) > 1e-12 * norm(eT))) continue;  // parallel: the sum of the edges is a segment
+          candidate(u);
+          candidate({-u[0], -u[1], -u[2]});
         }
+      }
+      const uint32_t first = uint32_t(planes_.size());
+      for (const V3& u : normals) {
+        const double hT = std::max({dot(u, tv[0]), dot(u, tv[1]), dot(u, tv[2])}), hB = b.support(u);
+        planes_.push_back({u[0], u[1], u[2], hT + hB});
       }
       cells_.push_back({first, uint32_t(planes_.size()) - first});
       Bvh::Box box;
@@ -206,6 +251,8 @@ class MeshConvexSumField : public DistanceField {
       boxes.push_back(box);
     }
     cellBvh_.build(boxes);
+    convolutionPieces(a, b, bDirs, tol, tri);
+    pruneInterior(soup, soupTris, tol);
     pieces_ = soupTris.size() / 3;
     soup_ = std::make_shared<MeshField>(std::move(soup), std::move(soupTris), "boundary pieces");
     uint64_t h = a_->contentHash() ^ (complement_ ? 0x9e3779b97f4a7c15ULL : 0);
@@ -253,6 +300,130 @@ class MeshConvexSumField : public DistanceField {
   size_t pieces_ = 0;
   uint64_t hash_ = 0;
 
+  // The pieces a + b of ∂A ⊕ ∂B with a common outward normal u (the convolution of the two
+  // boundaries), which cover the boundary of A ⊕ B: a boundary point x = a + b has x − B outside
+  // A touching it at a, so b ∈ F_B(u) for an outward normal u of A at a. On a face's interior u is
+  // its normal: T + F_B(n_T). On a convex edge u runs over the arc between its faces' normals: the
+  // parallelograms e ⊕ e_B of the B edges whose normal arcs meet it. A reflex edge or vertex adds
+  // nothing (x − B lies in the convex outer wedge, so b ∈ F_B of each incident face: the face pieces
+  // hold x). A convex vertex: v + the B facets whose normals lie in its normal cone; a saddle
+  // vertex: v + every B facet (a superset, as every piece lies in A ⊕ B).
+  template <typename Tri>
+  void convolutionPieces(const Mesh& a, const Convex& b, const std::vector<V3>& bDirs, double tol, Tri&& tri) const {
+    const double sigma = complement_ ? -1 : 1;  // A^c's outward normals are A's reversed
+    std::vector<V3> N(a.t.size());
+    for (size_t i = 0; i < a.t.size(); ++i) {
+      const auto& t = a.t[i];
+      V3 n = cross(sub(a.v[t[1]], a.v[t[0]]), sub(a.v[t[2]], a.v[t[0]]));
+      const double l = norm(n);
+      N[i] = l > 0 ? V3{sigma * n[0] / l, sigma * n[1] / l, sigma * n[2] / l} : V3{0, 0, 0};
+    }
+    auto supportFace = [&](const V3& u, std::vector<V3>& out) {
+      out.clear();
+      const double h = b.support(u);
+      for (const V3& q : b.v)
+        if (dot(u, q) >= h - tol) out.push_back(q);
+    };
+    std::vector<V3> fb, pts;
+    for (size_t i = 0; i < a.t.size(); ++i) {  // faces: T + F_B(N_T)
+      if (N[i] == V3{0, 0, 0}) continue;
+      supportFace(N[i], fb);
+      pts.clear();
+      for (uint32_t k : a.t[i])
+        for (const V3& q : fb) pts.push_back(add(a.v[k], q));
+      facetTriangles(N[i], pts, tol, tri);
+    }
+    // Edges: the two triangles of each (closed, consistently oriented mesh) and their far vertices.
+    std::map<std::pair<uint32_t, uint32_t>, std::pair<size_t, uint32_t>> firstSide;
+    std::vector<std::vector<uint32_t>> neighbours(a.v.size()), incident(a.v.size());
+    for (size_t i = 0; i < a.t.size(); ++i) {
+      const auto& t = a.t[i];
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t p = t[size_t(k)], q = t[size_t((k + 1) % 3)], far = t[size_t((k + 2) % 3)];
+        incident[p].push_back(uint32_t(i));
+        neighbours[p].push_back(q);
+        auto key = std::make_pair(std::min(p, q), std::max(p, q));
+        auto it = firstSide.find(key);
+        if (it == firstSide.end()) {
+          firstSide.emplace(key, std::make_pair(i, far));
+          continue;
+        }
+        const size_t j = it->second.first;
+        const V3 &P = a.v[p], &Q = a.v[q], &w1 = a.v[it->second.second], &w2 = a.v[far];
+        if (dot(N[j], sub(w2, P)) > tol) continue;  // reflex: the face pieces cover it
+        const V3 e = sub(Q, P);
+        for (const V3& d : bDirs) {
+          V3 u = cross(e, d);
+          const double l = norm(u);
+          if (!(l > 1e-12 * norm(e))) continue;
+          for (double sgn : {1.0, -1.0}) {
+            const V3 us{sgn * u[0] / l, sgn * u[1] / l, sgn * u[2] / l};
+            if (dot(us, sub(w1, P)) > tol || dot(us, sub(w2, P)) > tol) continue;  // not in the edge's arc
+            const double hb = b.support(us);
+            for (const auto& eb : b.edges) {
+              const V3 &q0 = b.v[eb[0]], &q1 = b.v[eb[1]];
+              if (dot(us, q0) < hb - tol || dot(us, q1) < hb - tol) continue;
+              tri(add(P, q0), add(Q, q0), add(Q, q1));
+              tri(add(P, q0), add(Q, q1), add(P, q1));
+            }
+          }
+        }
+      }
+    }
+    // Vertices.
+    for (size_t v = 0; v < a.v.size(); ++v) {
+      if (incident[v].empty()) continue;
+      bool convex = true, concave = true;
+      for (uint32_t f : incident[v])
+        for (uint32_t w : neighbours[v]) {
+          const double h = dot(N[f], sub(a.v[w], a.v[v]));
+          convex = convex && h <= tol;
+          concave = concave && h >= -tol;
+        }
+      if (concave && !convex) continue;
+      for (size_t f = 0; f < b.faces.size(); ++f) {
+        const V3& u = b.faceN[f];
+        bool inCone = true;
+        if (convex)
+          for (uint32_t w : neighbours[v]) inCone = inCone && dot(u, sub(a.v[w], a.v[v])) <= tol;
+        if (inCone) tri(add(a.v[v], b.faces[f][0]), add(a.v[v], b.faces[f][1]), add(a.v[v], b.faces[f][2]));
+      }
+    }
+  }
+
+  // Drops the pieces that lie in the interior of one convex T ⊕ B (all three corners strictly
+  // inside it) or of A + b0 (a ball about the centroid holding the triangle inside A): they hold
+  // no boundary point, so the rest still covers the boundary and the distance stays exact.
+  void pruneInterior(std::vector<double>& soup, std::vector<uint32_t>& tris, double tol) const {
+    std::vector<uint32_t> kept;
+    auto depth = [&](uint32_t cell, const double* p) {
+      const Cell& c = cells_[cell];
+      double m = INFINITY;
+      for (uint32_t k = c.first; k < c.first + c.count && m > tol; ++k) {
+        const auto& u = planes_[k];
+        m = std::min(m, u[3] - (u[0] * p[0] + u[1] * p[1] + u[2] * p[2]));
+      }
+      return m;
+    };
+    for (size_t t = 0; t + 2 < tris.size(); t += 3) {
+      const double* v[3] = {&soup[3 * tris[t]], &soup[3 * tris[t + 1]], &soup[3 * tris[t + 2]]};
+      double c[3], r2 = 0;
+      for (int k = 0; k < 3; ++k) c[k] = (v[0][k] + v[1][k] + v[2][k]) / 3;
+      for (const double* p : v) r2 = std::max(r2, (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]));
+      const double shifted[3] = {c[0] - b0_[0], c[1] - b0_[1], c[2] - b0_[2]};
+      double inA = a_->value(shifted);
+      if (complement_) inA = -inA;
+      bool interior = inA > std::sqrt(r2) + tol;
+      if (!interior)
+        cellBvh_.containing(v[0], [&](uint32_t cell) {
+          interior = interior || (depth(cell, v[0]) > tol && depth(cell, v[1]) > tol && depth(cell, v[2]) > tol);
+        });
+      if (!interior) kept.insert(kept.end(), {tris[t], tris[t + 1], tris[t + 2]});
+    }
+    if (kept.empty() && !tris.empty()) kept.assign(tris.begin(), tris.begin() + 3);  // MeshField needs one
+    tris.swap(kept);
+  }
+
   // The field of (A or A^c) ⊕ B, q the nearest boundary point where it is negative.
   double sumField(const double* p, double* q) const {
     const double shifted[3] = {p[0] - b0_[0], p[1] - b0_[1], p[2] - b0_[2]};
@@ -276,12 +447,23 @@ class MeshConvexSumField : public DistanceField {
   }
 };
 
-bool build(const Expr& aExpr, const Expr& bExpr, bool difference, Expr* out) {
+void scaleMesh(Mesh& m, double s) {
+  if (s == 1) return;
+  for (V3& p : m.v)
+    for (double& x : p) x *= s;
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%g × ", s);
+  m.what = buf + m.what;
+}
+
+bool build(const Expr& aExpr, const Expr& bExpr, bool difference, Expr* out, double scaleA = 1, double scaleB = 1) {
   bool aPoly = false, bPoly = false;
   std::optional<Mesh> b = closedMeshOf(bExpr, &bPoly);
   if (!b) return false;
   std::optional<Mesh> a = closedMeshOf(aExpr, &aPoly);
   if (!a) return false;
+  scaleMesh(*a, scaleA);
+  scaleMesh(*b, scaleB);
   std::optional<Convex> cb = convexOf(*b, std::max(extentOf(a->v), extentOf(b->v)));
   if (!cb) return false;
   if (difference)
@@ -315,6 +497,11 @@ bool build(const Expr& aExpr, const Expr& bExpr, bool difference, Expr* out) {
 bool meshConvexSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
   if (dims != 3) return false;
   return build(a, b, false, out) || build(b, a, false, out);
+}
+
+bool meshConvexMorph(const Expr& a, const Expr& b, double t, Expr* out) {
+  if (!(t > 0 && t < 1)) return false;
+  return build(a, b, false, out, 1 - t, t) || build(b, a, false, out, t, 1 - t);
 }
 
 bool meshConvexDifference(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {

@@ -185,7 +185,7 @@ int64_t Bvh::nearest(const double* p, F&& dist2, double& best2) const {
   stack[sp++] = 0;
   while (sp > 0) {
     const NodeB& n = nodes_[stack[--sp]];
-    if (boxDist2(n.box, p) > best2) continue;
+    if (boxDist2(n.box, p) >= best2 && best >= 0) continue;  // a tie cannot be nearer
     if (n.count > 0) {
       for (uint32_t k = n.first; k < n.first + n.count; ++k) {
         const double d = dist2(order_[k], best2);

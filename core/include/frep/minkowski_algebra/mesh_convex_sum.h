@@ -37,6 +37,9 @@ namespace frep::minkowski {
 // boundary mesh is used) and the other a convex polytope: an intersection of half-spaces
 // (convex_polytope.h) or a closed convex mesh. Registers the result for the job report.
 bool meshConvexSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out);
+// The metamorphosis (1 - t) A ⊕ t B (Pasko-Minkowski eq. 4.5, scalings about the origin) of such
+// operands, 0 < t < 1.
+bool meshConvexMorph(const Expr& a, const Expr& b, double t, Expr* out);
 // A ⊖ B when A is a closed mesh (or a polytope) and B a convex polytope.
 bool meshConvexDifference(const Expr& a, const Expr& b, uint32_t dims, Expr* out);
 
