@@ -316,7 +316,7 @@ std::string translateScene(const std::string& text, const std::string& fileName,
 
 std::string povFromField(const Expr& f, double thin, Expr* offending) {
   if (std::optional<minkowski::ExactTerm> t = minkowski::lookupExact(f);
-      t && t->kind != minkowski::ExactTerm::Kind::BallOffset) {
+      t && (t->kind == minkowski::ExactTerm::Kind::Sum || t->kind == minkowski::ExactTerm::Kind::Erosion)) {
     Reduction r = minkowski::reduce(t->sum);
     if (t->kind == minkowski::ExactTerm::Kind::Sum) return povUnion(r, thin);
     if (t->c0.ball == 0 && t->c0.discAxes() == 0) {

@@ -163,6 +163,17 @@ Expr registerHyperFunShape(const Expr& field, const std::vector<Expr>& xs, bool 
   return field;
 }
 
+Expr registerDistanceTwin(const Expr& field, const std::vector<Expr>& xs, const Expr& twin, const std::string& what) {
+  if (!identityCoords(xs)) return field;
+  ExactTerm t;
+  t.kind = ExactTerm::Kind::Distance;
+  t.twin = twin;
+  t.operand = what;
+  t.exactOutside = t.exactInside = true;
+  minkowski::registerExact(field, t);
+  return field;
+}
+
 bool exactMinkowskiSum(const std::vector<const Arg*>& operands, const std::vector<Expr>& xs, Expr* out) {
   if (xs.size() < 3) return false;
   Sum total;
@@ -180,7 +191,8 @@ bool exactMinkowskiSum(const std::vector<const Arg*>& operands, const std::vecto
 bool exactMinkowskiDiff(const Arg& A, const Arg& B, const std::vector<Expr>& xs, Expr* out) {
   if (xs.size() < 3 || A.objectDims != 3 || B.objectDims != 3) return false;
   std::optional<ExactTerm> ta = minkowski::lookupExact(A.value), tb = minkowski::lookupExact(B.value);
-  if (!ta || !tb || tb->kind != ExactTerm::Kind::Sum || ta->kind == ExactTerm::Kind::BallOffset) return false;
+  if (!ta || !tb || tb->kind != ExactTerm::Kind::Sum) return false;
+  if (ta->kind != ExactTerm::Kind::Sum && ta->kind != ExactTerm::Kind::Erosion) return false;
   ExactTerm t;
   t.kind = ExactTerm::Kind::Erosion;
   if (ta->kind == ExactTerm::Kind::Sum) {

@@ -22,5 +22,9 @@ bool exactMinkowskiDiff(const Arg& A, const Arg& B, const std::vector<Expr>& xs,
 // the offset path on models written the HyperFun way. Returns field.
 Expr registerHyperFunShape(const Expr& field, const std::vector<Expr>& xs, bool block,
                            const std::vector<Expr>& place, const std::vector<Expr>& size);
+// A HyperFun primitive whose sign-exact field has a closed-form exact signed distance `twin`
+// (the same set): registered, when read at the plain coordinates, so a Minkowski sum or
+// difference with a ball is the offset of the twin. Returns field.
+Expr registerDistanceTwin(const Expr& field, const std::vector<Expr>& xs, const Expr& twin, const std::string& what);
 
 }  // namespace frep::lang

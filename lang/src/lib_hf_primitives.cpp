@@ -41,7 +41,11 @@ Expr cylinder(const char* fn, std::vector<Arg>& a, int axis) {
   auto p = offset(fn, a);
   Expr R = scalarArg(fn, a, 2);
   auto o = others(axis);
-  return R * R - p[o[0]] * p[o[0]] - p[o[1]] * p[o[1]];
+  const Expr field = R * R - p[o[0]] * p[o[0]] - p[o[1]] * p[o[1]];
+  // R^2 - rho^2 >= 0 exactly where R - rho >= 0, the cylinder's exact signed distance.
+  if (!R.isConst() || !(R.constValue() > 0)) return field;
+  return registerDistanceTwin(field, arrayAtLeast(fn, a, 0, 3, "x"), R - sqrt(p[o[0]] * p[o[0]] + p[o[1]] * p[o[1]]),
+                              std::string(fn) + " (its exact distance R - rho)");
 }
 
 Expr ellCylinder(const char* fn, std::vector<Arg>& a, int axis) {
@@ -56,7 +60,13 @@ Expr torus(const char* fn, std::vector<Arg>& a, int axis) {
   auto o = others(axis);
   Expr rho2 = p[o[0]] * p[o[0]] + p[o[1]] * p[o[1]];
   // (sqrt(rho2) - R)^2 + h^2 <= r0^2, expanded as HyperFun does.
-  return r0 * r0 - (rho2 + p[axis] * p[axis]) - R * R + 2.0 * R * sqrt(rho2);
+  const Expr field = r0 * r0 - (rho2 + p[axis] * p[axis]) - R * R + 2.0 * R * sqrt(rho2);
+  // The same set as r0 - |(rho - R, h)|, the exact signed distance of a ring torus (R >= r0:
+  // for a spindle torus the nearest boundary point can lie across the axis).
+  if (!R.isConst() || !r0.isConst() || !(r0.constValue() > 0) || !(R.constValue() >= r0.constValue())) return field;
+  return registerDistanceTwin(field, arrayAtLeast(fn, a, 0, 3, "x"),
+                              r0 - sqrt(square(sqrt(rho2) - R) + p[axis] * p[axis]),
+                              std::string(fn) + " (its exact distance r0 - |(rho - R, h)|)");
 }
 
 Expr cone(const char* fn, std::vector<Arg>& a, int axis) {

@@ -138,5 +138,35 @@ TEST(FrDistanceOffset, WhatIsNotExactSearches) {
   EXPECT_NEAR(evalModel(d, {2.5, 0.5, -0.5}), 0.5 + 0.15, 1e-9);
 }
 
+TEST(FrDistanceOffset, HyperFunTorusAndCylinderOffsetByTheirExactDistances) {
+  // hfTorusZ's polynomial and hfCylinderZ's R^2 - rho^2 keep their HyperFun values, but a ball
+  // sum or difference reads them as their exact distances: r0 -+ r tubes and R -+ r cylinders.
+  const std::string shapes =
+      "tor(x[3], a[1]) { array c[3]; c = [0.1, 0, 0]; tor = hfTorusZ(x, c, 0.6, 0.2); }\n"
+      "cyl(x[3], a[1]) { array c[3]; c = [0, 0.2, 0]; cyl = hfCylinderZ(x, c, 0.3); }\n"
+      "b(x[3], a[1]) { b = frBall(x, 0.15); }\n";
+  Model tor = compileOk(shapes + "my_model(x[3], a[1]) { my_model = tor(x, a); }");
+  EXPECT_NEAR(evalModel(tor, {0.7, 0.0, 0.1}), 0.04 - 0.01 - 0.0, 1e-12);  // r0^2 - |p|^2 - R^2 + 2 R rho
+  Model sum = compileOk(shapes + "my_model(x[3], a[1]) { my_model = frMinkowski(x, tor, b); }");
+  Model diff = compileOk(shapes + "my_model(x[3], a[1]) { my_model = frMinkowskiDiff(x, tor, b); }");
+  Model cyl = compileOk(shapes + "my_model(x[3], a[1]) { my_model = frMinkowskiDiff(x, cyl, b); }");
+  for (const Model* m : {&sum, &diff, &cyl}) {
+    EXPECT_FALSE(hasExtremum(m->field));
+    ASSERT_EQ(minkowski::describeExact(m->field).size(), 1u);
+  }
+  for (const auto& p : randomPoints(1000, -1.0, 1.0)) {
+    const double rho = std::hypot(p[0] - 0.1, p[1]), tube = std::hypot(rho - 0.6, p[2]);
+    EXPECT_NEAR(evalModel(sum, {p[0], p[1], p[2]}), 0.35 - tube, 1e-9);
+    EXPECT_NEAR(evalModel(diff, {p[0], p[1], p[2]}), 0.05 - tube, 1e-9);
+    EXPECT_NEAR(evalModel(cyl, {p[0], p[1], p[2]}), 0.15 - std::hypot(p[0], p[1] - 0.2), 1e-9);
+  }
+  // A spindle torus (R < r0) has no such distance: the search runs.
+  Model spindle = compileOk("t(x[3], a[1]) { array c[3]; c = [0, 0, 0]; t = hfTorusZ(x, c, 0.1, 0.3); }\n"
+                            "b(x[3], a[1]) { b = frBall(x, 0.15); }\n"
+                            "my_model(x[3], a[1]) { array o[8]; o = [0, 0.01, -0.2, 0.2, -0.2, 0.2, -0.2, 0.2];\n"
+                            "  my_model = frMinkowski(x, t, b, o); }");
+  EXPECT_TRUE(hasExtremum(spindle.field));
+}
+
 }  // namespace
 }  // namespace frep::lang::testing

@@ -47,6 +47,8 @@ struct Exactness {
 Exactness exactnessOf(const Expr& e) {
   if (std::optional<ExactTerm> t = lookupExact(e); t && t->kind == ExactTerm::Kind::BallOffset)
     return {t->exactOutside, t->exactInside, "(" + t->operand + ")"};
+  if (std::optional<ExactTerm> t = lookupExact(e); t && t->kind == ExactTerm::Kind::Distance)
+    return {true, true, t->operand};
   if (e.op() != Op::Field) return {};
   const auto* d = dynamic_cast<const DistanceField*>(e.node().fn.get());
   if (!d) return {};
@@ -83,9 +85,14 @@ Expr offsetField(const Expr& f, const Ball& b, bool erosion, ExactTerm t) {
 }
 
 
-// An operand that is not an exact distance but an intersection of half-spaces is replaced by
-// its convex polytope's exact signed distance (same set: the sum's set is unchanged).
+// An operand that is not an exact distance but has a registered distance twin (hfCylinder,
+// hfTorus), or is an intersection of half-spaces, is replaced by that exact signed distance
+// (same set: the sum's set is unchanged).
 Expr exactOperand(const Expr& field, Exactness& x) {
+  if (std::optional<ExactTerm> t = lookupExact(field); t && t->kind == ExactTerm::Kind::Distance) {
+    x = {true, true, t->operand};
+    return t->twin;  // the same set, read as its exact distance
+  }
   x = exactnessOf(field);
   if (x.outside && x.inside) return field;
   std::optional<ConvexPolytope> p = convexPolytopeOf(field);

@@ -38,6 +38,7 @@ std::vector<std::string> describeExact(const Expr& f) {
     if (it == table().end()) return;
     const ExactTerm& t = it->second.term;
     if (t.kind == ExactTerm::Kind::Sum && t.sum.terms < 2) return;  // a member alone: no operation
+    if (t.kind == ExactTerm::Kind::Distance) return;                  // a primitive, no operation
     if (t.kind == ExactTerm::Kind::BallOffset)
       lines.push_back(std::string("exact Minkowski ") + (t.erosion ? "difference " : "sum ") + t.operand +
                       " as the offset f " + (t.erosion ? "- " : "+ ") +

@@ -16,8 +16,11 @@ namespace frep::minkowski {
 
 struct ExactTerm {
   // BallOffset: a distance-field operand plus or minus a ball (distance_offset.h);
-  // MeshPolytope: a closed mesh plus or minus a convex polytope (mesh_convex_sum.h).
-  enum class Kind { Sum, Erosion, BallOffset, MeshPolytope } kind = Kind::Sum;
+  // MeshPolytope: a closed mesh plus or minus a convex polytope (mesh_convex_sum.h);
+  // Distance: a field whose set is that of `twin`, an exact signed distance on both sides
+  // (HyperFun's hfCylinder, hfTorus: sign-exact polynomials of a shape with a closed distance).
+  enum class Kind { Sum, Erosion, BallOffset, MeshPolytope, Distance } kind = Kind::Sum;
+  Expr twin;  // Distance
   Sum sum;         // Sum: the secondary object; Erosion: the subtracted sum C1 ⊕ … ⊕ CN; BallOffset: the ball
   Sum c0;          // Erosion: the solid eroded (a block or a sphere)
   int pieces = 0;  // primitives of the union (Sum) or intersection (Erosion)
