@@ -328,6 +328,7 @@ Expr frMorphMinkowski(std::vector<Arg>& a) {
   if (n == 3 && t > 0.0 && t < 1.0 && numParams(A.value) == 0 && numParams(B.value) == 0) {
     // (1 - t) A ⊕ t B (eq. 4.5) without a search where the sum has an exact form.
     Expr r;
+    if (exactMinkowskiMorph(A, B, t, xs, &r)) return r;
     if (minkowski::meshConvexMorph(A.value, B.value, t, &r)) return through(r, xs, n);
   }
   Bounds bb = (t == 0.0 || t == 1.0) ? Bounds{} : boxOf(fn, o, B, 2);

@@ -188,6 +188,23 @@ bool exactMinkowskiSum(const std::vector<const Arg*>& operands, const std::vecto
   return true;
 }
 
+bool exactMinkowskiMorph(const Arg& A, const Arg& B, double t, const std::vector<Expr>& xs, Expr* out) {
+  if (xs.size() < 3 || A.objectDims != 3 || B.objectDims != 3 || !(t > 0 && t < 1)) return false;
+  std::optional<ExactTerm> ta = minkowski::lookupExact(A.value), tb = minkowski::lookupExact(B.value);
+  if (!ta || !tb || ta->kind != ExactTerm::Kind::Sum || tb->kind != ExactTerm::Kind::Sum) return false;
+  // (1 - t) A ⊕ t B (Pasko-Minkowski eq. 4.5): a basic-set sum scaled about the origin by s
+  // has its position, edges, discs and ball scaled by s (each member's support function is).
+  auto scaled = [](Sum s, double k) {
+    for (int i = 0; i < 3; ++i) s.offset[size_t(i)] *= k, s.lengths[size_t(i)] *= k, s.disc[size_t(i)] *= k;
+    s.ball *= k;
+    return s;
+  };
+  Sum total = scaled(ta->sum, 1 - t);
+  if (!total.add(scaled(tb->sum, t)) || !minkowski::reduce(total).ok) return false;
+  *out = exactField(total, xs);
+  return true;
+}
+
 bool exactMinkowskiDiff(const Arg& A, const Arg& B, const std::vector<Expr>& xs, Expr* out) {
   if (xs.size() < 3 || A.objectDims != 3 || B.objectDims != 3) return false;
   std::optional<ExactTerm> ta = minkowski::lookupExact(A.value), tb = minkowski::lookupExact(B.value);

@@ -20,6 +20,9 @@ bool exactMinkowskiDiff(const Arg& A, const Arg& B, const std::vector<Expr>& xs,
 // fields are sign-exact, not distances): registers `field` as that shape when it is read at the
 // plain coordinates with constant placement, so Minkowski operations take the exact algebra or
 // the offset path on models written the HyperFun way. Returns field.
+// frMorphMinkowski of two basic-set sums by the algebra: (1 - t) A ⊕ t B, each scaled about the
+// origin (eq. 4.5); false when either is not a registered sum.
+bool exactMinkowskiMorph(const Arg& A, const Arg& B, double t, const std::vector<Expr>& xs, Expr* out);
 Expr registerHyperFunShape(const Expr& field, const std::vector<Expr>& xs, bool block,
                            const std::vector<Expr>& place, const std::vector<Expr>& size);
 // A HyperFun primitive whose sign-exact field has a closed-form exact signed distance `twin`

@@ -14,8 +14,8 @@ frep mesh puts grid points at lo + i * voxel, voxel = longest extent / (res - 1)
 longest axis (and its minimum faces) are therefore always lattice planes. The -b boxes around
 uncut solids leave at least 2.2 voxels of the coarsest grid on every side (margin()).
 
-slow=True: too slow for the suite's 5-minute budget (Minkowski morphs and radius offsets at the
-default search gap, two sweeps); run_suite.py runs them with --slow or when --only names them.
+slow=True: too slow for the suite's 5-minute budget (a morph of a ball and a polytope of planes
+and radius offsets at the default search gap, two sweeps); run_suite.py runs them with --slow or when --only names them.
 Their families are covered in the budget by *_tol cases whose models give the search an explicit
 gap of 0.01 (gap=0.01 here), on grids 16-32 only (no 0.5 % check at 128).
 """
@@ -388,13 +388,13 @@ def _lerp(a, b, t):
 
 _box_case('morph_frblocks', F, 'morph',
           _lerp((-0.3, -0.2, -0.25), (-0.1, -0.5, -0.2), 0.35), _lerp((0.5, 0.2, 0.25), (0.2, 0.4, 0.4), 0.35), 0.0,
-          'frMorphMinkowski of frBlocks, t = 0.35: the box [(1-t) lo_A + t lo_B, (1-t) hi_A + t hi_B]').slow = True
+          'frMorphMinkowski of frBlocks, t = 0.35: the box [(1-t) lo_A + t lo_B, (1-t) hi_A + t hi_B]')
 _box_case('morph_hfblocks', F, 'morph',
           _lerp((-0.1, -0.4, -0.3), (-0.6, -0.1, -0.35), 0.6), _lerp((0.4, 0.5, 0.1), (0.4, 0.2, 0.45), 0.6), 0.0,
-          'frMorphMinkowski of hfBlocks, t = 0.6: the box of lerped corners').slow = True
+          'frMorphMinkowski of hfBlocks, t = 0.6: the box of lerped corners')
 _box_case('morph_ball_block', F, 'morph',
           _shift((-0.2, -0.15, -0.1), (0.05, 0.0, -0.05)), _shift((0.2, 0.15, 0.1), (0.05, 0.0, -0.05)), 0.25,
-          'frMorphMinkowski(frBall 0.5, frBlock 0.8x0.6x0.4, 0.5) = 0.4x0.3x0.2 box (+) ball 0.25: Steiner').slow = True
+          'frMorphMinkowski(frBall 0.5, frBlock 0.8x0.6x0.4, 0.5) = 0.4x0.3x0.2 box (+) ball 0.25: Steiner')
 _box_case('morph_hfsphere_planes', F, 'morph',
           _shift((-0.15, -0.09, -0.18), (-0.14, 0.07, 0.105)), _shift((0.18, 0.12, 0.06), (-0.14, 0.07, 0.105)), 0.42,
           'frMorphMinkowski(hfSphere 0.6, min/max box 1.1x0.7x0.8, 0.3) = 0.33x0.21x0.24 box (+) ball 0.42: Steiner').slow = True
