@@ -146,6 +146,10 @@ MeshField::MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::s
     }
   }
   bvh_.build(boxes);
+  corners_.resize(9 * nt);  // each triangle's corners in one cache-friendly block for the queries
+  for (size_t t = 0; t < nt; ++t)
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k) corners_[9 * t + 3 * c + k] = xyz_[3 * tris_[3 * t + c] + k];
   uint64_t h = 0xcbf29ce484222325ULL;
   for (double d : xyz_) {
     uint64_t b;
@@ -200,7 +204,8 @@ int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, 
   const int64_t t = bvh_.nearest(p, [&](uint32_t i, double cur) {
     double qq[3];
     int region;
-    const double d2 = triangleDist2(p, &xyz_[3 * tris_[3 * i]], &xyz_[3 * tris_[3 * i + 1]], &xyz_[3 * tris_[3 * i + 2]], qq, region);
+    const double* c = &corners_[9 * size_t(i)];
+    const double d2 = triangleDist2(p, c, c + 3, c + 6, qq, region);
     if (d2 < cur) bq[0] = qq[0], bq[1] = qq[1], bq[2] = qq[2], bestRegion = region;
     return d2;
   }, best2);

@@ -127,6 +127,7 @@ class MeshField : public DistanceField {
   std::vector<uint32_t> tris_;
   std::vector<double> faceN_, vertN_, edgeN_;  // pseudonormals
   std::vector<uint32_t> triEdge_;              // 3 edge ids per triangle (edge k: v[k]-v[k+1])
+  std::vector<double> corners_;                // 9 coordinates per triangle (a copy of xyz_ by tris_)
   Bvh bvh_;
   MeshCheck check_;
   uint64_t hash_ = 0;
