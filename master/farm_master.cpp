@@ -10,6 +10,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
+#include <cstring>
 #include <deque>
 #include <exception>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <random>
 #include <set>
 #include <thread>
 #include <utility>
@@ -85,6 +87,11 @@ constexpr size_t kIndependentFailures = 2;
 constexpr uint64_t kBanAfterRefuted = 3;
 constexpr size_t kMaxSkippedForPeer = 64;  // bricks a peer failed passed over per dispatch (bounded scan)
 constexpr int kRouterRcvHwm = 64;       // queued messages per connection (ZMQ_RCVHWM)
+// Verification (docs/farm.md, "Verification"): a checked brick is merged once two distinct
+// workers returned the same bytes; this many different results without two agreeing poison it
+// (the computation is not deterministic across these workers: other builds or machines).
+constexpr size_t kMaxOpinions = 4;
+constexpr uint32_t kFromJournal = ~uint32_t(0);  // Brick::mergedFrom of a brick replayed from the journal
 // Results received in a row are verified and decoded together on the decode threads; a batch
 // ends at a message of another kind, at the end of a turn's drain, or at these bounds.
 constexpr size_t kMaxArrivals = 64;
@@ -153,6 +160,25 @@ struct Brick {
   bool backupIssued = false, leaseReissued = false;
   std::string lastError;
   size_t maxLeaves = 0;  // upper bound on leaves in the region (payload sanity check)
+  // Verification: `verify`, merged only once two distinct workers returned the same bytes (in
+  // the sample, a suspect's, or recomputed for a convicted worker); `held`, results of it wait
+  // in Master::verifying_; `verified`, merged so; `tainted`, taken back after its slab went to
+  // the merge thread (its new result goes to the journal only: runJob merges again from there);
+  // mergedFrom, the worker whose result was merged (Master::workerNames_), or kFromJournal.
+  bool verify = false, held = false, verified = false, tainted = false;
+  uint32_t mergedFrom = kFromJournal;
+};
+
+// A result of a brick under verification, held until another worker returns the same bytes.
+struct Opinion {
+  std::string workerId;
+  Result result;          // its counters, merged with it
+  zmq::message_t bytes;   // its payload, as received (CRC and codec checked)
+};
+struct Verification {
+  std::vector<Opinion> opinions;  // of distinct workers, all different bytes
+  Clock::time_point starvedSince{};  // since when no connected worker could give the next one
+  bool starved = false;
 };
 
 // "sample": what the master keeps of a merged brick until its slab is merged: where its verified
@@ -186,6 +212,8 @@ struct Arrival {
   KeptBrick kept;   // "sample": where the payload is kept (journal or arena), origins and tiles
   std::string error;
   bool ok = false;
+  bool check = false;      // under verification: payload kept for the judge, not journaled yet
+  bool journaled = false;  // appended to the journal (a copy not merged is then revoked there)
 };
 
 struct Peer {
@@ -247,8 +275,18 @@ class Master {
     SignalScope signals;
     start_ = Clock::now();
     if (streaming_) merger_ = std::thread([this] { mergeSlabs(); });
+    std::optional<uint64_t> journalSeed;
     if (!opt_.journalPath.empty()) {
+      // Replayed without handing slabs to the merge thread: a record may be revoked further on.
+      replaying_ = true;
       journal_ = std::make_unique<Journal>(opt_.journalPath, jobId_, opt_.resume, [&](uint64_t id, const std::string& payload) {
+        if ((id == kJournalVerifySeed || id == kJournalRevoke) && payload.size() == 8) {
+          uint64_t v = 0;
+          std::memcpy(&v, payload.data(), 8);
+          if (id == kJournalVerifySeed) journalSeed = v;
+          else if (v < bricks_.size() && bricks_[v].phase == BrickPhase::Done) uncommit(v);
+          return;
+        }
         if (id >= bricks_.size() || bricks_[id].phase == BrickPhase::Done) return;
         BrickOutput out;
         KeptBrick kept;
@@ -258,9 +296,12 @@ class Master {
         commit(id, std::move(out), "journal", false, std::move(kept));
         ++report_.bricksFromJournal;
       });
+      replaying_ = false;
       if (report_.bricksFromJournal)
         spdlog::info("resumed {} of {} bricks from {}", report_.bricksFromJournal, bricks_.size(), opt_.journalPath);
     }
+    setUpVerification(journalSeed);
+    if (streaming_) queueCompleteSlabs();
     progress_ = std::make_unique<Progress>(opt_.progressBar, opt_.progressJson, bricks_.size());
     if (done_ + poisoned_ < bricks_.size()) {
       if (opt_.workers == 0 && opt_.listen.empty()) runInProcess();
@@ -277,6 +318,49 @@ class Master {
   }
 
  private:
+  // --verify (FarmOptions::verifyFraction): the sample's seed (the journal's on a resume, else the
+  // options', else a random one, written to the journal), whether two workers can be compared at
+  // all, and the bricks of the sample.
+  void setUpVerification(std::optional<uint64_t> journalSeed) {
+    report_.verifyFraction = opt_.verifyFraction;
+    if (opt_.verifyFraction < 0) return;
+    fraction_ = std::min(1.0, opt_.verifyFraction);
+    if (journalSeed) seed_ = *journalSeed;
+    else if (opt_.verifySeed) seed_ = opt_.verifySeed;
+    else {
+      std::random_device rd;
+      seed_ = (uint64_t(rd()) << 32 ^ rd()) | 1;
+    }
+    if (journal_ && !journalSeed) journal_->add(kJournalVerifySeed, &seed_, 8, crc32Of(&seed_, 8));
+    report_.verifySeed = seed_;
+    std::string unavailable;
+    if (opt_.workers == 0 && opt_.listen.empty())
+      unavailable = "--workers 0 computes in-process: there are no workers to compare";
+    else if (opt_.listen.empty() && localWorkerCount() == 1)
+      unavailable = "one local worker: there is no second worker to compute a brick again";
+    if (!unavailable.empty()) {
+      report_.verifyUnavailable = unavailable;
+      spdlog::warn("--verify cannot run: {}; the results are merged unchecked", unavailable);
+      return;
+    }
+    if (!opt_.listen.empty() && opt_.expectWorkers == 1)
+      spdlog::warn("--verify with --expect-workers 1: a checked brick waits for a second worker (up to {} s, then it "
+                   "is merged unchecked)", opt_.noWorkerTimeoutSec);
+    verifyOn_ = true;
+    for (Brick& b : bricks_)
+      if (b.phase != BrickPhase::Done) b.verify = verifySelected(jobId_, seed_, b.id, fraction_);
+  }
+
+  int localWorkerCount() const {
+    return opt_.workers > 0 ? opt_.workers : int(std::max(1u, std::thread::hardware_concurrency()));
+  }
+
+  uint32_t workerIndex(const std::string& workerId) {
+    auto [it, added] = workerIndex_.try_emplace(workerId, uint32_t(workerNames_.size()));
+    if (added) workerNames_.push_back(workerId);
+    return it->second;
+  }
+
   void plan() {
     const int b = opt_.brickVoxels;
     int n[3];
@@ -318,7 +402,10 @@ class Master {
   }
 
   // A brick's result is final: keep it (for "sample", `kept`; out's leaves are not kept), count it.
-  void commit(uint64_t id, BrickOutput&& out, const std::string& who, bool computed, KeptBrick&& kept = {}) {
+  // `verified`: two distinct workers returned its bytes. A tainted brick (uncommit) is only counted:
+  // its slab is the merge thread's, and its record is in the journal, which runJob merges again.
+  void commit(uint64_t id, BrickOutput&& out, const std::string& who, bool computed, KeptBrick&& kept = {},
+              bool verified = false) {
     Brick& b = bricks_[id];
     b.phase = BrickPhase::Done;
     for (auto& [rid, t] : b.holders)  // cancelled copies no longer take a worker's credit
@@ -326,11 +413,14 @@ class Master {
     b.holders.clear();
     leased_.erase(id);
     ++done_;
-    if (op_ == Operation::Sample) {
+    b.verified = verified;
+    b.mergedFrom = computed ? workerIndex(who) : kFromJournal;
+    if (verified) ++report_.verifiedBricks;
+    if (op_ == Operation::Sample && !std::exchange(b.tainted, false)) {
       report_.leaves += kept.origins.size();
       report_.tiles += kept.tiles.size();
       kept_[id] = std::move(kept);
-      if (streaming_ && --slabLeft_[id / perSlab_] == 0) queueCompleteSlabs();
+      if (streaming_ && --slabLeft_[id / perSlab_] == 0 && !replaying_) queueCompleteSlabs();
     }
     if (computed) {
       ++report_.bricksComputed;
@@ -349,6 +439,47 @@ class Master {
       share.pointEvals += out.stats.pointEvals;
     }
     if (op_ != Operation::Sample) outputs_[id] = std::move(out);
+  }
+
+  // Takes a merged brick back to be computed again (its worker was convicted of forging, or is
+  // under suspicion; or, replaying, the journal revokes it): a revocation goes to the journal, so
+  // a resume does not merge its record either. A "sample" brick whose slab was already handed to
+  // the merge thread cannot leave the stream: it is tainted (streamTainted_), computed again into
+  // the journal only, and runJob merges the whole job once more from the journal.
+  void uncommit(uint64_t id) {
+    Brick& b = bricks_[id];
+    if (b.phase != BrickPhase::Done) return;
+    if (journal_ && !replaying_) {
+      const uint64_t v = id;
+      journal_->add(kJournalRevoke, &v, 8, crc32Of(&v, 8));
+    }
+    b.phase = BrickPhase::Pending;
+    --done_;
+    if (b.mergedFrom == kFromJournal) {
+      if (report_.bricksFromJournal) --report_.bricksFromJournal;
+    } else {
+      --report_.bricksComputed;
+      auto& share = report_.perWorker[workerNames_[b.mergedFrom]];
+      if (share.bricks) --share.bricks;
+    }
+    if (b.verified && report_.verifiedBricks) --report_.verifiedBricks;
+    b.verified = false;
+    b.mergedFrom = kFromJournal;
+    if (op_ == Operation::Sample) {
+      if (streaming_ && id / perSlab_ < slabsQueued_) {
+        b.tainted = streamTainted_ = true;
+      } else {
+        report_.leaves -= kept_[id].origins.size();
+        report_.tiles -= kept_[id].tiles.size();
+        kept_[id] = KeptBrick{};
+        if (streaming_) ++slabLeft_[id / perSlab_];
+      }
+    } else {
+      outputs_[id] = BrickOutput{};
+    }
+    if (replaying_) return;  // still in pending_ from plan()
+    b.backupIssued = b.leaseReissued = false;
+    pending_.push_front(id);
   }
 
   void runInProcess() {
@@ -414,7 +545,7 @@ class Master {
     std::unique_ptr<LocalWorkers> local;
     int wanted = 0;
     if (opt_.listen.empty()) {
-      wanted = opt_.workers > 0 ? opt_.workers : int(std::max(1u, std::thread::hardware_concurrency()));
+      wanted = localWorkerCount();
       std::vector<std::string> args{"--connect", endpoint, "--threads", std::to_string(opt_.workerThreads),
                                     "--log-level", opt_.logLevel, "--master-timeout", "10"};
       if (!opt_.curveDir.empty()) args.insert(args.end(), {"--curve", opt_.curveDir});
@@ -498,6 +629,7 @@ class Master {
       reissueOverdue(now);
       dispatch(router, now);
       if (now - lastBeat >= hb) {
+        giveUpStarvedChecks(now);
         for (auto& [rid, p] : peers_) {
           Envelope e;
           e.set_job_id(jobId_);
@@ -565,7 +697,7 @@ class Master {
       if (bannedWorkers_.count(wid)) {
         ++report_.refused;
         Envelope r;
-        r.mutable_reject()->set_reason("worker " + wid + " was banned from this job: it failed bricks that other workers computed");
+        r.mutable_reject()->set_reason("worker " + wid + " was banned from this job: it failed bricks that other workers computed, or returned results other workers outvoted");
         send(router, in.routingId, r);
         return;
       }
@@ -726,6 +858,7 @@ class Master {
     a.workerId = p.workerId;
     a.result = std::move(*in.envelope.mutable_result());
     a.payload = std::move(*in.payload);
+    a.check = needsCheck(b, p);
     arrivalBytes_ += a.payload.size();
     arrivals_.push_back(std::move(a));
     if (arrivals_.size() >= kMaxArrivals || arrivalBytes_ >= kMaxArrivalBytes) verifyArrivals(router);
@@ -737,6 +870,11 @@ class Master {
   // output does not depend on that order anyway (outputs_ by brick, sorted in finish).
   void verifyArrivals(zmq::socket_t& router) {
     if (arrivals_.empty()) return;
+    // The first unchecked copy of a brick in the batch is journaled here, before the judge merges
+    // it (a copy not merged after all is revoked there); later copies and checked results (merged
+    // only once another worker agrees) are journaled by the judge if it merges them.
+    std::set<uint64_t> first;
+    for (Arrival& a : arrivals_) a.journaled = !a.check && first.insert(a.brick).second;
     decoders_.execute([&] {
       tbb::parallel_for(size_t(0), arrivals_.size(), [&](size_t i) {
         Arrival& a = arrivals_[i];
@@ -744,11 +882,10 @@ class Master {
         const size_t size = a.payload.size();
         const uint32_t crc = a.result.payload_crc32();
         a.ok = crc32Of(data, size) == crc && verifyPayload(data, size, bricks_[a.brick], a.out, a.kept, &a.error);
-        // Journaled before it is merged (judge); a copy that turns out to be a duplicate is
-        // harmless there (a resume merges the first record of a brick).
-        if (a.ok) journalAndKeep(a.brick, data, size, crc, a.kept);
-        if (a.ok && a.kept.inJournal) a.kept.received = HeldPayload::take(a.payload, heldBytes_, opt_.heldPayloadBytes);
-        a.payload = zmq::message_t();  // not held: freed now, the next message's buffer reuses its memory
+        a.journaled = a.journaled && a.ok;
+        if (a.journaled) keep(a);
+        // Not held: freed now, the next message's buffer reuses its memory.
+        if (!a.ok || a.journaled) a.payload = zmq::message_t();
       });
     });
     for (Arrival& a : arrivals_) judge(router, a);
@@ -756,17 +893,55 @@ class Master {
     arrivalBytes_ = 0;
   }
 
+  // Journals a verified payload and keeps it for the merge ("sample": the message itself while
+  // the held bytes allow, with a journal; a copy in the arena without one).
+  void keep(Arrival& a) {
+    journalAndKeep(a.brick, a.payload.data(), a.payload.size(), a.result.payload_crc32(), a.kept);
+    if (a.kept.inJournal) a.kept.received = HeldPayload::take(a.payload, heldBytes_, opt_.heldPayloadBytes);
+  }
+
+  // A copy journaled (verifyArrivals) that is not merged: void in the journal, so that a resume
+  // does not merge it either. Only the batch's first copy of a brick is journaled there, so the
+  // brick is not merged from another record now.
+  void revokeUnmerged(const Arrival& a) {
+    if (!a.journaled || !journal_) return;
+    const uint64_t v = a.brick;
+    journal_->add(kJournalRevoke, &v, 8, crc32Of(&v, 8));
+  }
+
+  // Whether a result of `b` from `p` is merged only once another worker returns the same bytes:
+  // with --verify, a brick of the sample, one already held, or any brick of a peer under
+  // suspicion (failures of it that other workers refuted).
+  bool needsCheck(const Brick& b, const Peer& p) const { return verifyOn_ && (b.verify || b.held || p.refuted > 0); }
+
+  // A result's counters (the worker's word: only the payload is checked) into its output.
+  static void countersOf(const Result& r, BrickOutput& out) {
+    out.stats.pointEvals = r.point_evals();
+    out.stats.intervalEvals = r.interval_evals();
+    out.stats.nanValues = r.nan_values();
+    out.extremumSearches = r.extremum_searches();
+    out.extremumUncertified = r.extremum_uncertified();
+    out.extremumSignDecided = r.extremum_sign_decided();
+    // A peer's gap only widens what the report admits (never a NaN, never below 0).
+    out.extremumWidestGap = r.extremum_widest_gap() >= 0 ? r.extremum_widest_gap() : INFINITY;
+    for (int k = 0; k < r.domain_errors_size() && k < int(kDomainErrorKinds); ++k)
+      out.stats.domainErrors.n[k] = r.domain_errors(k);
+  }
+
   void judge(zmq::socket_t& router, Arrival& a) {
     Brick& b = bricks_[a.brick];
     const uint64_t id = a.brick;
-    if (banned_.count(a.routingId)) {
-      // Its sender was dropped for garbage after sending it (an earlier result of this batch):
-      // ignored, as a message received after the ban would have been; the brick goes back.
+    if (banned_.count(a.routingId) || bannedWorkers_.count(a.workerId)) {
+      // Its sender was dropped (garbage, or convicted) after sending it (an earlier result of
+      // this batch): ignored, as a message received after the ban would have been; the brick
+      // goes back.
+      revokeUnmerged(a);
       if (b.phase == BrickPhase::Leased && b.holders.empty()) requeue(b, "worker " + a.workerId + " dropped", false);
       return;
     }
     if (b.phase == BrickPhase::Done || b.phase == BrickPhase::Poisoned) {
       ++report_.duplicates;  // another copy of this batch was merged first
+      if (b.phase == BrickPhase::Poisoned) revokeUnmerged(a);
       return;
     }
     if (!a.ok) {
@@ -782,25 +957,29 @@ class Master {
     }
     const Result& r = a.result;
     BrickOutput& out = a.out;
-    out.stats.pointEvals = r.point_evals();
-    out.stats.intervalEvals = r.interval_evals();
-    out.stats.nanValues = r.nan_values();
-    out.extremumSearches = r.extremum_searches();
-    out.extremumUncertified = r.extremum_uncertified();
-    out.extremumSignDecided = r.extremum_sign_decided();
-    // A peer's gap only widens what the report admits (never a NaN, never below 0).
-    out.extremumWidestGap = r.extremum_widest_gap() >= 0 ? r.extremum_widest_gap() : INFINITY;
-    for (int k = 0; k < r.domain_errors_size() && k < int(kDomainErrorKinds); ++k)
-      out.stats.domainErrors.n[k] = r.domain_errors(k);
+    countersOf(r, out);
     report_.perWorker[a.workerId].computeSeconds += r.compute_seconds();
     brickSeconds_.push_back(r.compute_seconds());
+    auto sender = peers_.find(a.routingId);
+    if (!a.check && sender != peers_.end() && needsCheck(b, sender->second)) {
+      // The brick must be checked since this copy arrived (its sender came under suspicion, or
+      // another copy of the batch was held), and this copy was journaled unchecked and its bytes
+      // let go: taken back (uncharged); the brick is computed again and checked.
+      revokeUnmerged(a);
+      b.verify = true;
+      if (b.held) awaitAnotherWorker(b);
+      else if (b.holders.empty()) requeue(b, "it is to be checked: computed again", false);
+      return;
+    }
+    if (a.check && !decide(router, a)) return;  // held until another worker agrees (or poisoned)
+    if (!a.journaled && (journal_ || op_ == Operation::Sample)) keep(a);  // checked, or a later copy of the batch
     // Other holders (straggler backups) may drop the brick.
     for (auto& [rid, t] : b.holders) {
       Envelope c;
       c.mutable_cancel()->set_brick_id(id);
       send(router, rid, c);
     }
-    commit(id, std::move(out), a.workerId, true, std::move(a.kept));
+    commit(id, std::move(out), a.workerId, true, std::move(a.kept), a.check);
     // Every other worker that failed this brick was refuted: the computation is deterministic.
     for (const std::string& w : std::vector<std::string>(b.failedBy.begin(), b.failedBy.end()))
       if (w != a.workerId) refute(router, w, id);
@@ -810,27 +989,46 @@ class Master {
   // kBanAfterRefuted times and more than twice the lower median of the other peers' refuted
   // failures fails what others compute: it is banned (told bye, its worker id refused, its
   // failures no longer count against any brick). Honest workers are almost never refuted, and a
-  // model that fails everywhere refutes no one (no one computes its bricks).
+  // model that fails everywhere refutes no one (no one computes its bricks). With --verify, a
+  // refuted worker is under suspicion: every result of it is checked from now on, and the
+  // bricks of it merged unchecked are computed again (recheckSuspect).
   void refute(zmq::socket_t& router, const std::string& workerId, uint64_t id) {
     ++report_.refutedFailures;
     auto it = std::find_if(peers_.begin(), peers_.end(), [&](auto& kv) { return kv.second.workerId == workerId; });
     if (it == peers_.end()) return;  // gone already
     Peer& p = it->second;
-    ++p.refuted;
+    if (++p.refuted == 1 && verifyOn_) recheckSuspect(workerId);
     std::vector<uint64_t> others;
     for (auto& [rid, q] : peers_)
       if (&q != &p) others.push_back(q.refuted);
     std::sort(others.begin(), others.end());
     const uint64_t median = others.empty() ? 0 : others[(others.size() - 1) / 2];
     if (p.refuted < kBanAfterRefuted || p.refuted <= 2 * median) return;
-    const std::string rid = it->first;
     spdlog::warn("worker {} banned: {} of its {} failures were computed by other workers (brick {} last)", workerId,
                  p.refuted, p.failures, id);
     ++report_.failingPeersBanned;
-    // Its failures no longer count against the bricks: it was wrong about those others did.
-    for (uint64_t f : p.failedBricks) {
-      Brick& b = bricks_[f];
-      if (b.failedBy.erase(workerId) && b.failures > 0) --b.failures;
+    banWorker(router, workerId, "it failed " + std::to_string(p.refuted) + " bricks that other workers computed");
+  }
+
+  // Bans a worker id for the rest of the job: its failures and its held results no longer count
+  // against or for any brick, its worker id is refused when it says hello again (bounded list),
+  // and if it is connected it is told bye and its bricks go back to the queue uncharged.
+  void banWorker(zmq::socket_t& router, const std::string& workerId, const std::string& why) {
+    auto it = std::find_if(peers_.begin(), peers_.end(), [&](auto& kv) { return kv.second.workerId == workerId; });
+    if (it != peers_.end())
+      for (uint64_t f : it->second.failedBricks) {
+        Brick& b = bricks_[f];
+        if (b.failedBy.erase(workerId) && b.failures > 0) --b.failures;
+      }
+    for (auto v = verifying_.begin(); v != verifying_.end();) {
+      auto& ops = v->second.opinions;
+      ops.erase(std::remove_if(ops.begin(), ops.end(), [&](const Opinion& o) { return o.workerId == workerId; }), ops.end());
+      if (!ops.empty()) {
+        ++v;
+        continue;
+      }
+      bricks_[v->first].held = false;
+      v = verifying_.erase(v);
     }
     if (bannedWorkers_.insert(workerId).second) {
       bannedWorkerOrder_.push_back(workerId);
@@ -839,7 +1037,172 @@ class Master {
         bannedWorkerOrder_.pop_front();
       }
     }
-    ban(router, rid, "it failed " + std::to_string(p.refuted) + " bricks that other workers computed");
+    if (it != peers_.end()) ban(router, it->first, why);
+  }
+
+  // ---- verification (--verify) -----------------------------------------------------------------
+
+  // Whether `workerId` returned one of the results of `b` held now (it may not compute b again).
+  bool holdsOpinion(const Brick& b, const std::string& workerId) const {
+    if (!b.held) return false;
+    auto v = verifying_.find(b.id);
+    return v != verifying_.end() && std::any_of(v->second.opinions.begin(), v->second.opinions.end(),
+                                                [&](const Opinion& o) { return o.workerId == workerId; });
+  }
+
+  // A brick whose result is held waits for another worker: back to the front of the queue (unless
+  // a backup copy is still leased).
+  void awaitAnotherWorker(Brick& b) {
+    if (!b.holders.empty()) return;
+    leased_.erase(b.id);
+    b.phase = BrickPhase::Pending;
+    b.backupIssued = b.leaseReissued = false;
+    pending_.push_front(b.id);
+  }
+
+  // A checked result (CRC and codec verified): true when it is to be merged now, that is when it
+  // has the same bytes as a held result of another worker (a majority of two: the workers whose
+  // held results differ are convicted). Otherwise it is held, and the brick goes to a worker that
+  // returned none of the held results; kMaxOpinions different results poison the brick.
+  bool decide(zmq::socket_t& router, Arrival& a) {
+    Brick& b = bricks_[a.brick];
+    Verification& v = verifying_[a.brick];
+    auto same = [&](const Opinion& o) {
+      return o.bytes.size() == a.payload.size() && std::memcmp(o.bytes.data(), a.payload.data(), a.payload.size()) == 0;
+    };
+    for (const Opinion& o : v.opinions)
+      if (o.workerId == a.workerId) {  // its own result again (a copy it was leased before): not a second opinion
+        ++report_.duplicates;
+        awaitAnotherWorker(b);
+        return false;
+      }
+    auto match = std::find_if(v.opinions.begin(), v.opinions.end(), same);
+    if (match != v.opinions.end()) {
+      const std::string agreed = match->workerId + " and " + a.workerId;
+      std::vector<std::string> outvoted;
+      for (const Opinion& o : v.opinions)
+        if (&o != &*match) outvoted.push_back(o.workerId);
+      verifying_.erase(a.brick);
+      b.held = false;
+      for (const std::string& w : outvoted) convict(router, w, a.brick, agreed);
+      return true;
+    }
+    std::string others;
+    for (const Opinion& o : v.opinions) others += (others.empty() ? "" : ", ") + o.workerId;
+    if (!v.opinions.empty()) {
+      ++report_.verifyMismatches;
+      spdlog::warn("brick {}: the result of worker {} differs from that of {}: another worker decides", a.brick,
+                   a.workerId, others);
+    }
+    if (v.opinions.size() + 1 >= kMaxOpinions) {
+      verifying_.erase(a.brick);
+      b.held = false;
+      leased_.erase(b.id);
+      poison(b,
+             "workers " + others + " and " + a.workerId + " returned " + std::to_string(kMaxOpinions) +
+                 " different results: the computation is not deterministic across them (other builds or machines?)",
+             std::to_string(kMaxOpinions) + " different results");
+      return false;
+    }
+    v.opinions.push_back(Opinion{a.workerId, a.result, std::move(a.payload)});
+    v.starved = false;
+    b.held = true;
+    awaitAnotherWorker(b);
+    return false;
+  }
+
+  // Worker `workerId` was outvoted on `brick` (`agreed` returned the same other bytes): it lied
+  // (or its machine computes differently). Banned; every brick it returned that was merged
+  // unchecked is computed again by the others.
+  void convict(zmq::socket_t& router, const std::string& workerId, uint64_t brick, const std::string& agreed) {
+    ++report_.liarsBanned;
+    banWorker(router, workerId, "its result for brick " + std::to_string(brick) + " differs from what workers " + agreed +
+                                    " computed");
+    const uint64_t redone = takeBackUnchecked(workerId, true);
+    report_.bricksRedone += redone;
+    spdlog::warn("worker {} banned: its result for brick {} differs from the one workers {} returned; {} brick(s) it "
+                 "returned unchecked are computed again",
+                 workerId, brick, agreed, redone);
+  }
+
+  // A worker under suspicion (its first refuted failure): the bricks of it merged unchecked are
+  // computed again and checked, those that can still leave the output (a streamed slab stays).
+  void recheckSuspect(const std::string& workerId) {
+    const uint64_t n = takeBackUnchecked(workerId, false);
+    report_.bricksRedone += n;
+    if (n)
+      spdlog::warn("worker {} is under suspicion (a failure of it was refuted): its {} brick(s) merged unchecked are "
+                   "computed again and checked",
+                   workerId, n);
+  }
+
+  // Uncommits the bricks merged unchecked from `workerId`'s results; `evenStreamed`: also those
+  // whose slab was handed to the merge thread (tainted). Returns how many.
+  uint64_t takeBackUnchecked(const std::string& workerId, bool evenStreamed) {
+    auto w = workerIndex_.find(workerId);
+    if (w == workerIndex_.end()) return 0;
+    uint64_t n = 0;
+    for (Brick& x : bricks_) {
+      if (x.phase != BrickPhase::Done || x.verified || x.mergedFrom != w->second) continue;
+      if (!evenStreamed && streaming_ && x.id / perSlab_ < slabsQueued_) continue;
+      uncommit(x.id);
+      if (!evenStreamed) x.verify = true;
+      ++n;
+    }
+    return n;
+  }
+
+  // Checked bricks held while no connected worker can give them another result (every one
+  // returned one of the held results): after FarmOptions::noWorkerTimeoutSec, a brick with one
+  // result is merged unchecked (verification cannot run: reported), one with different results
+  // is poisoned (no majority).
+  void giveUpStarvedChecks(Clock::time_point now) {
+    std::vector<uint64_t> due;
+    for (auto& [id, v] : verifying_) {
+      const Brick& b = bricks_[id];
+      bool someone = b.phase != BrickPhase::Pending;
+      for (auto p = peers_.begin(); !someone && p != peers_.end(); ++p)
+        someone = !p->second.unreachable && !holdsOpinion(b, p->second.workerId);
+      if (someone) {
+        v.starved = false;
+      } else if (!v.starved) {
+        v.starved = true;
+        v.starvedSince = now;
+      } else if (now - v.starvedSince > std::chrono::seconds(opt_.noWorkerTimeoutSec)) {
+        due.push_back(id);
+      }
+    }
+    for (uint64_t id : due) {
+      Brick& b = bricks_[id];
+      Verification v = std::move(verifying_[id]);
+      verifying_.erase(id);
+      b.held = false;
+      std::string who;
+      for (const Opinion& o : v.opinions) who += (who.empty() ? "" : ", ") + o.workerId;
+      if (v.opinions.size() > 1) {
+        poison(b, "workers " + who + " returned different results and no other worker joined within " +
+                      std::to_string(opt_.noWorkerTimeoutSec) + " s to decide",
+               std::to_string(v.opinions.size()) + " different results");
+        continue;
+      }
+      Opinion& o = v.opinions[0];
+      Arrival a;
+      a.brick = id;
+      a.workerId = o.workerId;
+      a.result = o.result;
+      a.payload = std::move(o.bytes);
+      if (!verifyPayload(a.payload.data(), a.payload.size(), b, a.out, a.kept, &a.error))
+        throw std::logic_error("brick " + std::to_string(id) + ": a held result no longer verifies: " + a.error);
+      countersOf(a.result, a.out);
+      keep(a);
+      ++report_.unverifiedBricks;
+      if (report_.verifyUnavailable.empty()) {
+        report_.verifyUnavailable = "no second worker was connected for " + std::to_string(opt_.noWorkerTimeoutSec) +
+                                    " s: bricks merged unchecked";
+        spdlog::warn("--verify cannot run: {} (brick {} first, from worker {})", report_.verifyUnavailable, id, who);
+      }
+      commit(id, std::move(a.out), a.workerId, true, std::move(a.kept));
+    }
   }
 
   // A verified payload: appended to the journal if there is one, and for "sample" kept until
@@ -914,6 +1277,7 @@ class Master {
   }
 
   void poison(Brick& b, const std::string& why, const std::string& count) {
+    if (std::exchange(b.held, false)) verifying_.erase(b.id);
     b.phase = BrickPhase::Poisoned;
     ++poisoned_;
     report_.poisoned.push_back(PoisonedBrick{b.id, b.lo, b.hi, why});
@@ -1073,6 +1437,7 @@ class Master {
   // no-worker timeout for one that has computed none (a peer that fails everything must not
   // poison bricks before an honest worker joins).
   bool mayTake(const Peer& cand, const Brick& b, Clock::time_point now) const {
+    if (holdsOpinion(b, cand.workerId)) return false;  // a checked brick goes to another worker, however long it waits
     if (!b.failedBy.count(cand.workerId)) return true;
     for (auto& [rid, q] : peers_)
       if (&q != &cand && !q.unreachable && !b.failedBy.count(q.workerId)) return false;
@@ -1127,7 +1492,9 @@ class Master {
           uint64_t id = reissue_.front();
           reissue_.pop_front();
           if (bricks_[id].phase != BrickPhase::Leased || bricks_[id].holders.count(rid)) continue;
-          if ((bricks_[id].suspect && !isolates) || bricks_[id].failedBy.count(cand.workerId)) notHere.push_back(id);
+          if ((bricks_[id].suspect && !isolates) || bricks_[id].failedBy.count(cand.workerId) ||
+              holdsOpinion(bricks_[id], cand.workerId))
+            notHere.push_back(id);
           else next = id;
         }
         reissue_.insert(reissue_.begin(), notHere.begin(), notHere.end());
@@ -1144,7 +1511,7 @@ class Master {
       Brick* oldest = nullptr;
       for (uint64_t id : leased_)
         if (Brick& b = bricks_[id]; !b.backupIssued && !b.suspect && !b.holders.count(rid) &&
-            !b.failedBy.count(it->second.workerId) &&
+            !b.failedBy.count(it->second.workerId) && !holdsOpinion(b, it->second.workerId) &&
             std::chrono::duration<double>(now - b.firstLease).count() > threshold &&
             (!oldest || b.firstLease < oldest->firstLease))
           oldest = &b;
@@ -1334,6 +1701,10 @@ class Master {
 
   FarmOutcome finish() {
     FarmOutcome o;
+    // Bricks of a convicted worker were in slabs already streamed: the journal holds the job as
+    // it must be; runJob merges it once more from there (a job that did not complete writes
+    // nothing anyway, and its journal is right for --resume).
+    report_.restreamed = streamTainted_ && done_ == bricks_.size() && !report_.interrupted;
     report_.operation = op_ == Operation::Mesh ? "mesh" : op_ == Operation::Render ? "render" : "sample";
     if (op_ == Operation::Render && done_ == bricks_.size()) {
       // The merge step of a render job: each tile's hits to their pixels (split-invariant, as
@@ -1417,6 +1788,17 @@ class Master {
   std::atomic<bool> mergeFailed_{false};
   std::vector<Tile> streamedTiles_;
   std::map<std::string, Peer> peers_;
+  // Verification (--verify): on (two workers can be compared), the fraction and seed of the
+  // sample, the held results of the bricks under verification, the workers whose results were
+  // merged (Brick::mergedFrom), the journal being replayed, a convicted worker's brick streamed.
+  bool verifyOn_ = false;
+  double fraction_ = 0;
+  uint64_t seed_ = 0;
+  std::map<uint64_t, Verification> verifying_;
+  std::vector<std::string> workerNames_;
+  std::map<std::string, uint32_t> workerIndex_;
+  bool replaying_ = false;
+  bool streamTainted_ = false;
   std::vector<double> brickSeconds_;
   double median_ = 0;    // medianBrickSeconds() of the first medianOf_ entries
   size_t medianOf_ = 0;
@@ -1476,6 +1858,17 @@ std::string FarmReport::toJson() const {
                  {"banned_peers", bannedPeers},  {"suspect_bricks", suspectBricks},
                  {"reconnects", reconnects},     {"master_stalls", masterStalls},
                  {"refuted_failures", refutedFailures}, {"failing_peers_banned", failingPeersBanned}};
+  char seed[17];
+  std::snprintf(seed, sizeof seed, "%016llx", static_cast<unsigned long long>(verifySeed));
+  j["verification"] = {{"fraction", verifyFraction >= 0 ? nlohmann::json(verifyFraction) : nlohmann::json()},
+                       {"seed", verifyFraction >= 0 ? nlohmann::json(seed) : nlohmann::json()},
+                       {"verified_bricks", verifiedBricks},
+                       {"verify_mismatches", verifyMismatches},
+                       {"liars_banned", liarsBanned},
+                       {"bricks_redone", bricksRedone},
+                       {"unverified_bricks", unverifiedBricks},
+                       {"unavailable", verifyUnavailable.empty() ? nlohmann::json() : nlohmann::json(verifyUnavailable)},
+                       {"restreamed", restreamed}};
   j["workers_seen"] = workersSeen;
   nlohmann::json w = nlohmann::json::object();
   for (auto& [id, s] : perWorker)
@@ -1492,7 +1885,57 @@ std::string FarmReport::toJson() const {
   return j.dump(2);
 }
 
-FarmOutcome runJob(const JobSpec& job, const FarmOptions& options) { return Master(job, options).run(); }
+FarmOutcome runJob(const JobSpec& job, const FarmOptions& options) {
+  FarmOutcome first = Master(job, options).run();
+  if (!first.report.restreamed) return first;
+  // A convicted worker's bricks were in slabs the sink already had: its results must not stay in
+  // the output. The journal holds the job as it must be (their records revoked, computed again):
+  // the sink starts over and the job is merged once more from the journal, in-process should a
+  // brick be missing there (none is).
+  if (!options.sampleSink.restart || options.journalPath.empty())
+    throw std::runtime_error("a worker convicted of forging results had bricks in slabs already streamed, and the stream "
+                             "cannot be restarted (it needs SampleSink::restart and a journal)");
+  spdlog::warn("a worker convicted of forging results had bricks in slabs already written: merging the whole job again "
+               "from the journal");
+  options.sampleSink.restart();
+  FarmOptions again = options;
+  again.resume = true;
+  again.workers = 0;
+  again.listen.clear();
+  again.verifyFraction = -1;
+  again.progressBar = again.progressJson = false;
+  again.onListening = nullptr;
+  FarmOutcome second = Master(job, again).run();
+  if (second.report.bricksFromJournal != second.report.bricks)
+    spdlog::warn("{} brick(s) were missing from the journal and computed in-process",
+                 second.report.bricks - second.report.bricksFromJournal);
+  FarmReport r = first.report;  // the job's counters; the output's from the second merge
+  r.leaves = second.report.leaves;
+  r.tiles = second.report.tiles;
+  r.wallSeconds += second.report.wallSeconds;
+  r.peakRssBytes = std::max(r.peakRssBytes, second.report.peakRssBytes);
+  r.poisoned = second.report.poisoned;
+  r.interrupted = second.report.interrupted;
+  second.result.stats = first.result.stats;
+  second.report = std::move(r);
+  return second;
+}
+
+namespace {
+uint64_t mix64(uint64_t z) {  // splitmix64's finalizer
+  z += 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+}  // namespace
+
+bool verifySelected(uint64_t jobId, uint64_t seed, uint64_t brick, double fraction) {
+  if (fraction >= 1) return true;
+  if (!(fraction > 0)) return false;
+  const uint64_t h = mix64(mix64(jobId ^ mix64(seed)) ^ brick);
+  return double(h >> 11) * 0x1.0p-53 < fraction;
+}
 
 bool isLoopbackEndpoint(const std::string& endpoint) {
   if (endpoint.rfind("tcp://", 0) != 0) return false;

@@ -33,10 +33,22 @@ namespace frep::farm {
 // first one it did not complete: result.leaves holds the merged leaves of the others
 // (result.tiles always holds every tile, sorted). A piece is one of a few buffers (one per merge
 // thread), refilled: read it during the call and keep nothing that points into it.
+// `restart` (optional): forget everything handed over so far; the slabs are handed over again
+// from the first. runJob calls it, then merges the whole job once more from the journal, when a
+// worker convicted of forging (FarmOptions::verifyFraction) had bricks in slabs already handed
+// over: its bricks are recomputed and the output must not keep its values. Without `restart` (or
+// without a journal) such a job throws std::runtime_error instead of returning a forged output.
 struct SampleSink {
   std::function<void(const std::vector<Tile>& tiles)> tiles;  // optional
   std::function<void(const std::vector<LeafBlock>& leaves)> leaves;
+  std::function<void()> restart;  // optional
 };
+
+// Whether brick `brick` of job `jobId` is in the verification sample of `fraction` drawn with
+// `seed` (FarmOptions::verifyFraction, verifySeed): a pseudo-random choice, the same for the same
+// job, seed and brick (a resumed job checks the same bricks). fraction >= 1: every brick; <= 0:
+// none.
+bool verifySelected(uint64_t jobId, uint64_t seed, uint64_t brick, double fraction);
 
 // The leaves of a SampleSink::leaves call (but a slab's last): ~0.5 MB, decoded into a buffer
 // that stays in the core's cache while the sink reads it (a whole slab's buffer, ~70 MB for a
@@ -72,6 +84,15 @@ struct FarmOptions {
   int decodeThreads = 0;         // farm: threads verifying and decoding results (0: defaultDecodeThreads(); 1: the loop's own)
                                  // (streaming a sample: as many again merge its slabs, on their own thread)
   std::string logLevel = "warn"; // local mode: workers' --log-level
+  // Verification (docs/farm.md, "Verification"): < 0 off. Otherwise the fraction (0..1) of the
+  // bricks, chosen by verifySelected, whose result is merged only once two distinct workers
+  // returned the same bytes; every result of a peer under suspicion (refuted failures) is
+  // checked too, even with 0. A mismatch goes to a third worker; the workers outvoted are banned
+  // and every brick they returned unchecked is recomputed. 1: no single worker changes a result.
+  double verifyFraction = -1;
+  // The sample's seed, mixed with the job id; 0: a random one, written to the journal so that a
+  // resumed job checks the same bricks (a worker knows the job id, not the seed). Tests set it.
+  uint64_t verifySeed = 0;
   SampleSink sampleSink;         // "sample": stream the merged output (see SampleSink)
   // Called once the master is bound, with the actual endpoint (tcp://127.0.0.1:* picks a free
   // port): tests and embedders start their workers from it.
@@ -116,6 +137,16 @@ struct FarmReport {
   uint64_t bannedPeers = 0;     // peers dropped for garbage or failing peers (their bricks not charged)
   uint64_t refutedFailures = 0;     // failures of a brick that another worker then computed
   uint64_t failingPeersBanned = 0;  // peers banned for them (docs/farm.md, "Failing peers")
+  // Verification (FarmOptions::verifyFraction; "verification" in the JSON):
+  double verifyFraction = -1;     // as asked (< 0: off)
+  uint64_t verifySeed = 0;        // the sample's seed (from the journal on a resume)
+  uint64_t verifiedBricks = 0;    // merged once two distinct workers returned the same bytes
+  uint64_t verifyMismatches = 0;  // results that differed from another worker's for the brick
+  uint64_t liarsBanned = 0;       // workers outvoted on a brick: banned
+  uint64_t bricksRedone = 0;      // merged bricks of theirs (or of suspects) recomputed
+  uint64_t unverifiedBricks = 0;  // selected, merged unchecked: no second worker to check them
+  std::string verifyUnavailable;  // why verification could not run ("" when it could)
+  bool restreamed = false;        // "sample" streamed: merged once more from the journal (SampleSink::restart)
   uint64_t suspectBricks = 0;   // bricks whose worker died computing them (then retried alone)
   uint64_t reconnects = 0;      // workers back under a new connection, leases kept
   uint64_t masterStalls = 0;    // the master's own loop stopped longer than the liveness window

@@ -17,6 +17,15 @@ namespace frep::farm {
 // one longer than what remains of the file: the record and everything after it are dropped.
 constexpr uint64_t kMaxJournalRecord = uint64_t(256) << 20;
 
+// Records whose "brick" is one of these are not bricks (a master of an older release ignores
+// them, as any id beyond its bricks). kJournalRevoke, payload a u64 brick id: the records of that
+// brick before it are void (its worker was convicted of forging, or the record was never
+// merged); a replay forgets the brick and merges the brick's next record, if any.
+// kJournalVerifySeed, payload a u64: the verification sample's seed (FarmOptions::verifySeed),
+// so that a resumed job checks the same bricks.
+constexpr uint64_t kJournalRevoke = ~uint64_t(0);
+constexpr uint64_t kJournalVerifySeed = ~uint64_t(0) - 1;
+
 // The journal's file cannot be opened, written or truncated (a full disk, EFBIG, EIO): an I/O
 // error (frep exit 3), not a farm error.
 struct JournalIoError : std::runtime_error {
