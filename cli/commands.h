@@ -62,6 +62,8 @@ struct FarmRequest {
   bool strict = false;       // --strict: uncertified extremum searches fail the job (exit 8)
   std::string curveDir;
   bool insecure = false;     // --listen on the network without --curve
+  std::string verify;        // --verify F: the fraction of bricks checked on a second worker ("" = off)
+  int replicate = 1;         // --replicate 2: every brick checked (= --verify 1)
 };
 
 struct SampleRequest {

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <algorithm>
 #include <bitset>
 #include <fstream>
@@ -102,7 +103,18 @@ farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, cons
     throw badArgs("--listen " + f.listen +
                   ": without --curve anyone who can reach this address can join the farm and forge results; add "
                   "--curve DIR (see frep keygen) or, on a trusted network, --insecure");
+  requireRange("--replicate", f.replicate, 1, 2, " (2: every brick computed by two workers, as --verify 1)");
+  double verify = -1;
+  if (!f.verify.empty()) {
+    char* end = nullptr;
+    verify = std::strtod(f.verify.c_str(), &end);
+    if (end == f.verify.c_str() || *end != '\0' || !(verify >= 0 && verify <= 1))  // NaN fails too
+      throw badArgs("--verify: expected the fraction of bricks to check, a number from 0 to 1, got '" + f.verify + "'");
+  }
+  if (f.replicate == 2 && verify >= 0 && verify != 1)
+    throw badArgs("--replicate 2 checks every brick (it is --verify 1), but --verify " + f.verify + " was given too");
   farm::FarmOptions o;
+  o.verifyFraction = f.replicate == 2 ? 1.0 : verify;
   o.workers = f.workers;
   o.listen = f.listen;
   o.expectWorkers = f.expectWorkers;
@@ -240,7 +252,16 @@ std::string bricksSummary(const farm::FarmReport& report) {
   return "bricks " + std::to_string(report.bricks) + " (" + std::to_string(report.bricksComputed) + " computed, " +
          std::to_string(report.bricksFromJournal) + " from the journal), workers " +
          std::to_string(report.workersSeen) + ", retries " + std::to_string(report.retries) + ", " +
-         formatNumber(std::round(report.wallSeconds * 1000) / 1000) + " s";
+         formatNumber(std::round(report.wallSeconds * 1000) / 1000) + " s" + verificationSummary(report);
+}
+
+std::string verificationSummary(const farm::FarmReport& report) {
+  if (report.verifyFraction < 0) return "";
+  if (!report.verifyUnavailable.empty() && report.verifiedBricks == 0)
+    return "; not verified (" + report.verifyUnavailable + ")";
+  return "; verified " + std::to_string(report.verifiedBricks) + " (mismatches " +
+         std::to_string(report.verifyMismatches) + ", workers banned for them " + std::to_string(report.liarsBanned) +
+         ", bricks recomputed " + std::to_string(report.bricksRedone) + ")";
 }
 
 }  // namespace frep::cli

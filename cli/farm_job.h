@@ -65,5 +65,7 @@ void requireComplete(const farm::FarmReport& report);
 
 // "bricks N (C computed, J from the journal), workers W, retries R, T s" for the summary.
 std::string bricksSummary(const farm::FarmReport& report);
+// "; verified V (mismatches M, workers banned for them L, bricks recomputed R)" with --verify, else "".
+std::string verificationSummary(const farm::FarmReport& report);
 
 }  // namespace frep::cli

@@ -69,6 +69,13 @@ void addFarmOptions(CLI::App* sub, FarmRequest& f) {
   sub->add_option("--curve", f.curveDir, "Require CURVE keys from DIR (see frep keygen)");
   sub->add_flag("--insecure", f.insecure,
                 "Allow --listen on a non-loopback address without --curve (anyone who reaches it can join)");
+  sub->add_option("--verify", f.verify,
+                  "Compute a fraction F (0 to 1) of the bricks, and every brick of a worker under suspicion, again "
+                  "on another worker and merge them only if the bytes agree; a worker outvoted is banned and its "
+                  "bricks recomputed (default: off)");
+  sub->add_option("--replicate", f.replicate,
+                  "2: every brick computed by two workers and merged only if they agree (= --verify 1); 1: once "
+                  "(default)");
 }
 
 void checkObjectIsNotAFile(const ModelRequest& m) {

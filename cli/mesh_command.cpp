@@ -56,8 +56,8 @@ int runMeshVdb(const MeshRequest& request) {
   if (request.tolerance > 0 || request.noSharp)
     throw badArgs("--tolerance/--no-sharp: simplification checks every change against the model; a .vdb has none");
   if (!request.farm.listen.empty() || request.farm.expectWorkers != 0 || request.farm.resume ||
-      !request.farm.curveDir.empty())
-    throw badArgs("--listen/--expect-workers/--resume/--curve: a .vdb is meshed in-process (use --threads)");
+      !request.farm.curveDir.empty() || !request.farm.verify.empty() || request.farm.replicate != 1)
+    throw badArgs("--listen/--expect-workers/--resume/--curve/--verify/--replicate: a .vdb is meshed in-process (use --threads)");
 
   openMeshOutputFiles(outputs);
   const auto start = std::chrono::steady_clock::now();

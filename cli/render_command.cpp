@@ -264,6 +264,7 @@ int runRender(const RenderRequest& r) {
   uint64_t intervals = 0, points = 0, bricks = 0;
   size_t hitPixels = 0;
   int workersSeen = 0;
+  farm::FarmReport checks;  // --verify's counters over every job
   double farmSeconds = 0, pixelStep = 0;
   for (int k = 0; k < frames; ++k) {
     const double azimuth = r.azimuth + (r.frames > 0 ? 360.0 * k / r.frames : 0.0);
@@ -285,6 +286,12 @@ int runRender(const RenderRequest& r) {
           intervals += outcome.report.intervalEvals, points += outcome.report.pointEvals;
           bricks += outcome.report.bricks, farmSeconds += outcome.report.wallSeconds;
           workersSeen = std::max(workersSeen, outcome.report.workersSeen);
+          checks.verifyFraction = outcome.report.verifyFraction;  // --verify: summed over the cells and frames
+          checks.verifiedBricks += outcome.report.verifiedBricks;
+          checks.verifyMismatches += outcome.report.verifyMismatches;
+          checks.liarsBanned += outcome.report.liarsBanned;
+          checks.bricksRedone += outcome.report.bricksRedone;
+          if (checks.verifyUnavailable.empty()) checks.verifyUnavailable = outcome.report.verifyUnavailable;
         } else {
           depth.width = w, depth.height = h, depth.hits.assign(size_t(w) * size_t(h), RayHit{});
         }
@@ -308,7 +315,7 @@ int runRender(const RenderRequest& r) {
             << ", pixel " << formatNumber(pixelStep) << (r.perspective ? " (tangent units)" : "") << ", "
             << hitPixels << " on the solid; " << intervals << " interval and " << points << " point evaluations; "
             << bricks << " tiles on " << (options.workers == 0 && options.listen.empty() ? "the master (in-process)" : std::to_string(workersSeen) + (workersSeen == 1 ? " worker" : " workers"))
-            << " in " << formatNumber(std::round(farmSeconds * 1000) / 1000) << " s\n";
+            << " in " << formatNumber(std::round(farmSeconds * 1000) / 1000) << " s" << verificationSummary(checks) << "\n";
   return kExitOk;
 }
 

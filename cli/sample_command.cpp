@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include "allocator_tuning.h"
 #include "arg_parse.h"
@@ -91,10 +92,16 @@ int runSample(const SampleRequest& request) {
                grid.dims[2], grid.voxel);
   // The merge streams into the grid slab by slab as the slabs complete (the master never holds
   // the whole sample and the tree at once); a job that does not complete writes nothing (what it
-  // streamed is dropped with the builder).
-  io::LevelSetBuilder builder(farm::gridOf(job), request.band);  // the lattice the master merges on
-  options.sampleSink.tiles = [&](const std::vector<Tile>& tiles) { builder.addTiles(tiles); };
-  options.sampleSink.leaves = [&](const std::vector<LeafBlock>& slab) { builder.addLeaves(slab); };
+  // streamed is dropped with the builder). With --verify, a worker convicted of forging after its
+  // bricks were streamed restarts the stream (a new builder; the master merges from the journal).
+  std::optional<io::LevelSetBuilder> builder;
+  builder.emplace(farm::gridOf(job), request.band);  // the lattice the master merges on
+  options.sampleSink.tiles = [&](const std::vector<Tile>& tiles) { builder->addTiles(tiles); };
+  options.sampleSink.leaves = [&](const std::vector<LeafBlock>& slab) { builder->addLeaves(slab); };
+  options.sampleSink.restart = [&] {
+    builder.reset();  // its memory first
+    builder.emplace(farm::gridOf(job), request.band);
+  };
   jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
   farm::FarmReport& report = outcome.report;
@@ -110,7 +117,7 @@ int runSample(const SampleRequest& request) {
   meta.sourceHash = m.model.sourceHash;
   meta.iso = request.model.iso;
   jsonPhase("write");  // with the signed distance (levelSetRebuild) unless --store raw
-  builder.write(out.tempPath(), meta);
+  builder->write(out.tempPath(), meta);
   out.commit();
   writeReport(reportOut, report);
   std::remove(options.journalPath.c_str());  // the output is complete: nothing to resume
@@ -120,7 +127,7 @@ int runSample(const SampleRequest& request) {
   std::ostream& text = request.farm.json ? std::cerr : std::cout;
   text << "wrote " << request.region.out << ": " << grid.dims[0] << "x" << grid.dims[1] << "x" << grid.dims[2]
        << " voxels of " << formatNumber(grid.voxel) << ", band " << request.band << " voxels\n"
-       << "  leaves " << builder.leaves() << ", tiles " << outcome.result.tiles.size() << "\n"
+       << "  leaves " << builder->leaves() << ", tiles " << outcome.result.tiles.size() << "\n"
        << "  evaluations " << s.pointEvals << " (" << formatNumber(std::round(fraction * 1e4) / 100)
        << "% of dense " << s.denseEvals << "), interval " << s.intervalEvals << "\n"
        << "  NaN values " << s.nanValues << (s.nanValues ? " (domain errors, stored as outside)" : "") << "\n"

@@ -6,7 +6,7 @@ _frep_options() {
   local model="-o --object -a --params -x --map -i --iso"
   local region="-b --bounds --res -g --grid -O --out"
   local geometric="--t-frames --t-range --v-range --v-cells --w-range --w-cells --c-range --c-levels --g-values"
-  local farm="--workers --threads --listen --expect-workers --brick --heartbeat-ms --resume --json --no-progress --curve --insecure --strict"
+  local farm="--workers --threads --listen --expect-workers --brick --heartbeat-ms --resume --json --no-progress --curve --insecure --strict --verify --replicate"
   case "$1" in
     check) echo "-h --help -o --object -b --bounds" ;;
     eval) echo "-h --help $model --at --tolerance" ;;
@@ -40,10 +40,11 @@ _frep() {
     --wrl|--stl|--stlb|--pov|--cli) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     -O|--out) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     --curve) COMPREPLY=($(compgen -d -- "$cur")); return ;;
+    --replicate) COMPREPLY=($(compgen -W "1 2" -- "$cur")); return ;;
     -o|--object|--object-a|--object-b|-a|--params|-x|--map|-i|--iso|-b|--bounds|--res|-g|--grid|--at|--tolerance|\
     --gs|--up|--size|--azimuth|--elevation|--distance|--zoom|--eye|--target|--fov|--background|--colour|--color|--frames|\
     --t-frames|--t-range|--v-range|--v-cells|--w-range|--w-cells|--c-range|--c-levels|--g-values|\
-    --band|--workers|--threads|--listen|--expect-workers|--brick|--heartbeat-ms|--thin|--min-size)
+    --band|--workers|--threads|--listen|--expect-workers|--brick|--heartbeat-ms|--thin|--min-size|--verify)
       return ;;  # a value: nothing to offer
   esac
   if [[ -z "$verb" ]]; then

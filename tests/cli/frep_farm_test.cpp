@@ -144,6 +144,39 @@ TEST_F(FarmCli, BadFarmArgumentsAreNamed) {
   EXPECT_FALSE(fileExists(path("x.vdb")));
 }
 
+// --verify (docs/farm.md, "Verification"): the checked run's bytes are the unchecked run's and
+// the report counts what was checked; bad values are exit 2 naming the option; one worker
+// cannot check and says so.
+TEST_F(FarmCli, VerifyChecksBricksAndRefusesBadFractions) {
+  ASSERT_EQ(run(sampleArgs("plain.vdb") + " --workers 2").code, 0);
+  const std::string reference = readText(path("plain.vdb"));
+  RunResult r = run(sampleArgs("checked.vdb") + " --workers 2 --replicate 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(readText(path("checked.vdb")) == reference) << "output bytes differ";
+  std::string report = readText(path("checked.vdb.report.json"));
+  EXPECT_EQ(jsonNumber(report, "verified_bricks"), jsonNumber(report, "total")) << report;
+  EXPECT_EQ(jsonNumber(report, "verify_mismatches"), 0) << report;
+  EXPECT_EQ(jsonNumber(report, "liars_banned"), 0) << report;
+  EXPECT_NE(r.out.find("; verified "), std::string::npos) << r.out;
+  r = run(sampleArgs("quarter.vdb") + " --workers 2 --verify 0.25");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(readText(path("quarter.vdb")) == reference) << "output bytes differ";
+  EXPECT_GE(jsonNumber(readText(path("quarter.vdb.report.json")), "verified_bricks"), 0);
+  r = run(sampleArgs("lone.vdb") + " --workers 1 --verify 1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("--verify cannot run: one local worker"), std::string::npos) << r.err;
+  EXPECT_NE(readText(path("lone.vdb.report.json")).find("\"unavailable\": \"one local worker"), std::string::npos);
+  for (const char* bad : {"--verify 1.5", "--verify -0.1", "--verify nan", "--verify x", "--replicate 3",
+                          "--replicate 0", "--replicate 2 --verify 0.5"}) {
+    SCOPED_TRACE(bad);
+    r = run(sampleArgs("x.vdb") + " " + bad);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find(std::string(bad).find("--replicate") == 0 ? "--replicate" : "--verify"), std::string::npos)
+        << r.err;
+  }
+  EXPECT_FALSE(fileExists(path("x.vdb")));
+}
+
 TEST_F(FarmCli, JsonProgressEventsForBatchSystems) {
   RunResult r = run(sampleArgs("j.vdb") + " --workers 2 --json");
   ASSERT_EQ(r.code, 0) << r.err;
