@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <cstdlib>
@@ -19,6 +18,7 @@
 #include "frep/io/atomic_output.h"
 #include "frep/io/error.h"
 #include "frep/io/geometry_files.h"
+#include "frep/io/input_file.h"
 #include "frep/io/mesh_writer.h"
 #include "frep/io/vdb_writer.h"
 #include "frep/io/world_lattice.h"
@@ -80,15 +80,20 @@ Model compileModel(const std::string& source, const std::string& file, const std
   return m;
 }
 
+// The model file as frep reads it (io::readInputFile): a regular file of at most 1 GiB, its
+// size checked before anything is allocated; a FIFO, a device (/dev/zero) or a larger file
+// raise IoError (an OSError) naming the path at once, never a hang nor a huge allocation.
 Model loadModel(const std::string& path, const std::string& object, const std::vector<double>& params, double iso) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw io::ioError("cannot read model '" + path + "': " + std::strerror(errno));
   std::string text;
-  char buf[65536];
-  for (size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
-  const bool bad = std::ferror(f);
-  std::fclose(f);
-  if (bad) throw io::ioError("cannot read model '" + path + "': read error");
+  try {
+    text = io::readInputFile(path);
+  } catch (const io::Error& e) {
+    // "cannot open file 'm.hf' (No such file or directory)" -> "cannot read model 'm.hf': No such ..."
+    const std::string what = e.what(), open = "cannot open file '" + path + "' (";
+    if (what.rfind(open, 0) == 0 && what.back() == ')')
+      throw io::ioError("cannot read model '" + path + "': " + what.substr(open.size(), what.size() - open.size() - 1));
+    throw io::ioError("cannot read model " + what);
+  }
   return compileModel(text, path, object, params, iso);
 }
 

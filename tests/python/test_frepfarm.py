@@ -59,6 +59,26 @@ def test_load_file_and_missing_file(tmp_path):
         frepfarm.load(str(bad))
 
 
+
+def test_load_refuses_fifo_device_and_huge_file_at_once(tmp_path):
+    """load() reads as frep does (io::readInputFile): a FIFO with no writer, /dev/zero and a
+    file above 1 GiB raise OSError naming the path at once: no hang, no GB allocation."""
+    import time
+    fifo = tmp_path / "model.fifo"
+    os.mkfifo(fifo)
+    huge = tmp_path / "huge.hf"
+    with open(huge, "wb") as f:
+        f.truncate((1 << 30) + 1)  # sparse: no disk used
+    for path, why in [(fifo, "not a regular file"), ("/dev/zero", "not a regular file"),
+                      (huge, "more than the limit of 1 GiB"), (tmp_path, "is a directory")]:
+        start = time.monotonic()
+        with pytest.raises(OSError) as e:
+            frepfarm.load(str(path))
+        assert isinstance(e.value, frepfarm.IoError)
+        assert str(e.value).startswith("cannot read model '" + str(path) + "'"), str(e.value)
+        assert why in str(e.value)
+        assert time.monotonic() - start < 5
+
 def test_too_many_params():
     with pytest.raises(ValueError, match="has a\\[1\\], got 2"):
         frepfarm.compile(SPHERE, params=[1, 2])
