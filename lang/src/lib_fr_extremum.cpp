@@ -23,6 +23,7 @@
 #include "frep/expressions/tape.h"
 #include "frep/minkowski_algebra/distance_offset.h"
 #include "frep/minkowski_algebra/mesh_convex_sum.h"
+#include "frep/minkowski_algebra/sampled_operand.h"
 #include "frep/relations/relations.h"
 #include "lib_fr_minkowski.h"
 #include "lib_hf_util.h"
@@ -74,6 +75,7 @@ struct Options {
   SearchOptions search;
   bool hasBox = false;
   Bounds box;
+  int sampleRes = 0;  // method 2: the sampled operand's grid (0: search)
 };
 
 // The trailing options array (argument i, when present); boxDims: coordinates of the box.
@@ -95,13 +97,23 @@ Options parseOptions(const char* fn, std::vector<Arg>& a, int i, size_t boxDims)
                            " [method, tol, lo1, hi1, ...] (got " + std::to_string(v.size()) + ")",
                        i);
   double method = v[0].constValue(), tol = v[1].constValue();
-  if (method != 0.0 && method != 1.0)
-    throw LibraryError(std::string(fn) + ": method (options[1]) must be 0 (branch-and-bound) or 1 (grid)",
+  const bool sampling = std::string(fn) == "frMinkowski" || std::string(fn) == "frMinkowskiDiff";
+  if (method != 0.0 && method != 1.0 && !(method == 2.0 && sampling))
+    throw LibraryError(std::string(fn) + ": method (options[1]) must be 0 (branch-and-bound), 1 (grid) or 2 "
+                                         "(sampled operand: frMinkowski, frMinkowskiDiff)",
                        i);
   if (!(tol >= 0.0))
     throw LibraryError(std::string(fn) + ": tol (options[2]) must be >= 0 (0: default)", i);
+  if (method == 2.0) {
+    if (tol != 0.0 && !(tol == std::floor(tol) && tol >= 8 && tol <= 1024))
+      throw LibraryError(std::string(fn) + ": with method 2, options[2] is the sampling grid: a whole number "
+                                           "from 8 to 1024 (0: 128)",
+                         i);
+    o.sampleRes = tol == 0.0 ? 128 : int(tol);
+    tol = 0.0;
+  }
   o.search.method = method == 1.0 ? ExtremumMethod::Grid : ExtremumMethod::BranchAndBound;
-  if (tol > 0.0) (method == 1.0 ? o.search.eps : o.search.tolerance) = tol;
+  if (tol > 0.0 && method != 2.0) (method == 1.0 ? o.search.eps : o.search.tolerance) = tol;
   if (v.size() > 2) {
     o.hasBox = true;
     for (size_t d = 0; d < boxDims; ++d) {
@@ -254,9 +266,49 @@ bool exactPair(std::vector<Arg>& a, bool diff, Expr* out) {
   return true;
 }
 
+// Method 2 (options [2, res [, box of the sampled operand]]): the operand that is not a ball or
+// a convex polytope is meshed on a res^3 grid and the exact paths run on its mesh
+// (minkowski_algebra/sampled_operand.h); the report gives the sampled operand's bound.
+bool sampledPair(const char* fn, std::vector<Arg>& a, bool diff, Expr* out) {
+  if (a.size() != 4 || !a[3].isArray || !a[3].array || a[3].array->empty() || !(*a[3].array)[0].isConst() ||
+      (*a[3].array)[0].constValue() != 2.0)
+    return false;
+  const Arg& A = objectArg(fn, a, 1, "A");
+  const Arg& B = objectArg(fn, a, 2, "B");
+  const size_t n = pairDims(fn, A, B);
+  std::vector<Expr>& xs = coordArg(fn, a, n);
+  const Options o = parseOptions(fn, a, 3, n);
+  if (n != 3 || numParams(A.value) > 0 || numParams(B.value) > 0)
+    throw LibraryError(std::string(fn) + ": method 2 (a sampled operand) takes two 3D objects without parameters", 3);
+  auto exact = [&](const Expr& p, const Expr& q, Expr* r) {
+    return diff ? minkowski::distanceBallDifference(p, q, 3, r) || minkowski::meshConvexDifference(p, q, 3, r)
+                : minkowski::distanceBallSum(p, q, 3, r) || minkowski::meshConvexSum(p, q, 3, r);
+  };
+  // The sampled operand is A, or for a sum B when A is the ball or polytope.
+  for (int k = 0; k < (diff ? 1 : 2); ++k) {
+    const Arg& S = k == 0 ? A : B;
+    const Bounds box = o.hasBox ? o.box : autoBox(fn, S, k + 1);
+    std::optional<minkowski::SampledOperand> s =
+        guarded(fn, 3, [&] { return minkowski::sampleOperand(S.value, box, o.sampleRes, "'" + S.name + "'"); });
+    if (!s)
+      throw LibraryError(std::string(fn) + ": method 2: '" + S.name + "' has no closed surface inside its box " +
+                             "(give the box in the options: [2, res, lo1, hi1, ...])",
+                         3);
+    Expr r;
+    if (k == 0 ? exact(s->field, B.value, &r) : exact(A.value, s->field, &r)) {
+      *out = through(r, xs, n);
+      return true;
+    }
+  }
+  throw LibraryError(std::string(fn) + ": method 2 needs the other operand to be a ball (frBall, hfSphere) or a "
+                                       "convex polytope (hfBlock, planes, a convex mesh)",
+                     3);
+}
+
 Expr frMinkowski(std::vector<Arg>& a) {
   Expr exact;
   if (exactPair(a, false, &exact)) return exact;
+  if (sampledPair("frMinkowski", a, false, &exact)) return exact;
   return objectPair("frMinkowski", a, [](const Expr& A, const Expr& B, uint32_t n, const Bounds& bb, const Options& o) {
     return minkowskiSum(A, B, n, bb, minkowskiOptions(o));
   });
@@ -296,6 +348,7 @@ Expr frMinkowskiSum(std::vector<Arg>& a) {
 Expr frMinkowskiDiff(std::vector<Arg>& a) {
   Expr exact;
   if (exactPair(a, true, &exact)) return exact;
+  if (sampledPair("frMinkowskiDiff", a, true, &exact)) return exact;
   return objectPair("frMinkowskiDiff", a,
                     [](const Expr& A, const Expr& B, uint32_t n, const Bounds& bb, const Options& o) {
                       return minkowskiDifference(A, B, n, bb, o.search);

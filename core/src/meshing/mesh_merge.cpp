@@ -8,6 +8,7 @@
 // vertex (they never do: a vertex depends on its edge only) the smaller record (position, then
 // normal) wins, so the result is the same whatever the order of the pieces.
 #include "frep/meshing/mesh_merge.h"
+#include "frep/expressions/field_function.h"
 #include "frep/extremum/extremum.h"
 
 #include <malloc.h>
@@ -206,7 +207,9 @@ double rawMeshErrorBound(const Mesh& mesh, const Tape& tape, const GridSpec& gri
                                   ? s.tolerance
                                   : std::sqrt(double(s.numParams())) / 2.0 * s.eps);  // Pasko-Minkowski §4's d
   }
-  return std::sqrt(longest2 / 3.0) + endGuard * std::sqrt(3.0) * grid.voxel + search;
+  double sampled = 0;  // sampled operands' own bounds (field_function.h)
+  for (const auto& f : tape.fields()) sampled = std::max(sampled, f->setErrorBound());
+  return std::sqrt(longest2 / 3.0) + endGuard * std::sqrt(3.0) * grid.voxel + search + sampled;
 }
 
 }  // namespace frep

@@ -42,11 +42,12 @@ bool translatedCoordinate(const Expr& e, uint32_t i) {
 struct Exactness {
   bool outside = false, inside = false;
   std::string what;
+  double bound = 0;  // a sampled operand's (sampled_operand.h)
 };
 
 Exactness exactnessOf(const Expr& e) {
   if (std::optional<ExactTerm> t = lookupExact(e); t && t->kind == ExactTerm::Kind::BallOffset)
-    return {t->exactOutside, t->exactInside, "(" + t->operand + ")"};
+    return {t->exactOutside, t->exactInside, "(" + t->operand + ")", t->errorBound};
   if (std::optional<ExactTerm> t = lookupExact(e); t && t->kind == ExactTerm::Kind::Distance)
     return {true, true, t->operand};
   if (e.op() != Op::Field) return {};
@@ -54,7 +55,7 @@ Exactness exactnessOf(const Expr& e) {
   if (!d) return {};
   for (int i = 0; i < d->dims(); ++i)
     if (!translatedCoordinate(e.arg(i), static_cast<uint32_t>(i))) return {};
-  return {d->exactOutside(), d->exactInside(), d->describe()};
+  return {d->exactOutside(), d->exactInside(), d->describe(), d->setErrorBound()};
 }
 
 std::string ballText(const Ball& b) {
@@ -114,6 +115,7 @@ bool distanceBallSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
     ExactTerm t;
     t.operand = x.what + " + " + ballText(*ball);
     t.exactOutside = true;  // dist(x, A ⊕ ball) = dist(x - c, A) - r outside
+    t.errorBound = x.bound;
     *out = offsetField(field, *ball, false, t);
     return true;
   }
@@ -131,6 +133,7 @@ bool distanceBallDifference(const Expr& a0, const Expr& b, uint32_t dims, Expr* 
   t.operand = x.what + " - " + ballText(*ball);
   t.erosion = true;
   t.exactInside = true;  // dist(x, complement of A ⊖ ball) = dist(x + c, complement of A) - r inside
+  t.errorBound = x.bound;
   *out = offsetField(a, *ball, true, t);
   return true;
 }

@@ -115,6 +115,7 @@ double extentOf(const std::vector<V3>& pts) {
 
 // The mesh as a convex body, or nothing when some vertex lies outside a face's plane.
 std::optional<Convex> convexOf(const Mesh& m, double scale) {
+  if (m.t.size() > 4096) return std::nullopt;  // a tool, not a part: the check is quadratic
   Convex c;
   c.v = m.v;
   const double tol = 1e-9 * scale;
@@ -281,6 +282,7 @@ class MeshConvexSumField : public DistanceField {
   }
   uint64_t contentHash() const override { return hash_; }
   std::string describe() const override { return name_; }
+  double setErrorBound() const override { return a_->setErrorBound(); }
   bool exactOutside() const override { return !complement_; }
   bool exactInside() const override { return complement_; }
   size_t pieces() const { return pieces_; }
@@ -478,6 +480,7 @@ bool build(const Expr& aExpr, const Expr& bExpr, bool difference, Expr* out, dou
   std::vector<uint32_t> tris;
   for (const auto& t : a->t) tris.insert(tris.end(), t.begin(), t.end());
   auto aField = std::make_shared<MeshField>(std::move(xyz), std::move(tris), a->what);
+  if (aExpr.op() == Op::Field) aField->setSetErrorBound(aExpr.node().fn->setErrorBound() * scaleA);
   const std::string name = a->what + (difference ? " ⊖ " : " ⊕ ") + b->what;
   auto field = std::make_shared<MeshConvexSumField>(*a, aField, *cb, difference, name);
   *out = fieldExpr(field, Expr::x(0), Expr::x(1), Expr::x(2));
@@ -488,6 +491,7 @@ bool build(const Expr& aExpr, const Expr& bExpr, bool difference, Expr* out, dou
   t.erosion = difference;
   t.exactOutside = !difference;
   t.exactInside = difference;
+  t.errorBound = field->setErrorBound();
   registerExact(*out, t);
   return true;
 }

@@ -1,6 +1,8 @@
 // The table of exact Minkowski terms, keyed by hash-consed node (registry.h).
 #include "frep/minkowski_algebra/registry.h"
 
+#include <cstdio>
+
 #include <mutex>
 #include <unordered_map>
 
@@ -30,6 +32,15 @@ std::optional<ExactTerm> lookupExact(const Expr& e) {
   return it->second.term;
 }
 
+namespace {
+std::string boundText(double sampled) {
+  if (!(sampled > 0)) return "error bound 0 (no search)";
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "error bound %.3g (the sampled operand's; no search)", sampled);
+  return buf;
+}
+}  // namespace
+
 std::vector<std::string> describeExact(const Expr& f) {
   std::vector<std::string> lines;
   forEachNode(f, [&](const Node& n) {
@@ -41,11 +52,11 @@ std::vector<std::string> describeExact(const Expr& f) {
     if (t.kind == ExactTerm::Kind::Distance) return;                  // a primitive, no operation
     if (t.kind == ExactTerm::Kind::BallOffset)
       lines.push_back(std::string("exact Minkowski ") + (t.erosion ? "difference " : "sum ") + t.operand +
-                      " as the offset f " + (t.erosion ? "- " : "+ ") +
-                      "r of an exact signed distance, error bound 0 (no search)");
+                      " as the offset f " + (t.erosion ? "- " : "+ ") + "r of an exact signed distance, " +
+                      boundText(t.errorBound));
     else if (t.kind == ExactTerm::Kind::MeshPolytope)
-      lines.push_back(std::string("exact Minkowski ") + (t.erosion ? "difference " : "sum ") + t.operand +
-                      ", error bound 0 (no search)");
+      lines.push_back(std::string("exact Minkowski ") + (t.erosion ? "difference " : "sum ") + t.operand + ", " +
+                      boundText(t.errorBound));
     else if (t.kind == ExactTerm::Kind::Sum)
       lines.push_back("exact Minkowski algebra (Roerdink): " + t.sum.describe() + " as a union of " +
                       std::to_string(t.pieces) + " primitives, error bound 0 (no search)");

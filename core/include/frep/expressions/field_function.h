@@ -35,6 +35,10 @@ class FieldFunction {
   // Returns the value and writes the three partial derivatives.
   virtual double gradient(const double p[3], double g[3]) const = 0;
   virtual Interval bound(const Interval box[3]) const = 0;
+  // How far the boundary of this field's solid may lie from the one the model names (a sampled
+  // operand's meshing bound, minkowski_algebra/sampled_operand.h); 0 for exact geometry. Added
+  // to a mesh's surface_error_bound (rawMeshErrorBound).
+  virtual double setErrorBound() const { return 0.0; }
 };
 
 using FieldFunctionPtr = std::shared_ptr<const FieldFunction>;

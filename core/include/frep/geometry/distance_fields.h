@@ -121,6 +121,9 @@ class MeshField : public DistanceField {
   Interval bound(const Interval box[3]) const override;
   double windingNumber(const double* p) const;                   // exact sum, O(n)
   double volume() const;                                          // divergence theorem
+  // A mesh made from a model (a sampled operand): its distance from the model's surface.
+  void setSetErrorBound(double e) { setError_ = e; }
+  double setErrorBound() const override { return setError_; }
 
  private:
   std::vector<double> xyz_;
@@ -128,6 +131,7 @@ class MeshField : public DistanceField {
   std::vector<double> faceN_, vertN_, edgeN_;  // pseudonormals
   std::vector<uint32_t> triEdge_;              // 3 edge ids per triangle (edge k: v[k]-v[k+1])
   std::vector<double> corners_;                // 9 coordinates per triangle (a copy of xyz_ by tris_)
+  double setError_ = 0;
   Bvh bvh_;
   MeshCheck check_;
   uint64_t hash_ = 0;

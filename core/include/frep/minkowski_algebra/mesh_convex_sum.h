@@ -35,7 +35,7 @@ namespace frep::minkowski {
 
 // A ⊕ B over x[0..3) when one operand is a closed triangle mesh (or a convex polytope, whose
 // boundary mesh is used) and the other a convex polytope: an intersection of half-spaces
-// (convex_polytope.h) or a closed convex mesh. Registers the result for the job report.
+// (convex_polytope.h) or a closed convex mesh of at most 4096 triangles. Registers the result.
 bool meshConvexSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out);
 // The metamorphosis (1 - t) A ⊕ t B (Pasko-Minkowski eq. 4.5, scalings about the origin) of such
 // operands, 0 < t < 1.

@@ -28,6 +28,7 @@ struct ExactTerm {
   // is itself an exact signed distance (so a further ball can take the same path).
   std::string operand;
   bool erosion = false, exactOutside = false, exactInside = false;
+  double errorBound = 0;  // BallOffset, MeshPolytope: a sampled operand's (sampled_operand.h)
 };
 
 void registerExact(const Expr& e, const ExactTerm& t);
