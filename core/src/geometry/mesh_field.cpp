@@ -197,9 +197,9 @@ void MeshField::orientConsistently() {
   }
 }
 
-int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, double& best2) const {
+int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, double& best2, double start2) const {
   double bq[3] = {0, 0, 0};
-  best2 = INFINITY;
+  best2 = start2;
   bestRegion = 0;
   const int64_t t = bvh_.nearest(p, [&](uint32_t i, double cur) {
     double qq[3];
@@ -257,6 +257,14 @@ double MeshField::distance(const double* p, double* q) const {
   int region;
   nearestTriangle(p, q, region, best2);  // no sign: an open mesh's would cost a winding number
   return std::sqrt(best2);
+}
+
+double MeshField::distance(const double* p, double* q, double atMost) const {
+  double best2;
+  int region;
+  const double start = atMost * (1 + 1e-9) + 1e-300;  // rounding: the true distance must be inside
+  if (std::isfinite(start) && nearestTriangle(p, q, region, best2, start * start) >= 0) return std::sqrt(best2);
+  return distance(p, q);
 }
 
 double MeshField::gradient(const double* p, double* g) const {

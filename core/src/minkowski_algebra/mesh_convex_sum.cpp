@@ -427,10 +427,11 @@ class MeshConvexSumField : public DistanceField {
   }
 
   // The field of (A or A^c) ⊕ B, q the nearest boundary point where it is negative.
+  // In a T ⊕ B the largest c_T is returned alone (a lower bound of the depth, like the max with
+  // f_A: the sign certificates need no more), which saves the query of A near the surface;
+  // outside, dist(x, sum) <= dist(x - b0, A) bounds the boundary pieces' search.
   double sumField(const double* p, double* q) const {
-    const double shifted[3] = {p[0] - b0_[0], p[1] - b0_[1], p[2] - b0_[2]};
-    double g = a_->value(shifted);
-    if (complement_) g = -g;
+    double g = -INFINITY;
     cellBvh_.containing(p, [&](uint32_t i) {
       const Cell& c = cells_[i];
       double m = INFINITY;
@@ -441,7 +442,10 @@ class MeshConvexSumField : public DistanceField {
       g = std::max(g, m);
     });
     if (g >= 0) return g;
-    return -soup_->distance(p, q);
+    const double shifted[3] = {p[0] - b0_[0], p[1] - b0_[1], p[2] - b0_[2]};
+    const double inA = complement_ ? -a_->value(shifted) : a_->value(shifted);
+    if (inA >= 0) return inA;
+    return -soup_->distance(p, q, -inA);
   }
   bool sameGeometry(const DistanceField& o) const override {
     const auto& m = static_cast<const MeshConvexSumField&>(o);

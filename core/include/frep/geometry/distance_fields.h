@@ -31,7 +31,8 @@ class Bvh {
   };
   void build(const std::vector<Box>& boxes);
   // Calls dist2(i, best2) for candidate primitives in near-first order, pruning boxes farther
-  // than the best squared distance found; returns the nearest primitive (or -1 if none).
+  // than the best squared distance found (or than best2's starting value, when finite: then
+  // only primitives nearer than it count); returns the nearest primitive (or -1 if none).
   template <typename F>
   int64_t nearest(const double* p, F&& dist2, double& best2) const;
   // Calls visit(i) for every primitive whose box contains p.
@@ -115,6 +116,9 @@ class MeshField : public DistanceField {
   const std::vector<double>& vertices() const { return xyz_; }
   const std::vector<uint32_t>& triangles() const { return tris_; }
   double distance(const double* p, double* q = nullptr) const;  // unsigned, closest point
+  // The same when it is known to be at most `atMost` (the search prunes by it; a larger
+  // bound is only slower, never wrong).
+  double distance(const double* p, double* q, double atMost) const;
   // The Lipschitz bound, and on a closed mesh a box that touches no leaf box of the hierarchy
   // has one sign and |f| >= its gap to them: the bound of a box near, not on, the surface
   // then excludes 0 (the sampler keeps fewer voxels).
@@ -137,7 +141,7 @@ class MeshField : public DistanceField {
   uint64_t hash_ = 0;
   std::string name_;
   double signedDistance(const double* p, double* q) const;
-  int64_t nearestTriangle(const double* p, double* q, int& region, double& best2) const;
+  int64_t nearestTriangle(const double* p, double* q, int& region, double& best2, double start2 = INFINITY) const;
   void orientConsistently();
   bool sameGeometry(const DistanceField& o) const override {
     const auto& m = static_cast<const MeshField&>(o);
@@ -190,11 +194,12 @@ int64_t Bvh::nearest(const double* p, F&& dist2, double& best2) const {
   stack[sp++] = 0;
   while (sp > 0) {
     const NodeB& n = nodes_[stack[--sp]];
-    if (boxDist2(n.box, p) >= best2 && best >= 0) continue;  // a tie cannot be nearer
+    const double gap2 = boxDist2(n.box, p);
+    if (gap2 > best2 || (gap2 == best2 && best >= 0)) continue;  // a tie cannot be nearer
     if (n.count > 0) {
       for (uint32_t k = n.first; k < n.first + n.count; ++k) {
         const double d = dist2(order_[k], best2);
-        if (d < best2 || best < 0) {
+        if (d < best2 || (best < 0 && best2 == INFINITY)) {
           best2 = d;
           best = order_[k];
         }
