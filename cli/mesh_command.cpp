@@ -116,6 +116,8 @@ int runMesh(const MeshRequest& request) {
   if (request.tolerance < 0 && request.tolerance != -1)
     throw badArgs("--tolerance: expected 0 (no simplification) or more voxels, got " + formatNumber(request.tolerance));
   if (!std::isfinite(request.tolerance)) throw badArgs("--tolerance: expected a finite number of voxels");
+  if (request.tolerance > 0 && !(request.tolerance >= kMinSimplifyTolerance && request.tolerance <= kMaxSimplifyTolerance))
+    throw badArgs("--tolerance: expected 0 (no simplification) or 1e-30 to 1e30 voxels, got " + formatNumber(request.tolerance));
   farm::FarmOptions options = farmOptions(request.farm, request.region.out, request.logLevel, request.threads);
   Box box = request.region.bounds.empty() ? Box{} : parseBounds("-b/--bounds", request.region.bounds);
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);

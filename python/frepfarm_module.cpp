@@ -214,6 +214,9 @@ struct PyMesh {
 
 PyMesh meshModel(const Model& m, std::array<double, 3> lo, std::array<double, 3> hi, int res, double simplify,
                  const std::vector<double>& fixed) {
+  // As frep mesh --tolerance: NaN or an infinity would make simplification spin without end.
+  if (!(simplify == 0 || (simplify >= kMinSimplifyTolerance && simplify <= kMaxSimplifyTolerance)))
+    throw py::value_error("simplify: expected 0 (no simplification) or 1e-30 to 1e30 voxels");
   GridSpec grid = gridOf(lo, hi, res);
   MeshOptions options;
   options.fixedCoords = fixedCoordsOf(m, fixed);

@@ -534,3 +534,26 @@ TEST(MeshSimplify, ThinWallsAndGapsStayApartWhenCellsAreContracted) {
     EXPECT_LT(r.mesh.triangles.size(), r.rawTriangles / 4) << name;
   }
 }
+
+// A tolerance whose error levels are no normal numbers (5e-324 voxels spun without end, an
+// infinity too, in frep mesh, the Python module and a worker given such a job) is refused;
+// the smallest and largest allowed ones simplify and stop.
+TEST(MeshSimplify, RefusesTolerancesItsErrorLevelsCannotHold) {
+  const GridSpec g = cubeGrid(1.2, 12);
+  const TapePtr tape = Tape::compile(blockAt(0.013, -0.021, 0.007, 0.9, 0.7, 0.5), 3);
+  const Mesh raw = meshGrid(tape, g, {}, 0);
+  for (double tol : {5e-324, 1e-31, 1e31, 1e300, HUGE_VAL}) {
+    Mesh m = raw;
+    SimplifyOptions so;
+    so.tolerance = tol;
+    EXPECT_THROW(simplifyMesh(m, tape, g, so), std::invalid_argument) << tol;
+  }
+  for (double tol : {kMinSimplifyTolerance, kMaxSimplifyTolerance}) {
+    Mesh m = raw;
+    SimplifyOptions so;
+    so.tolerance = tol;
+    simplifyMesh(m, tape, g, so);
+    EXPECT_EQ(mc::checkEdgePairs(m.triangles, m.positions.size()), "") << tol;
+    EXPECT_LE(m.triangles.size(), raw.triangles.size()) << tol;
+  }
+}

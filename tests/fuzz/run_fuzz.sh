@@ -7,7 +7,8 @@
 # BUILD/findings/<target>-crash-* (add it to corpus/<target>/ with its fix).
 # FUZZ_SCALE=N multiplies every iteration count (a longer local run).
 # Then the process fuzz loops (tests/cli/process_fuzz: the frep binary run once per damaged
-# input, about a minute), built in the Release build RELEASE (FREP_BUILD, default build/).
+# input, about a minute), built in the Release build RELEASE (FREP_BUILD, default build/), and
+# the Python module's fuzz run (fuzz_python.py, at most a minute) against that build's module.
 set -eu
 HERE=$(cd "$(dirname "$0")" && pwd)
 REPO=$(cd "$HERE/../.." && pwd)
@@ -63,3 +64,16 @@ cmake --build "$RELEASE" -j"$(nproc)" --target cli_process_fuzz >/dev/null
   exit 1
 }
 echo "run_fuzz: process fuzz loops: $(grep -c '^\[       OK \]' "$BUILD/findings/process.log") passed, $(( $(date +%s) - start )) s"
+# The Python module (python/frepfarm_module.cpp) as Python calls it: fuzz_python.py feeds mutated
+# models and odd arguments from seed 1 to the Release build's module in a child process; a signal,
+# a hang, MemoryError or an "internal error" is a finding (kept as findings/python-<case>.txt).
+if [ -f "$RELEASE/python/CMakeFiles/frepfarm_python.dir/flags.make" ]; then
+  cmake --build "$RELEASE" -j"$(nproc)" --target frepfarm_python >/dev/null
+  /usr/bin/python3 "$HERE/fuzz_python.py" --module-dir "$RELEASE/python" --cases $((3000 * SCALE)) \
+      --budget $((60 * SCALE)) --findings "$BUILD/findings" || {
+    echo "run_fuzz: python: FINDING (replay: tests/fuzz/fuzz_python.py --seed 1 --replay CASE)"
+    exit 1
+  }
+else
+  echo "run_fuzz: python: the frepfarm module is not configured in $RELEASE (no pybind11); skipped"
+fi

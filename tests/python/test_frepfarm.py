@@ -285,3 +285,12 @@ def test_mesh_write_formats(tmp_path):
 def test_keyboard_interrupt_stays_python():
     import signal
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_mesh_refuses_simplify_out_of_range():
+    """simplify=inf and 5e-324 spun without end (found by tests/fuzz/fuzz_python.py)."""
+    m = sphere()
+    for bad in [math.inf, math.nan, 5e-324, -1.0, 1e31]:
+        with pytest.raises(ValueError, match="simplify: expected 0"):
+            m.mesh([-1, -1, -1], [1, 1, 1], res=6, simplify=bad)
+    assert len(m.mesh([-1, -1, -1], [1, 1, 1], res=6, simplify=1e-30).triangles) > 0

@@ -403,12 +403,22 @@ void blockPass(Work& g, const TapePtr& tape, const GridSpec& grid, const Simplif
   g = std::move(c);
 }
 
+// See kMinSimplifyTolerance: a tolerance whose error levels are not normal numbers is refused
+// (a master's job or a caller could otherwise make the simplifier spin without end).
+void checkTolerance(double tolerance, const GridSpec& grid) {
+  const double tol = tolerance * grid.voxel;
+  if (!(tolerance >= kMinSimplifyTolerance && tolerance <= kMaxSimplifyTolerance) || !(tol > 1e-140 && tol < 1e140))
+    throw std::invalid_argument("simplifyMesh: tolerance " + std::to_string(tolerance) +
+                                " voxels: expected 0 or 1e-30 to 1e30 voxels (and at most 1e140 in length)");
+}
+
 }  // namespace
 
 SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options) {
   SimplifyStats stats;
   stats.trianglesBefore = stats.trianglesAfter = mesh.triangles.size() + 2 * mesh.carry.counters.collapses;
   if (!(options.tolerance > 0) || mesh.triangles.empty()) return stats;
+  checkTolerance(options.tolerance, grid);
   Work w = workOf(std::move(mesh), options.threads);
   stats += mesh.carry.counters;  // the regions' share (simplifyRegion in the workers)
   mesh.carry = SimplifyCarry();
@@ -438,6 +448,7 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
 void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid, const SimplifyOptions& options,
                     const std::array<int32_t, 3>& lo, const std::array<int32_t, 3>& hi) {
   if (!(options.tolerance > 0) || piece.triangles.empty()) return;
+  checkTolerance(options.tolerance, grid);
   Mesh m;  // the piece as a mesh: its vertices are in key order, its triangles canonical
   m.positions.reserve(piece.vertices.size()), m.normals.reserve(piece.vertices.size()), m.keys.reserve(piece.vertices.size());
   for (const MeshVertex& v : piece.vertices) {

@@ -17,7 +17,9 @@ Simplifier::Simplifier(Work&& work, const TapePtr& tape, const GridSpec& grid, c
   // Error levels e_k = tol * 2^k up to two voxels (or the tolerance if larger): a replaced
   // triangle allows its new ones at most that much error, however far its own chord was (the
   // mesher's chords across a crease can be most of a voxel deep).
-  while (std::ldexp(tol_, maxLevel_ + 1) <= std::max(tol_, grid_.voxel) * (1 + 1e-12)) ++maxLevel_;
+  // (At most the last level levelTol_ holds: simplifyMesh refuses tolerances that would go further.)
+  while (maxLevel_ + 1 < int(levelTol_.size()) && std::ldexp(tol_, maxLevel_ + 1) <= std::max(tol_, grid_.voxel) * (1 + 1e-12))
+    ++maxLevel_;
   for (size_t k = 0; k < levelTol_.size(); ++k) levelTol_[k] = std::ldexp(tol_, int(k));
   if (tape_->numVars() > 3 && opt_.fixedCoords.size() < tape_->numVars() - 3)
     throw std::invalid_argument("simplifyMesh: the model has " + std::to_string(tape_->numVars()) +

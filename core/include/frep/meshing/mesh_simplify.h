@@ -41,6 +41,12 @@
 
 namespace frep {
 
+// The tolerances simplification takes (voxels): 0 (off) or within [kMinSimplifyTolerance,
+// kMaxSimplifyTolerance]. Its error levels tolerance * voxel * 2^k and their squares must be
+// normal numbers: 5e-324 or an infinity would loop without end. Others throw invalid_argument.
+constexpr double kMinSimplifyTolerance = 1e-30;
+constexpr double kMaxSimplifyTolerance = 1e30;
+
 struct SimplifyOptions {
   double tolerance = 0;  // in voxels (grid.voxel); <= 0: the mesh is left as it is
   // true: a merged vertex goes where its quadric is least (on edges and corners of the model);
