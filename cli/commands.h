@@ -39,6 +39,18 @@ struct RelateRequest {
 };
 int runRelate(const RelateRequest& request);
 
+// frep measure: certified volume, area, centroid and inertia (measure_command.cpp, docs/measure.md).
+struct MeasureRequest {
+  ModelRequest model;
+  std::string bounds;        // -b text; "" = hfp's ±10
+  double tolerance = 0.005;  // relative width of the volume and area bounds
+  int threads = 0;           // 0: all cores (same numbers for any count)
+  long long maxCells = 2000000;  // budget of boundary cells (about 1.5 KB each at the peak)
+  bool json = false;         // one JSON object on stdout
+  bool noProgress = false;
+};
+int runMeasure(const MeasureRequest& request);
+
 struct SliceRequest {
   ModelRequest model;
   RegionRequest region;

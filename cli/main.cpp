@@ -214,6 +214,19 @@ int main(int argc, char** argv) {
   relateCmd->add_option("-b,--bounds", relate.bounds, "Box searched (default 10)");
   relateCmd->add_option("--min-size", relate.minSize, "Smallest box edge of the subdivision (default 1e-4 of the box)");
   relateCmd->add_option("--at", relate.at, "Also classify the point X,Y,Z against both");
+  MeasureRequest measure;
+  CLI::App* measureCmd = app.add_subcommand("measure", "Certified volume, surface area, centroid and inertia tensor of a model "
+                                                       "(lower and upper bounds; docs/measure.md)");
+  addModelOptions(measureCmd, measure.model, true);
+  measureCmd->add_option("-b,--bounds", measure.bounds,
+                         "Box measured (solid ∩ box): B | min,max | bx,by,bz | xmin,ymin,zmin,xmax,ymax,zmax (default 10)");
+  measureCmd->add_option("--tolerance", measure.tolerance,
+                         "Refine until (upper - lower) <= T * lower for the volume and the area (default 0.005)");
+  measureCmd->add_option("--threads", measure.threads, "Threads (default 0: all cores; same numbers for any count)");
+  measureCmd->add_option("--max-cells", measure.maxCells,
+                         "Budget of boundary cells (about 1.5 KB of memory each); refinement stops there with a warning (default 2000000)");
+  measureCmd->add_flag("--json", measure.json, "The result as one JSON object on stdout");
+  measureCmd->add_flag("--no-progress", measure.noProgress, "No progress line");
   RenderRequest render;
   CLI::App* renderCmd = app.add_subcommand("render", "Shaded PNG of a model by certified interval ray casting");
   addModelOptions(renderCmd, render.model, true);
@@ -247,7 +260,7 @@ int main(int argc, char** argv) {
   bool keygenForce = false;
   keygenCmd->add_flag("--force", keygenForce, "Replace the keys DIR already has (workers holding the old ones are locked out)");
 
-  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, povCmd, renderCmd}) sub->fallthrough();
+  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, povCmd, renderCmd, measureCmd}) sub->fallthrough();
 
   try {
     app.parse(argc, argv);
@@ -255,13 +268,15 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov, relate, render and keygen";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov, relate, measure, render and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
 
   logLevel = setUpLogging(logLevel, logLevelOption->count() > 0);
-  if ((sampleCmd->parsed() && sample.farm.json) || (meshCmd->parsed() && mesh.farm.json)) enableJsonEvents();
+  if ((sampleCmd->parsed() && sample.farm.json) || (meshCmd->parsed() && mesh.farm.json) ||
+      (measureCmd->parsed() && measure.json))
+    enableJsonEvents();
   try {
     if (check->parsed()) {
       checkObjectIsNotAFile(checkModel);
@@ -278,6 +293,10 @@ int main(int argc, char** argv) {
     if (keygenCmd->parsed()) return runKeygen(keygenDir, keygenForce);
     if (povCmd->parsed()) return runPov(pov);
     if (relateCmd->parsed()) return runRelate(relate);
+    if (measureCmd->parsed()) {
+      checkObjectIsNotAFile(measure.model);
+      return runMeasure(measure);
+    }
     if (renderCmd->parsed()) {
       checkObjectIsNotAFile(render.model);
       render.logLevel = logLevel;

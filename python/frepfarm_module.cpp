@@ -24,6 +24,7 @@
 #include "frep/io/world_lattice.h"
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
+#include "frep/measure/mass_properties.h"
 #include "frep/meshing/mesh.h"
 #include "frep/primitives/ops.h"
 #include "frep/meshing/mesh_simplify.h"
@@ -247,6 +248,74 @@ PyMesh meshModel(const Model& m, std::array<double, 3> lo, std::array<double, 3>
   return out;
 }
 
+py::dict boundDict(const MeasureBound& b) {
+  py::dict d;
+  d["lower"] = b.lower;
+  d["upper"] = b.upper;
+  return d;
+}
+
+py::list tensorList(const std::array<MeasureBound, 9>& t) {
+  py::list rows;
+  for (int i = 0; i < 3; ++i) {
+    py::list row;
+    for (int j = 0; j < 3; ++j) row.append(boundDict(t[size_t(i * 3 + j)]));
+    rows.append(row);
+  }
+  return rows;
+}
+
+// As frep measure --json: certified bounds of solid ∩ [lo, hi] (frep/measure/mass_properties.h).
+py::dict measureModel(const Model& m, std::array<double, 3> lo, std::array<double, 3> hi, double tolerance,
+                      int threads, long long maxCells) {
+  if (m.dims != 3) throw py::value_error("measure: the object has x[" + std::to_string(m.dims) + "]; measure needs a 3D object");
+  if (!(tolerance > 0.0 && tolerance < 1.0)) throw py::value_error("tolerance: expected a relative width in (0, 1), e.g. 0.005");
+  if (maxCells < 1000) throw py::value_error("max_cells: expected at least 1000");
+  for (int a = 0; a < 3; ++a)
+    if (!(hi[size_t(a)] > lo[size_t(a)]) || !std::isfinite(lo[size_t(a)]) || !std::isfinite(hi[size_t(a)]))
+      throw py::value_error("lo, hi: expected finite bounds with hi > lo on every axis");
+  const Interval box[3] = {{lo[0], hi[0]}, {lo[1], hi[1]}, {lo[2], hi[2]}};
+  MeasureOptions options;
+  options.tolerance = tolerance;
+  options.threads = threads;
+  options.maxBoundaryCells = uint64_t(maxCells);
+  bool interrupted = false;
+  options.progress = [&interrupted](const MeasureProgress&) {
+    py::gil_scoped_acquire locked;  // Ctrl-C: stop after this round, then KeyboardInterrupt
+    if (PyErr_CheckSignals() != 0) interrupted = true;
+    return !interrupted;
+  };
+  MassProperties r;
+  {
+    py::gil_scoped_release unlocked;
+    r = measureMassProperties(m.field, box, options);
+  }
+  if (interrupted) throw py::error_already_set();
+  py::dict d;
+  d["volume"] = boundDict(r.volume);
+  d["area"] = boundDict(r.area);
+  d["cut_area"] = boundDict(r.cutArea);
+  py::list faces;
+  for (int b = 0; b < 6; ++b)
+    if (r.cutFaces & (1u << b)) faces.append(std::string(1, "xyz"[b / 2]) + (b % 2 ? "-max" : "-min"));
+  d["cut_faces"] = faces;
+  py::list centroid;
+  for (const MeasureBound& c : r.centroid) centroid.append(boundDict(c));
+  d["centroid"] = centroid;
+  d["inertia"] = tensorList(r.inertia);
+  d["inertia_about"] = "centroid";
+  d["inertia_origin"] = tensorList(r.inertiaOrigin);
+  d["area_bounded"] = r.areaBounded;
+  d["tolerance_reached"] = r.toleranceReached;
+  d["stop_reason"] = r.stopReason;
+  py::dict cells;
+  cells["inside"] = r.insideCells;
+  cells["boundary"] = r.boundaryCells;
+  cells["first_order"] = r.firstOrderCells;
+  d["cells"] = cells;
+  return d;
+}
+
 void writeMeshFile(const PyMesh& m, const std::string& path) {
   io::MeshFormat format = io::meshFormatFromPath("path", path);
   io::AtomicOutput out("path", path);
@@ -292,7 +361,12 @@ PYBIND11_MODULE(frepfarm, mod) {
            "Sparse narrow-band sampling of the box [lo, hi] with res points along its longest axis")
       .def("mesh", &meshModel, py::arg("lo"), py::arg("hi"), py::arg("res") = 128, py::arg("simplify") = 0.0,
            py::arg("fixed") = std::vector<double>{},
-           "Watertight mesh of f = 0 in [lo, hi]; simplify > 0: tolerance in voxels (frep mesh's 0.1)");
+           "Watertight mesh of f = 0 in [lo, hi]; simplify > 0: tolerance in voxels (frep mesh's 0.1)")
+      .def("measure", &measureModel, py::arg("lo") = std::array<double, 3>{-10, -10, -10},
+           py::arg("hi") = std::array<double, 3>{10, 10, 10}, py::arg("tolerance") = 0.005, py::arg("threads") = 0,
+           py::arg("max_cells") = 2000000LL,
+           "Certified volume, area, centroid and inertia tensors of solid ∩ [lo, hi] as lower/upper bounds "
+           "(frep measure --json's dict; docs/measure.md)");
 
   mod.def("compile", &compileModel, py::arg("source"), py::arg("file") = "<string>", py::arg("object") = "",
           py::arg("params") = std::vector<double>{}, py::arg("iso") = 0.0,
