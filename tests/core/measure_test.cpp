@@ -208,6 +208,14 @@ TEST(Measure, RFunctionBox) {
   check("R-function box", f, 1.5, boxExact(0.9, 0.7, 1.2, c));
 }
 
+TEST(Measure, HyperFunSlabBlock) {
+  // hfBlock's form: R-conjunctions of slabs (x - v)(v + d - x), measured as min of half-spaces.
+  const Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  const Expr f = rIntersection(rIntersection((x + 0.3) * (0.5 - x), (y + 0.2) * (0.6 - y)), (z - 0.1) * (0.4 - z));
+  const double c[3] = {0.1, 0.2, 0.25};
+  check("hfBlock form", f, 1.5, boxExact(0.8, 0.8, 0.3, c));
+}
+
 TEST(Measure, MeasureFormHasTheSignOfTheField) {
   minkowski::Shape s;
   s.kind = minkowski::ShapeKind::Block;
@@ -216,7 +224,11 @@ TEST(Measure, MeasureFormHasTheSignOfTheField) {
   const Expr box = minkowski::unionExpr(minkowski::reduce(minkowski::sumOf(s)));
   const Expr rblock = block({Expr(0.1), Expr(0.0), Expr(0.0)}, {Expr(0.5), Expr(0.4), Expr(0.3)}, Expr(0.0));
   const Expr blend = rUnion(sphere({Expr(0.2), Expr(0.0), Expr(0.0)}, 0.5), 2.0 * -rblock, 0.3);
-  for (const Expr& f : {box, rblock, blend}) {
+  const Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  const Expr slabs = rIntersection(rIntersection((x + 0.3) * (0.5 - x), (y + 0.2) * (0.6 - y)), (z - 0.1) * (0.4 - z));
+  const Expr notSlabs = (x + 0.3) * (x - 0.5);  // a + b not constant: kept as it is
+  EXPECT_TRUE(measureForm(notSlabs).same(notSlabs));
+  for (const Expr& f : {box, rblock, blend, slabs}) {
     TapePtr a = Tape::compile(f, 3), b = Tape::compile(measureForm(f), 3);
     PointEvaluator pa, pb;
     uint64_t state = 12345;

@@ -81,6 +81,52 @@ bool boxDistance(const Expr& e, Expr& m) {
   return false;
 }
 
+// e as c0 + c . x when it is built of constants, x0..x2, +, -, negation and products by
+// constants only.
+bool affine(const Expr& e, double& c0, double c[3]) {
+  c0 = c[0] = c[1] = c[2] = 0.0;
+  double a0, a[3], b0, b[3];
+  switch (e.op()) {
+    case Op::Const: c0 = e.constValue(); return true;
+    case Op::Var:
+      if (e.node().index > 2) return false;
+      c[e.node().index] = 1.0;
+      return true;
+    case Op::Neg:
+      if (!affine(e.arg(0), a0, a)) return false;
+      c0 = -a0;
+      for (int i = 0; i < 3; ++i) c[i] = -a[i];
+      return true;
+    case Op::Add: case Op::Sub: {
+      if (!affine(e.arg(0), a0, a) || !affine(e.arg(1), b0, b)) return false;
+      const double s = e.op() == Op::Add ? 1.0 : -1.0;
+      c0 = a0 + s * b0;
+      for (int i = 0; i < 3; ++i) c[i] = a[i] + s * b[i];
+      return true;
+    }
+    case Op::Mul: {
+      const int k = e.arg(0).isConst() ? 0 : e.arg(1).isConst() ? 1 : -1;
+      if (k < 0 || !affine(e.arg(1 - k), a0, a)) return false;
+      const double m = e.arg(k).constValue();
+      c0 = m * a0;
+      for (int i = 0; i < 3; ++i) c[i] = m * a[i];
+      return true;
+    }
+    default: return false;
+  }
+}
+
+// a * b with a, b affine and a + b a positive constant (HyperFun's slab (x - v)(v + d - x)):
+// both factors cannot be negative at once, so the product has the sign of min(a, b).
+bool slabProduct(const Expr& e) {
+  if (e.op() != Op::Mul || e.arg(0).same(e.arg(1))) return false;
+  double a0, a[3], b0, b[3];
+  if (!affine(e.arg(0), a0, a) || !affine(e.arg(1), b0, b)) return false;
+  for (int i = 0; i < 3; ++i)
+    if (a[i] + b[i] != 0.0) return false;
+  return a0 + b0 > 0.0 && (a[0] != 0.0 || a[1] != 0.0 || a[2] != 0.0);
+}
+
 struct Rewriter {
   std::unordered_map<const Node*, Expr> done;
   Expr run(const Expr& e) {
@@ -96,9 +142,10 @@ struct Rewriter {
       // near an edge is no part of the solid and only widens the enclosures there.
       case Op::RAnd: out = min(run(e.arg(0)), run(e.arg(1))); break;
       case Op::ROr: out = max(run(e.arg(0)), run(e.arg(1))); break;
-      case Op::Mul:  // by a positive constant
+      case Op::Mul:  // by a positive constant, or a slab
         if (e.arg(0).isConst() && e.arg(0).constValue() > 0.0) out = e.arg(0) * run(e.arg(1));
         else if (e.arg(1).isConst() && e.arg(1).constValue() > 0.0) out = run(e.arg(0)) * e.arg(1);
+        else if (slabProduct(e)) out = min(e.arg(0), e.arg(1));
         break;
       case Op::Add:
         if (boxDistance(e, m)) out = m;

@@ -91,7 +91,8 @@ MassProperties measureMassProperties(const Expr& f, const Interval box[3], const
 // its sign (the R-function's rounding of the level sets near an edge is no part of the solid but
 // widens every enclosure there), and an exact box or cylinder distance
 // |max(d, 0)| + min(max_k d_k, 0) becomes max_k d_k (the distance's formula kinks along every
-// face, where no gradient cone exists for the area bound).
+// face, where no gradient cone exists for the area bound), and a product a b of affine factors
+// whose sum is a positive constant (hfBlock's slab (x - v)(v + d - x)) becomes min(a, b).
 Expr measureForm(const Expr& f);
 
 }  // namespace frep
