@@ -378,8 +378,9 @@ Expr frMorphMinkowski(std::vector<Arg>& a) {
   double t = constArg(fn, a, 3, "the time t");
   if (!(t >= 0.0 && t <= 1.0)) throw LibraryError("frMorphMinkowski: t must be in [0, 1]", 3);
   Options o = parseOptions(fn, a, 4, n);
-  if (n == 3 && t > 0.0 && t < 1.0 && numParams(A.value) == 0 && numParams(B.value) == 0) {
-    // (1 - t) A ⊕ t B (eq. 4.5) without a search where the sum has an exact form.
+  if (n == 3 && t > 0.0 && t < 1.0 && numParams(A.value) == 0 && numParams(B.value) == 0 && a.size() == 4) {
+    // (1 - t) A ⊕ t B (eq. 4.5) without a search where the sum has an exact form; search options
+    // given explicitly ask for the search.
     Expr r;
     if (exactMinkowskiMorph(A, B, t, xs, &r)) return r;
     if (minkowski::meshConvexMorph(A.value, B.value, t, &r)) return through(r, xs, n);
