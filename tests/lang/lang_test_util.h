@@ -43,6 +43,23 @@ inline double valueOf(const std::string& expr, std::vector<double> x = {0, 0, 0}
   return evalModel(m, x);
 }
 
+// Whether f still holds an extremum node (a search), i.e. no exact path took the operation.
+inline bool hasExtremum(const Expr& f) {
+  bool found = false;
+  forEachNode(f, [&](const Node& n) { found = found || n.op == Op::Extremum; });
+  return found;
+}
+
+// The unit cube [0, 1]^3 as six flat Bezier patches: a closed mesh operand ("cube").
+inline const std::string kBezierCube =
+    "cube(x[3], a[1]) {\n"
+    "  array c[72];\n"
+    "  c = [0,0,0, 0,1,0, 1,0,0, 1,1,0,   0,0,1, 1,0,1, 0,1,1, 1,1,1,\n"
+    "       0,0,0, 1,0,0, 0,0,1, 1,0,1,   0,1,0, 0,1,1, 1,1,0, 1,1,1,\n"
+    "       0,0,0, 0,0,1, 0,1,0, 0,1,1,   1,0,0, 1,1,0, 1,0,1, 1,1,1];\n"
+    "  cube = frBezierSurface(x, c, 1, 1);\n"
+    "}\n";
+
 // Expects relative agreement to 1e-9 (absolute near zero).
 #define EXPECT_CLOSE(actual, expected)                                                  \
   do {                                                                                  \

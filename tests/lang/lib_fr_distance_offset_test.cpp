@@ -13,22 +13,9 @@
 namespace frep::lang::testing {
 namespace {
 
-const std::string kCube =
-    "cube(x[3], a[1]) {\n"
-    "  array c[72];\n"
-    "  c = [0,0,0, 0,1,0, 1,0,0, 1,1,0,   0,0,1, 1,0,1, 0,1,1, 1,1,1,\n"
-    "       0,0,0, 1,0,0, 0,0,1, 1,0,1,   0,1,0, 0,1,1, 1,1,0, 1,1,1,\n"
-    "       0,0,0, 0,0,1, 0,1,0, 0,1,1,   1,0,0, 1,1,0, 1,0,1, 1,1,1];\n"
-    "  cube = frBezierSurface(x, c, 1, 1);\n"
-    "}\n"
+const std::string kCube = kBezierCube +
     "ball(x[3], a[1]) { array c[3]; c = [0.1, -0.05, 0.2]; ball = frBall(x, 0.25, c); }\n"
     "b2(x[3], a[1]) { b2 = frBall(x, 0.15); }\n";
-
-bool hasExtremum(const Expr& f) {
-  bool found = false;
-  forEachNode(f, [&](const Node& n) { found = found || n.op == Op::Extremum; });
-  return found;
-}
 
 // Signed distance to [0, 1]^3, positive inside.
 double cubeDistance(double x, double y, double z) {

@@ -12,22 +12,9 @@
 namespace frep::lang::testing {
 namespace {
 
-const std::string kCube =
-    "cube(x[3], a[1]) {\n"
-    "  array c[72];\n"
-    "  c = [0,0,0, 0,1,0, 1,0,0, 1,1,0,   0,0,1, 1,0,1, 0,1,1, 1,1,1,\n"
-    "       0,0,0, 1,0,0, 0,0,1, 1,0,1,   0,1,0, 0,1,1, 1,1,0, 1,1,1,\n"
-    "       0,0,0, 0,0,1, 0,1,0, 0,1,1,   1,0,0, 1,1,0, 1,0,1, 1,1,1];\n"
-    "  cube = frBezierSurface(x, c, 1, 1);\n"
-    "}\n"
+const std::string kCube = kBezierCube +
     "blk(x[3], a[1]) { array v[3]; v = [-0.1, -0.2, 0]; blk = hfBlock(x, v, 0.3, 0.2, 0.1); }\n"
     "ball(x[3], a[1]) { ball = frBall(x, 0.15); }\n";
-
-bool hasExtremum(const Expr& f) {
-  bool found = false;
-  forEachNode(f, [&](const Node& n) { found = found || n.op == Op::Extremum; });
-  return found;
-}
 
 // Signed distance to the box [lo, hi], positive inside.
 double boxDistance(const std::array<double, 3>& p, const std::array<double, 3>& lo, const std::array<double, 3>& hi) {

@@ -9,12 +9,6 @@
 namespace frep::lang::testing {
 namespace {
 
-bool hasExtremum(const Expr& f) {
-  bool found = false;
-  forEachNode(f, [&](const Node& n) { found = found || n.op == Op::Extremum; });
-  return found;
-}
-
 double at(const Model& m, std::vector<double> x) { return evalModel(m, std::move(x)); }
 
 const std::string kParts =

@@ -17,12 +17,6 @@ const std::string kShapes =
     "b(x[3], a[1]) { b = frBall(x, 0.15); }\n"
     "blk(x[3], a[1]) { array v[3]; v = [-0.1, -0.1, -0.1]; blk = hfBlock(x, v, 0.2, 0.2, 0.2); }\n";
 
-bool hasExtremum(const Expr& f) {
-  bool found = false;
-  forEachNode(f, [&](const Node& n) { found = found || n.op == Op::Extremum; });
-  return found;
-}
-
 double statedBound(const Expr& f) {
   const auto lines = minkowski::describeExact(f);
   EXPECT_EQ(lines.size(), 1u);
