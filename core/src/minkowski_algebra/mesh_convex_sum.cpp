@@ -202,9 +202,9 @@ class MeshConvexSumField : public DistanceField {
       soupTris.insert(soupTris.end(), {base, base + 1, base + 2});
     };
     std::vector<Bvh::Box> boxes;
-    std::vector<V3> bLo(1, {INFINITY, INFINITY, INFINITY}), bHi(1, {-INFINITY, -INFINITY, -INFINITY});
+    V3 bLo{INFINITY, INFINITY, INFINITY}, bHi{-INFINITY, -INFINITY, -INFINITY};  // B's box
     for (const V3& p : b.v)
-      for (int k = 0; k < 3; ++k) bLo[0][size_t(k)] = std::min(bLo[0][size_t(k)], p[size_t(k)]), bHi[0][size_t(k)] = std::max(bHi[0][size_t(k)], p[size_t(k)]);
+      for (size_t k = 0; k < 3; ++k) bLo[k] = std::min(bLo[k], p[k]), bHi[k] = std::max(bHi[k], p[k]);
     // B's facet normals, one per plane (a triangulated face gives several triangles).
     std::vector<V3> bNormals;
     for (const V3& n : b.faceN) {
@@ -246,8 +246,8 @@ class MeshConvexSumField : public DistanceField {
       cells_.push_back({first, uint32_t(planes_.size()) - first});
       Bvh::Box box;
       for (int k = 0; k < 3; ++k) {
-        box.lo[k] = std::min({tv[0][size_t(k)], tv[1][size_t(k)], tv[2][size_t(k)]}) + bLo[0][size_t(k)] - tol;
-        box.hi[k] = std::max({tv[0][size_t(k)], tv[1][size_t(k)], tv[2][size_t(k)]}) + bHi[0][size_t(k)] + tol;
+        box.lo[k] = std::min({tv[0][size_t(k)], tv[1][size_t(k)], tv[2][size_t(k)]}) + bLo[size_t(k)] - tol;
+        box.hi[k] = std::max({tv[0][size_t(k)], tv[1][size_t(k)], tv[2][size_t(k)]}) + bHi[size_t(k)] + tol;
       }
       boxes.push_back(box);
     }
