@@ -153,6 +153,7 @@ ExtremumResult ExtremumSolver::Impl::grid(const double* X) {
   std::vector<double> t(p), u(m);
   size_t best = 0;
   for (size_t start = 0; start < total; start += B) {
+    if ((start / B) % 64 == 63) checkInterrupt();  // a fine grid over 3+ parameters is long
     const size_t count = std::min(B, total - start);
     for (size_t i = 0; i < count; ++i) {
       size_t idx = start + i;
@@ -229,20 +230,29 @@ ExtremumSolver::ExtremumSolver(std::shared_ptr<const ExtremumSpec> spec, TapePtr
 }
 ExtremumSolver::~ExtremumSolver() = default;
 
+// Every search starts by checking the run's interrupter (frep/interrupt/interrupter.h): the
+// evaluators reach the searches without a parameter for it.
 ExtremumResult ExtremumSolver::solve(const double* X, const double* warmT) {
+  checkInterrupt();
   if (spec_->method == ExtremumMethod::Grid) return impl_->grid(X);
   return impl_->branchAndBound(X, warmT);
 }
 ExtremumResult ExtremumSolver::solveSign(const double* X) {
+  checkInterrupt();
   if (spec_->method == ExtremumMethod::BranchAndBound && impl_->useTerms)
     return impl_->branchAndBoundTerms(X, nullptr, true);
   return solve(X);
 }
-ExtremumResult ExtremumSolver::solveGrid(const double* X) { return impl_->grid(X); }
+ExtremumResult ExtremumSolver::solveGrid(const double* X) {
+  checkInterrupt();
+  return impl_->grid(X);
+}
 ExtremumResult ExtremumSolver::solveBranchAndBound(const double* X, const double* warmT) {
+  checkInterrupt();
   return impl_->branchAndBound(X, warmT);
 }
 Interval ExtremumSolver::bound(const Interval* X, bool signOnly, bool budgetOnly) {
+  checkInterrupt();
   return impl_->bound(X, signOnly, budgetOnly);
 }
 

@@ -13,6 +13,7 @@
 #include "extremum/extremum_terms.h"
 #include "frep/evaluators/eval.h"
 #include "frep/extremum/extremum.h"
+#include "frep/interrupt/interrupter.h"
 
 namespace frep {
 
@@ -212,7 +213,7 @@ struct ExtremumSolver::Impl {
         break;
       }
       if (!atTop(top)) continue;
-      ++splits;
+      if (++splits % 64 == 0) checkInterrupt();  // up to maxBoxes splits in one search
       const uint32_t d = widestDim(lo.data(), hi.data());
       const double mid = 0.5 * (lo[d] + hi[d]);
       if (!(mid > lo[d] && mid < hi[d])) {  // cannot split further: keep its bound

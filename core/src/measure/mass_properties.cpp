@@ -448,13 +448,32 @@ MassProperties measureMassProperties(const TapePtr& tape, const Interval box[3],
       }
 
   std::vector<Cell> inside, boundary;
+  std::vector<Cell> splitParents;  // the boundary leaves the last round split: its fallback
   double insideVolume = 0.0, insideCap = 0.0;
   unsigned insideCapMask = 0;
+  const Interrupter* run = InterruptScope::choose(opt.interrupt);
+  InterruptScope quiet(nullptr);  // checked only where a cancel leaves valid bounds (below)
+  auto stop = [&](const char* reason) {
+    out.stopped = true;
+    out.stopReason = reason;
+  };
   for (int round = 0;; ++round) {
-    parallelChunks(pending.size(), 8, opt.threads, [&](size_t b, size_t e) {
-      Worker& w = workers.local();
-      for (size_t i = b; i < e; ++i) evaluateCell(pending[i], w, box);
-    });
+    try {
+      InterruptScope scope(run);
+      parallelChunks(pending.size(), 8, opt.threads, [&](size_t b, size_t e) {
+        Worker& w = workers.local();
+        for (size_t i = b; i < e; ++i) evaluateCell(pending[i], w, box);
+      });
+    } catch (const Interrupted&) {
+      // Cancelled inside a round: its children are half evaluated, so the leaves of the last
+      // whole round stand (their bounds hold). In the first round there are none.
+      if (round == 0) throw;
+      for (Cell& c : splitParents) boundary.push_back(std::move(c));
+      pending.clear();
+      stop("cancelled");
+      break;
+    }
+    splitParents.clear();
     for (Cell& c : pending) {
       if (c.cls == kInside) {
         double h[3];
@@ -504,14 +523,20 @@ MassProperties measureMassProperties(const TapePtr& tape, const Interval box[3],
       out.stopReason = "tolerance reached";
       break;
     }
-    if (opt.progress && !opt.progress(pr)) {
-      out.stopped = true;
-      out.stopReason = "stopped by the caller";
+    if ((opt.cancel && opt.cancel->load()) || (run && run->cancelled())) {
+      stop("cancelled");
       break;
     }
-    if (opt.cancel && opt.cancel->load()) {
-      out.stopped = true;
-      out.stopReason = "cancelled";
+    if (run) {
+      try {
+        run->progress("measure", uint64_t(out.rounds), 0);  // total unknown: rounds until the tolerance
+      } catch (const Interrupted&) {
+        stop("cancelled");
+        break;
+      }
+    }
+    if (opt.progress && !opt.progress(pr)) {
+      stop("stopped by the caller");
       break;
     }
 
@@ -577,6 +602,7 @@ MassProperties measureMassProperties(const TapePtr& tape, const Interval box[3],
         ch.depth = c.depth + 1;
         pending.push_back(std::move(ch));
       }
+      splitParents.push_back(std::move(c));
     }
     boundary = std::move(kept);
   }

@@ -13,6 +13,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
@@ -187,6 +188,7 @@ class RegionMesher {
   }
 
   MeshPiece run() {
+    InterruptScope scope(InterruptScope::choose(opt_.interrupt));  // the sampler below takes it too
     MeshPiece piece;
     piece.regionLo = {int32_t(lo_[0]), int32_t(lo_[1]), int32_t(lo_[2])};
     if (lo_[0] >= cellHi_[0] || lo_[1] >= cellHi_[1] || lo_[2] >= cellHi_[2]) return piece;
@@ -269,9 +271,11 @@ class RegionMesher {
     tbb::enumerable_thread_specific<RootWorker> workers;
     constexpr size_t B = BatchEvaluator<double>::kBatch;
     static_assert(B <= BatchGradientEvaluator::kBatch, "a batch of roots gets its normals in one gradient batch");
+    std::atomic<uint64_t> groupsDone{0};
     parallelChunks(groupStart.size() - 1, 1, opt_.threads, [&](size_t gb, size_t ge) {
       RootWorker& w = workers.local();
       for (size_t g = gb; g < ge; ++g) {
+        reportProgress("mesh", ++groupsDone, groupStart.size() - 1);
         TapePtr tape = blockTape(w, order[groupStart[g]].first);
         for (size_t start = groupStart[g]; start < groupStart[g + 1]; start += B) {
           size_t count = std::min(B, groupStart[g + 1] - start);

@@ -419,6 +419,7 @@ SimplifyStats simplifyMesh(Mesh& mesh, const TapePtr& tape, const GridSpec& grid
   stats.trianglesBefore = stats.trianglesAfter = mesh.triangles.size() + 2 * mesh.carry.counters.collapses;
   if (!(options.tolerance > 0) || mesh.triangles.empty()) return stats;
   checkTolerance(options.tolerance, grid);
+  InterruptScope scope(InterruptScope::choose(options.interrupt));
   Work w = workOf(std::move(mesh), options.threads);
   stats += mesh.carry.counters;  // the regions' share (simplifyRegion in the workers)
   mesh.carry = SimplifyCarry();
@@ -449,6 +450,7 @@ void simplifyRegion(MeshPiece& piece, const TapePtr& tape, const GridSpec& grid,
                     const std::array<int32_t, 3>& lo, const std::array<int32_t, 3>& hi) {
   if (!(options.tolerance > 0) || piece.triangles.empty()) return;
   checkTolerance(options.tolerance, grid);
+  InterruptScope scope(InterruptScope::choose(options.interrupt));
   Mesh m;  // the piece as a mesh: its vertices are in key order, its triangles canonical
   m.positions.reserve(piece.vertices.size()), m.normals.reserve(piece.vertices.size()), m.keys.reserve(piece.vertices.size());
   for (const MeshVertex& v : piece.vertices) {

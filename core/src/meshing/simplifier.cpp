@@ -46,6 +46,10 @@ const SimplifyStats& Simplifier::run() {
       purgeAt = 2 * queue_.size() + 1024;
     }
     if (report && (examined & 4095) == 0) opt_.progress(kGlobalStage, examined, examined + queue_.size());
+    if ((examined & 1023) == 0) {  // each collapse checks its error at up to 64^2 points
+      if (w_.confined) checkInterrupt();
+      else reportProgress("simplify", examined, examined + queue_.size());
+    }
     ++examined;
     Candidate c = queue_.top();
     queue_.pop();

@@ -10,6 +10,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -290,16 +291,19 @@ std::vector<RayHit> castRegion(const TapePtr& view, const Camera& camera, const 
     throw std::invalid_argument("render: the region [" + std::to_string(region.c0) + "," + std::to_string(region.c1) +
                                 ")x[" + std::to_string(region.r0) + "," + std::to_string(region.r1) +
                                 ") is not made of whole " + std::to_string(kRenderTile) + "-pixel tiles of the image");
+  InterruptScope scope(InterruptScope::choose(opt.interrupt));
   std::vector<RayHit> hits(size_t(region.c1 - region.c0) * size_t(region.r1 - region.r0));
   Caster caster(camera, opt, view, region, hits);
   const int tx0 = region.c0 / kRenderTile, ty0 = region.r0 / kRenderTile;
   const int tilesX = (region.c1 - 1) / kRenderTile + 1 - tx0, tilesY = (region.r1 - 1) / kRenderTile + 1 - ty0;
   tbb::enumerable_thread_specific<Worker> workers;
+  std::atomic<uint64_t> tilesDone{0};
   parallelChunks(size_t(tilesX) * size_t(tilesY), 1, opt.threads, [&](size_t b, size_t e) {
     Worker& w = workers.local();
     for (size_t t = b; t < e; ++t) {
       const int c0 = (tx0 + int(t % size_t(tilesX))) * kRenderTile, r0 = (ty0 + int(t / size_t(tilesX))) * kRenderTile;
       caster.topTile(w, c0, std::min(c0 + kRenderTile, region.c1), r0, std::min(r0 + kRenderTile, region.r1));
+      reportProgress("render", ++tilesDone, size_t(tilesX) * size_t(tilesY));
     }
   });
   if (stats) {

@@ -1,6 +1,7 @@
 // Internal to core: one way to run a loop over [0, n) in chunks, and to sort, with a
 // thread-count option (1: serial on the calling thread, > 1: that many threads, 0: TBB's
-// default), shared by the sampler, both meshers and the simplifier.
+// default), shared by the sampler, both meshers and the simplifier. Each chunk runs under the
+// caller's interrupter (frep/interrupt/interrupter.h), checked before it starts.
 #pragma once
 
 #include <tbb/blocked_range.h>
@@ -11,12 +12,19 @@
 #include <algorithm>
 #include <cstddef>
 
+#include "frep/interrupt/interrupter.h"
+
 namespace frep {
 
 // fn(begin, end) for chunks of at least `grain` items.
 template <typename Fn>
 void parallelChunks(size_t n, size_t grain, int threads, Fn&& fn) {
-  auto body = [&](const tbb::blocked_range<size_t>& r) { fn(r.begin(), r.end()); };
+  const Interrupter* run = currentInterrupter();
+  auto body = [&](const tbb::blocked_range<size_t>& r) {
+    InterruptScope scope(run);  // a TBB thread may come from another run: this chunk is ours
+    if (run) run->check();
+    fn(r.begin(), r.end());
+  };
   if (n == 0) return;
   if (threads == 1) {
     body(tbb::blocked_range<size_t>(0, n));

@@ -14,6 +14,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -76,6 +77,7 @@ class Sampler {
   }
 
   SampleResult run() {
+    InterruptScope scope(InterruptScope::choose(opt_.interrupt));
     // Level 1 (serial): descend to cubes of at most 32^3, collecting the ambiguous ones.
     int64_t side = kLeafDim;
     while (side < std::max({hi_[0] - lo_[0], hi_[1] - lo_[1], hi_[2] - lo_[2]})) side *= 2;
@@ -85,9 +87,13 @@ class Sampler {
 
     // Level 2 (parallel): each work cube independently down to the voxels.
     tbb::enumerable_thread_specific<Worker> workers;
+    std::atomic<uint64_t> cubesDone{0};
     parallelChunks(work.size(), 1, opt_.threads, [&](size_t b, size_t e) {
       Worker& w = workers.local();
-      for (size_t i = b; i != e; ++i) cube(w, work[i].first, kWorkSide, work[i].second);
+      for (size_t i = b; i != e; ++i) {
+        cube(w, work[i].first, kWorkSide, work[i].second);
+        reportProgress("sample", ++cubesDone, work.size());  // a chunk is all cubes when serial
+      }
     });
 
     SampleResult res;

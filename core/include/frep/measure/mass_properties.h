@@ -31,6 +31,7 @@
 
 #include "frep/evaluators/interval.h"
 #include "frep/expressions/tape.h"
+#include "frep/interrupt/interrupter.h"
 
 namespace frep {
 
@@ -58,6 +59,10 @@ struct MeasureOptions {
   // Called after every round; return false to stop early (the bounds so far are valid).
   std::function<bool(const MeasureProgress&)> progress;
   const std::atomic<bool>* cancel = nullptr;  // set: stop after the current round
+  // Cancelled: stop within the current round and return the last whole round's bounds (valid,
+  // stopped = true); in the first round, throw Interrupted. Progress: ("measure", rounds, 0).
+  // Null: the caller's.
+  const Interrupter* interrupt = nullptr;
 };
 
 struct MassProperties {

@@ -141,6 +141,8 @@ struct MeshOptions {
   // Roots are kept at least this fraction of the edge away from its ends, so no two vertices
   // coincide and no triangle is degenerate (the surface moves by at most this much).
   double endGuard = 1e-3;
+  // Cancel and progress ("mesh": leaves' vertex groups started of total); null: the caller's.
+  const Interrupter* interrupt = nullptr;
 };
 
 // Triangles of the cells whose minimum corner is in [lo, hi) (index space; lo a multiple of 8,

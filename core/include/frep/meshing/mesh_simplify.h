@@ -63,6 +63,9 @@ struct SimplifyOptions {
   // (collapse candidates examined of examined + queued, so its total grows). Never changes the
   // result.
   std::function<void(int stage, uint64_t done, uint64_t total)> progress;
+  // Cancel (checked every 1024 candidates and every block) and progress ("simplify": the global
+  // pass's candidates examined of examined + queued); null: the caller's.
+  const Interrupter* interrupt = nullptr;
 };
 
 struct SimplifyStats : SimplifyCounters {

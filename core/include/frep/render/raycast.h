@@ -25,6 +25,7 @@
 #include "frep/expressions/expr.h"
 #include "frep/expressions/tape.h"
 #include "frep/geometry/vec3.h"
+#include "frep/interrupt/interrupter.h"
 
 namespace frep {
 
@@ -58,6 +59,8 @@ struct RenderOptions {
   double nearDepth = 0.0, farDepth = 1.0;  // depth range searched (d in Camera's frame)
   int threads = 0;                          // 0: TBB's default, 1: serial
   bool footprint = true;                    // search pixel footprints where the centre ray misses
+  // Cancel and progress ("render": tiles done of total); null: the caller's.
+  const Interrupter* interrupt = nullptr;
 };
 
 struct RenderStats {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "frep/expressions/tape.h"
+#include "frep/interrupt/interrupter.h"
 
 namespace frep {
 
@@ -90,6 +91,8 @@ struct SampleOptions {
   std::array<int32_t, 3> regionHi{-1, -1, -1};
   std::vector<double> fixedCoords;  // values of x[3], x[4], ... for models of dimension > 3
   int threads = 0;                  // 0: TBB's default; 1: serial (deterministic either way)
+  // Cancel and progress ("sample": work cubes done of total); null: the caller's, if any.
+  const Interrupter* interrupt = nullptr;
 };
 
 struct SampleStats {
