@@ -35,11 +35,12 @@ got="$("$tmp/consumer-pc")"
 [ "$got" = "$expect" ] || { echo "pkg-config consumer printed '$got', expected $expect"; exit 1; }
 echo "pkg-config frepfarm: $got"
 
-# The Python module, when it was built: installed under the prefix, importable from there.
+# The Python package, when it was built: installed under the prefix (site/frepfarm/), importable
+# from there.
 module="$(find "$prefix" -name 'frepfarm*.so' | head -n 1)"
-if ls "$build"/python/frepfarm*.so >/dev/null 2>&1; then
+if ls "$build"/python/frepfarm/frepfarm*.so >/dev/null 2>&1; then
   [ -n "$module" ] || { echo "the Python module was built but not installed"; exit 1; }
-  got="$(cd "$tmp" && PYTHONPATH="$(dirname "$module")" /usr/bin/python3 -c \
+  got="$(cd "$tmp" && PYTHONPATH="$(dirname "$(dirname "$module")")" /usr/bin/python3 -c \
     'import frepfarm; print(frepfarm.compile("my_model(x[3], a[1]) { my_model = 1 - x[1]^2 - x[2]^2 - x[3]^2; }").eval([0.5, 0.25, 0.0])[0])')"
   [ "$got" = "$expect" ] || { echo "installed Python module printed '$got', expected $expect"; exit 1; }
   echo "installed Python module ($module): $got"
