@@ -29,6 +29,7 @@
 #include "frep/primitives/ops.h"
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/sampling/sample.h"
+#include "interruptible.h"
 
 namespace py = pybind11;
 using namespace frep;
@@ -99,7 +100,8 @@ Model loadModel(const std::string& path, const std::string& object, const std::v
 }
 
 // f at each row of an (N, dims) array, by the batch evaluator (256 points per call).
-py::array_t<double> evalPoints(const Model& m, py::array_t<double, py::array::c_style | py::array::forcecast> points) {
+py::array_t<double> evalPoints(const Model& m, py::array_t<double, py::array::c_style | py::array::forcecast> points,
+                               py::object progress) {
   if (points.ndim() == 1 && points.shape(0) == m.dims) points = points.reshape({py::ssize_t(1), py::ssize_t(m.dims)});
   if (points.ndim() != 2 || points.shape(1) != m.dims)
     throw py::value_error("points: expected an array of shape (N, " + std::to_string(m.dims) + ") for object '" +
@@ -108,12 +110,12 @@ py::array_t<double> evalPoints(const Model& m, py::array_t<double, py::array::c_
   py::array_t<double> out{py::ssize_t(n)};
   const double* in = points.data();
   double* res = out.mutable_data();
-  {
-    py::gil_scoped_release unlocked;
+  python::interruptible(progress, [&] {
     BatchEvaluator<double> eval;
     eval.reserve(*m.tape);
     const uint32_t vars = m.tape->numVars();
     for (size_t start = 0; start < n; start += BatchEvaluator<double>::kBatch) {
+      if (start % (64 * BatchEvaluator<double>::kBatch) == 0) reportProgress("eval", start, n);
       const size_t count = std::min(BatchEvaluator<double>::kBatch, n - start);
       for (uint32_t v = 0; v < vars; ++v) {
         double* lane = eval.in(v);
@@ -122,7 +124,8 @@ py::array_t<double> evalPoints(const Model& m, py::array_t<double, py::array::c_
       const double* values = eval.eval(*m.tape, count);
       std::copy(values, values + count, res + start);
     }
-  }
+    return true;
+  });
   return out;
 }
 
@@ -152,17 +155,14 @@ struct Volume {
 };
 
 Volume sampleModel(const Model& m, std::array<double, 3> lo, std::array<double, 3> hi, int res, int band,
-                   const std::vector<double>& fixed) {
+                   const std::vector<double>& fixed, py::object progress) {
   if (band < 1 || band > 64) throw py::value_error("band: expected 1 to 64 voxels");
   SampleOptions options;
   options.bandVoxels = band;
   options.fixedCoords = fixedCoordsOf(m, fixed);
   GridSpec grid = gridOf(lo, hi, res);
   Volume v;
-  {
-    py::gil_scoped_release unlocked;
-    v.result = sample(m.tape, grid, options);
-  }
+  v.result = python::interruptible(progress, [&] { return sample(m.tape, grid, options); });
   v.name = m.name;
   v.sourceHash = m.sourceHash;
   v.iso = m.iso;
@@ -214,7 +214,7 @@ struct PyMesh {
 };
 
 PyMesh meshModel(const Model& m, std::array<double, 3> lo, std::array<double, 3> hi, int res, double simplify,
-                 const std::vector<double>& fixed) {
+                 const std::vector<double>& fixed, py::object progress) {
   // As frep mesh --tolerance: NaN or an infinity would make simplification spin without end.
   if (!(simplify == 0 || (simplify >= kMinSimplifyTolerance && simplify <= kMaxSimplifyTolerance)))
     throw py::value_error("simplify: expected 0 (no simplification) or 1e-30 to 1e30 voxels");
@@ -222,7 +222,7 @@ PyMesh meshModel(const Model& m, std::array<double, 3> lo, std::array<double, 3>
   MeshOptions options;
   options.fixedCoords = fixedCoordsOf(m, fixed);
   PyMesh out;
-  py::gil_scoped_release unlocked;
+  python::interruptible(progress, [&] {
   // As frep mesh: a solid cut by the box is meshed as solid ∩ box, capped 2e-3 voxel inside the
   // box's faces on a grid one voxel larger, and the result must be closed.
   TapePtr tape = m.tape;
@@ -243,6 +243,8 @@ PyMesh meshModel(const Model& m, std::array<double, 3> lo, std::array<double, 3>
     s.fixedCoords = options.fixedCoords;
     out.errorBound = simplifyMesh(out.mesh, tape, grid, s).errorBound;
   }
+  return true;
+  });
   const std::string defect = closureDefect(out.mesh.triangles, out.mesh.positions.size());
   if (!defect.empty()) throw std::runtime_error("internal error: the mesh is not closed (" + defect + ")");
   return out;
@@ -267,7 +269,7 @@ py::list tensorList(const std::array<MeasureBound, 9>& t) {
 
 // As frep measure --json: certified bounds of solid ∩ [lo, hi] (frep/measure/mass_properties.h).
 py::dict measureModel(const Model& m, std::array<double, 3> lo, std::array<double, 3> hi, double tolerance,
-                      int threads, long long maxCells) {
+                      int threads, long long maxCells, py::object progress) {
   if (m.dims != 3) throw py::value_error("measure: the object has x[" + std::to_string(m.dims) + "]; measure needs a 3D object");
   if (!(tolerance > 0.0 && tolerance < 1.0)) throw py::value_error("tolerance: expected a relative width in (0, 1), e.g. 0.005");
   if (maxCells < 1000) throw py::value_error("max_cells: expected at least 1000");
@@ -279,18 +281,10 @@ py::dict measureModel(const Model& m, std::array<double, 3> lo, std::array<doubl
   options.tolerance = tolerance;
   options.threads = threads;
   options.maxBoundaryCells = uint64_t(maxCells);
-  bool interrupted = false;
-  options.progress = [&interrupted](const MeasureProgress&) {
-    py::gil_scoped_acquire locked;  // Ctrl-C: stop after this round, then KeyboardInterrupt
-    if (PyErr_CheckSignals() != 0) interrupted = true;
-    return !interrupted;
-  };
-  MassProperties r;
-  {
-    py::gil_scoped_release unlocked;
-    r = measureMassProperties(m.field, box, options);
-  }
-  if (interrupted) throw py::error_already_set();
+  // Ctrl-C: KeyboardInterrupt; progress returning False: the last whole round's bounds,
+  // stop_reason "cancelled".
+  const MassProperties r =
+      python::interruptible(progress, [&] { return measureMassProperties(m.field, box, options); });
   py::dict d;
   d["volume"] = boundDict(r.volume);
   d["area"] = boundDict(r.area);
@@ -338,11 +332,14 @@ PYBIND11_MODULE(frepfarm, mod) {
 
   static py::exception<ModelError> modelError(mod, "ModelError", PyExc_ValueError);
   static py::exception<io::Error> ioErrorType(mod, "IoError", PyExc_OSError);
+  static py::exception<python::Cancelled> cancelledType(mod, "Cancelled", PyExc_RuntimeError);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const ModelError& e) {
       modelError(e.what());
+    } catch (const python::Cancelled& e) {
+      cancelledType(e.what());
     } catch (const io::Error& e) {
       if (e.code == io::kExitBadArgs) PyErr_SetString(PyExc_ValueError, e.what());
       else ioErrorType(e.what());
@@ -354,17 +351,17 @@ PYBIND11_MODULE(frepfarm, mod) {
       .def_readonly("dims", &Model::dims, "n of the object's x[n]")
       .def_readonly("objects", &Model::objects, "every object in the source")
       .def_readonly("warnings", &Model::warnings)
-      .def("eval", &evalPoints, py::arg("points"),
+      .def("eval", &evalPoints, py::arg("points"), py::arg("progress") = py::none(),
            "f at each row of an (N, dims) float64 array (or one point of length dims): N values")
       .def("sample", &sampleModel, py::arg("lo"), py::arg("hi"), py::arg("res") = 128, py::arg("band") = 3,
-           py::arg("fixed") = std::vector<double>{},
+           py::arg("fixed") = std::vector<double>{}, py::arg("progress") = py::none(),
            "Sparse narrow-band sampling of the box [lo, hi] with res points along its longest axis")
       .def("mesh", &meshModel, py::arg("lo"), py::arg("hi"), py::arg("res") = 128, py::arg("simplify") = 0.0,
-           py::arg("fixed") = std::vector<double>{},
+           py::arg("fixed") = std::vector<double>{}, py::arg("progress") = py::none(),
            "Watertight mesh of f = 0 in [lo, hi]; simplify > 0: tolerance in voxels (frep mesh's 0.1)")
       .def("measure", &measureModel, py::arg("lo") = std::array<double, 3>{-10, -10, -10},
            py::arg("hi") = std::array<double, 3>{10, 10, 10}, py::arg("tolerance") = 0.005, py::arg("threads") = 0,
-           py::arg("max_cells") = 2000000LL,
+           py::arg("max_cells") = 2000000LL, py::arg("progress") = py::none(),
            "Certified volume, area, centroid and inertia tensors of solid ∩ [lo, hi] as lower/upper bounds "
            "(frep measure --json's dict; docs/measure.md)");
 
