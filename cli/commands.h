@@ -139,6 +139,20 @@ int runRender(const RenderRequest& request);
 bool isMeshOrVdb(const std::string& path);
 int runRenderMesh(const RenderRequest& request);
 
+// frep view: a local web page showing the model in 3D with slices and frep mesh's report,
+// recomputed on every save of the file (view_command.cpp, docs/view.md).
+struct ViewRequest {
+  ModelRequest model;
+  std::string bounds;            // -b, passed to frep mesh and frep slice ("" = hfp's ±10)
+  int res = 0;                   // --res of frep mesh (0: its default)
+  std::string cells;             // -g of frep mesh
+  int workers = -1;              // --workers of frep mesh (-1: its default, one per core)
+  std::string host = "127.0.0.1";
+  int port = 8080;               // 0: any free port (printed)
+  std::string logLevel = "info"; // passed to the frep mesh children
+};
+int runView(const ViewRequest& request);
+
 int runKeygen(const std::string& dir, bool force);  // force: replace existing keys
 
 // frep pov: a scene with `$ ... <+> ... $` Minkowski terms, or a .hf model built from the basic

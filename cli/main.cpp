@@ -254,13 +254,24 @@ int main(int argc, char** argv) {
   renderCmd->add_flag("--no-footprint", render.noFootprint,
                       "Cast centre rays only (sub-pixel features between pixel centres are then not drawn)");
 
+  ViewRequest view;
+  CLI::App* viewCmd = app.add_subcommand("view", "Local web page showing the model in 3D with slices and the mesh "
+                                                 "report, updated on every save (docs/view.md)");
+  addModelOptions(viewCmd, view.model, true);
+  viewCmd->add_option("-b,--bounds", view.bounds, "Box: B | min,max | bx,by,bz | xmin,ymin,zmin,xmax,ymax,zmax (default 10)");
+  viewCmd->add_option("--res", view.res, "Points of frep mesh along the longest axis (default 128)");
+  viewCmd->add_option("-g,--grid", view.cells, "Cells per axis of frep mesh, hfp style: N or Nx,Ny,Nz (instead of --res)");
+  viewCmd->add_option("--workers", view.workers, "Local workers of frep mesh (default: one per core; 0 in-process)");
+  viewCmd->add_option("--host", view.host, "Address to serve on (default 127.0.0.1: this machine only)");
+  viewCmd->add_option("--port", view.port, "Port to serve on (default 8080; 0: any free port, printed)");
+
   std::string keygenDir;
   CLI::App* keygenCmd = app.add_subcommand("keygen", "Write CURVE keys for a farm on a shared network");
   keygenCmd->add_option("dir", keygenDir, "Directory for the keys")->required();
   bool keygenForce = false;
   keygenCmd->add_flag("--force", keygenForce, "Replace the keys DIR already has (workers holding the old ones are locked out)");
 
-  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, povCmd, renderCmd, measureCmd}) sub->fallthrough();
+  for (CLI::App* sub : {check, evalCmd, sliceCmd, sampleCmd, meshCmd, povCmd, renderCmd, measureCmd, viewCmd}) sub->fallthrough();
 
   try {
     app.parse(argc, argv);
@@ -268,7 +279,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::string message = e.what();
     if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov, relate, measure, render and keygen";
+      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov, relate, measure, render, view and keygen";
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
     return kExitBadArgs;
   }
@@ -289,6 +300,11 @@ int main(int argc, char** argv) {
     if (sliceCmd->parsed()) {
       checkObjectIsNotAFile(slice.model);
       return runSlice(slice);
+    }
+    if (viewCmd->parsed()) {
+      checkObjectIsNotAFile(view.model);
+      view.logLevel = logLevel;
+      return runView(view);
     }
     if (keygenCmd->parsed()) return runKeygen(keygenDir, keygenForce);
     if (povCmd->parsed()) return runPov(pov);
