@@ -17,6 +17,7 @@ _frep_options() {
     pov) echo "-h --help -o --object -O --out --thin" ;;
     relate) echo "-h --help --object-a --object-b -b --bounds --min-size --at" ;;
     measure) echo "-h --help $model -b --bounds --tolerance --threads --max-cells --json --no-progress" ;;
+    view) echo "-h --help $model -b --bounds --res -g --grid --workers --host --port" ;;
     keygen) echo "-h --help --force" ;;
   esac
 }
@@ -25,7 +26,7 @@ _frep() {
   local cur prev verb i
   cur="${COMP_WORDS[COMP_CWORD]}"
   prev="${COMP_WORDS[COMP_CWORD-1]}"
-  local verbs="check eval slice sample mesh render pov relate measure keygen"
+  local verbs="check eval slice sample mesh render pov relate measure view keygen"
   for ((i = 1; i < COMP_CWORD; i++)); do
     case "${COMP_WORDS[i]}" in
       --log-level) ((i++)) ;;
@@ -45,7 +46,8 @@ _frep() {
     -o|--object|--object-a|--object-b|-a|--params|-x|--map|-i|--iso|-b|--bounds|--res|-g|--grid|--at|--tolerance|\
     --gs|--up|--size|--azimuth|--elevation|--distance|--zoom|--eye|--target|--fov|--background|--colour|--color|--frames|\
     --t-frames|--t-range|--v-range|--v-cells|--w-range|--w-cells|--c-range|--c-levels|--g-values|\
-    --band|--workers|--threads|--listen|--expect-workers|--brick|--heartbeat-ms|--thin|--min-size|--verify|--max-cells)
+    --band|--workers|--threads|--listen|--expect-workers|--brick|--heartbeat-ms|--thin|--min-size|--verify|--max-cells|\
+    --host|--port)
       return ;;  # a value: nothing to offer
   esac
   if [[ -z "$verb" ]]; then
