@@ -149,7 +149,7 @@ TEST_F(FrepTest, BadArgumentsNameTheField) {
       {"slice s.hf --res 16", "frep: error: -O/--out: the output PNG path is required"},
       {"sample s.hf --band 0 -O s.vdb", "frep: error: --band: expected an integer from 1 to 64 (voxels), got 0"},
       {"eval s.hf", "--at is required"},
-      {"frob s.hf", "frep: error: unknown verb 'frob'; the verbs are check, eval, slice, sample, mesh, pov, relate, measure, render and keygen"},
+      {"frob s.hf", "frep: error: unknown verb 'frob'; the verbs are check, eval, slice, sample, mesh, pov, relate, measure, render, view and keygen"},
       {"eval s.hf --at 0,0,0 --log-level loud", "--log-level"},
   };
   for (const Case& c : cases) {
