@@ -576,8 +576,15 @@ def _compile(root, iso):
         if grids:
             import pyopenvdb
             for i, g in enumerate(grids):
-                files[id(g)] = os.path.join(tmp, "grid%d.vdb" % i)
-                pyopenvdb.write(files[id(g)], grids=[g])
+                if id(g) in files:
+                    continue  # one grid in several volume() shapes
+                path = files[id(g)] = os.path.join(tmp, "grid%d.vdb" % i)
+                if "frep_grid_checksum" in g:
+                    # The checksum is of the bytes frep wrote; pyopenvdb writes other bytes, so
+                    # frep would read the grid as rewritten by a foreign tool (with a warning).
+                    g = g.deepCopy()
+                    del g["frep_grid_checksum"]
+                pyopenvdb.write(path, grids=[g])
         text, spans = _program(root, "my_model", files)
         try:
             # frVolume reads the file's bytes here, once: the model keeps the grid.
