@@ -58,7 +58,7 @@ ChildResult runChild(const std::vector<std::string>& argv, const std::atomic<boo
       ::kill(pid, SIGTERM);
       termSent = std::chrono::steady_clock::now();
     }
-    if (r.cancelled && !killed && std::chrono::steady_clock::now() - termSent > std::chrono::seconds(5)) {
+    if (r.cancelled && !killed && std::chrono::steady_clock::now() - termSent > std::chrono::seconds(2)) {
       ::kill(pid, SIGKILL);  // a child that ignores the interrupt contract
       killed = true;
     }
@@ -80,6 +80,7 @@ ChildResult runChild(const std::vector<std::string>& argv, const std::atomic<boo
     if (f.fd >= 0) ::close(f.fd);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+  if (r.cancelled) r.stopSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - termSent).count();
   r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
   return r;
 }

@@ -161,7 +161,8 @@ void ViewSession::runJob(uint64_t generation, std::shared_ptr<std::atomic<bool>>
   std::lock_guard<std::mutex> lock(mutex_);
   if (r.cancelled) {
     ++interrupted_;
-    spdlog::info("save {}: interrupted by a newer save after {:.3f} s", generation, seconds);
+    spdlog::info("save {}: interrupted by a newer save after {:.3f} s; frep mesh stopped {:.3f} s after SIGTERM",
+                 generation, seconds, r.stopSeconds);
     return;  // the newer job owns the state
   }
   if (generation != generation_) return;

@@ -17,13 +17,18 @@ packages=(
   assimp-utils python3-stl  # independent readers of the mesh files in tests/cli/frep_mesh_formats_test.cpp
   clang libclang-rt-14-dev
   pybind11-dev python3-dev python3-numpy  # the Python module (python/)
+  libcpp-httplib-dev  # frep view's HTTP server (cli/view_command.cpp)
 )
 test_packages=(
   python3-pytest  # tests/python
   clang-format  # ctest clang_format (tests/format/check_format.py): clang-format 14 on Debian 12
   python3-yaml python3-jsonschema docker-compose  # tests/deploy: Compose v1 (docker-compose 1.29) and schemas
   slurm-wlm munge  # tests/deploy/slurm_e2e.sh: a real single-node Slurm (about 16 s to install)
+  chromium python3-websocket python3-pil  # tests/view: frep view's page in headless Chromium
 )
+# npm installs three.js for frep view's page (deploy/build.sh); Debian's npm, unless node's own
+# packages (e.g. NodeSource's nodejs, which conflicts with it) already provide the command.
+command -v npm >/dev/null || packages+=(npm)
 [ "${1:-}" = --build-only ] || packages+=("${test_packages[@]}")
 missing=()
 for p in "${packages[@]}"; do
