@@ -22,10 +22,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "allocator_tuning.h"
-#include "brick.h"
-#include "farm_master.h"
-#include "wire.h"
+#include "frep/worker/allocator_tuning.h"
+#include "frep/worker/brick.h"
+#include "frep/master/farm_master.h"
+#include "frep/net/wire.h"
 
 using namespace frep;
 using namespace frep::farm;

@@ -12,9 +12,9 @@
 #include <zmq.hpp>
 
 #include "arg_parse.h"
-#include "brick.h"
+#include "frep/worker/brick.h"
 #include "exit_codes.h"
-#include "journal.h"
+#include "frep/master/journal.h"
 
 namespace frep::cli {
 

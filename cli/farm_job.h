@@ -8,7 +8,7 @@
 
 #include "frep/io/atomic_output.h"
 #include "commands.h"
-#include "farm_master.h"
+#include "frep/master/farm_master.h"
 #include "frep/sampling/sample.h"
 #include "model_loader.h"
 

@@ -8,7 +8,7 @@
 
 #include "commands.h"
 #include "json_events.h"
-#include "status_line.h"
+#include "frep/master/status_line.h"
 #include "exit_codes.h"
 #include "frep/io/geometry_files.h"
 #include "hfp_invocation.h"
@@ -206,7 +206,7 @@ int main(int argc, char** argv) {
   povCmd->add_option("-O,--out", pov.out, "Output POV-Ray file (required)");
   povCmd->add_option("--thin", pov.thin, "Thickness of pieces without interior: segments, discs (default 0.01)");
   RelateRequest relate;
-  CLI::App* relateCmd = app.add_subcommand("relate", "Certified relations of two models: intersection, inclusion, point membership");
+  CLI::App* relateCmd = app.add_subcommand("relate", "Certified relations of two models: intersection, inclusion, clearance, penetration depth, point membership");
   relateCmd->add_option("a", relate.a.path, "Model A (.hf)")->required();
   relateCmd->add_option("b", relate.b.path, "Model B (.hf)")->required();
   relateCmd->add_option("--object-a", relate.a.object, "Object of A (default my_model, else the first)");
@@ -214,6 +214,9 @@ int main(int argc, char** argv) {
   relateCmd->add_option("-b,--bounds", relate.bounds, "Box searched (default 10)");
   relateCmd->add_option("--min-size", relate.minSize, "Smallest box edge of the subdivision (default 1e-4 of the box)");
   relateCmd->add_option("--at", relate.at, "Also classify the point X,Y,Z against both");
+  relateCmd->add_option("--distance-tol", relate.distanceTol,
+                        "Width of the clearance and penetration bounds (default 1e-4 of the box)");
+  relateCmd->add_flag("--json", relate.json, "One JSON object on stdout");
   MeasureRequest measure;
   CLI::App* measureCmd = app.add_subcommand("measure", "Certified volume, surface area, centroid and inertia tensor of a model "
                                                        "(lower and upper bounds; docs/measure.md)");

@@ -17,7 +17,7 @@
 #include "commands.h"
 #include "exit_codes.h"
 #include "frep/measure/mass_properties.h"
-#include "status_line.h"
+#include "frep/master/status_line.h"
 
 namespace frep::cli {
 namespace {

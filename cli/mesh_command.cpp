@@ -10,16 +10,16 @@
 #include <cstdio>
 #include <iostream>
 
-#include "allocator_tuning.h"
+#include "frep/worker/allocator_tuning.h"
 #include "arg_parse.h"
-#include "brick.h"
+#include "frep/worker/brick.h"
 #include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "exit_codes.h"
 #include "farm_job.h"
 #include "frep/attributes/colour.h"
 #include "json_events.h"
-#include "progress.h"
+#include "frep/master/progress.h"
 #include "frep/meshing/mesh.h"
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/io/mesh_writer.h"

@@ -27,7 +27,7 @@
 #include "frep/render/rasterize.h"
 #include "frep/render/raycast.h"
 #include "frep/render/shade.h"
-#include "brick.h"
+#include "frep/worker/brick.h"
 #include "geometric_types.h"
 
 namespace frep::cli {

@@ -8,17 +8,17 @@
 #include <iostream>
 #include <optional>
 
-#include "allocator_tuning.h"
+#include "frep/worker/allocator_tuning.h"
 #include "arg_parse.h"
-#include "brick.h"
+#include "frep/worker/brick.h"
 #include "frep/io/world_lattice.h"
 #include "frep/io/atomic_output.h"
 #include "commands.h"
-#include "curve.h"
+#include "frep/net/curve.h"
 #include "exit_codes.h"
 #include "farm_job.h"
 #include "json_events.h"
-#include "farm_master.h"
+#include "frep/master/farm_master.h"
 #include "sampling_grid.h"
 #include "frep/io/vdb_writer.h"
 

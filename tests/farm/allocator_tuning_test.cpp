@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "allocator_tuning.h"
+#include "frep/worker/allocator_tuning.h"
 
 using frep::farm::adviseHugePages;
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "crc32.h"
+#include "frep/farm/crc32.h"
 
 using namespace frep::farm;
 

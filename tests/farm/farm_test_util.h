@@ -20,9 +20,9 @@
 
 #include <zmq.hpp>
 
-#include "brick.h"
-#include "farm_master.h"
-#include "wire.h"
+#include "frep/worker/brick.h"
+#include "frep/master/farm_master.h"
+#include "frep/net/wire.h"
 
 extern char** environ;
 

@@ -12,7 +12,7 @@
 #include <zmq_addon.hpp>
 
 #include "farm_test_util.h"
-#include "wire.h"
+#include "frep/net/wire.h"
 
 using namespace farmtest;
 

@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "journal.h"
+#include "frep/master/journal.h"
 
 using frep::farm::Journal;
 

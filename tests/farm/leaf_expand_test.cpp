@@ -8,7 +8,7 @@
 #include <cstring>
 #include <random>
 
-#include "leaf_expand.h"
+#include "frep/farm/leaf_expand.h"
 
 using namespace frep::farm;
 

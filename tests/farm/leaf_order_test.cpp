@@ -7,7 +7,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "leaf_order.h"
+#include "frep/master/leaf_order.h"
 
 using frep::farm::rankByOrigin;
 using Origin = std::array<int32_t, 3>;

@@ -6,7 +6,7 @@
 #include <thread>
 #include <vector>
 
-#include "payload_arena.h"
+#include "frep/master/payload_arena.h"
 
 using frep::farm::PayloadArena;
 

@@ -1,6 +1,6 @@
 // The progress bar's text, its ETA, and log lines printed around it (status_line.h).
-#include "progress.h"
-#include "status_line.h"
+#include "frep/master/progress.h"
+#include "frep/master/status_line.h"
 
 #include <gtest/gtest.h>
 #include <spdlog/sinks/base_sink.h>

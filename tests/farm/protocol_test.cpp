@@ -12,9 +12,9 @@
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
-#include "curve.h"
+#include "frep/net/curve.h"
 #include "farm_test_util.h"
-#include "wire.h"
+#include "frep/net/wire.h"
 
 using namespace farmtest;
 

@@ -13,7 +13,7 @@
 #include <zmq.hpp>
 
 #include "farm_test_util.h"
-#include "wire.h"
+#include "frep/net/wire.h"
 
 using namespace farmtest;
 

@@ -15,8 +15,8 @@
 #include <zmq.hpp>
 
 #include "farm_test_util.h"
-#include "journal.h"
-#include "wire.h"
+#include "frep/master/journal.h"
+#include "frep/net/wire.h"
 
 using namespace farmtest;
 

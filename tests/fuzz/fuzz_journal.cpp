@@ -7,7 +7,7 @@
 #include <string>
 
 #include "fuzz_target.h"
-#include "journal.h"
+#include "frep/master/journal.h"
 
 void frep::fuzz::journal(const uint8_t* data, size_t size) {
   static const std::string path = "/tmp/frep_fuzz_journal." + std::to_string(::getpid());

@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "brick.h"
+#include "frep/worker/brick.h"
 #include "farm.pb.h"
 #include "frep/meshing/mesh.h"
 #include "fuzz_target.h"

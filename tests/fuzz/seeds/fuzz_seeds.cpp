@@ -8,9 +8,9 @@
 #include <fstream>
 #include <string>
 
-#include "brick.h"
+#include "frep/worker/brick.h"
 #include "frep/io/vdb_writer.h"
-#include "journal.h"
+#include "frep/master/journal.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "leaf_order.h"
+#include "frep/master/leaf_order.h"
 
 #include <stdexcept>
 #include <tbb/parallel_sort.h>

@@ -1,4 +1,4 @@
-#include "status_line.h"
+#include "frep/master/status_line.h"
 
 namespace frep::farm {
 

@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "crc32.h"
+#include "frep/farm/crc32.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>

@@ -1,4 +1,4 @@
-#include "allocator_tuning.h"
+#include "frep/worker/allocator_tuning.h"
 
 #include <malloc.h>
 #include <sys/mman.h>

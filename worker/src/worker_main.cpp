@@ -7,10 +7,10 @@
 
 #include <cstdlib>
 
-#include "allocator_tuning.h"
-#include "brick.h"
+#include "frep/worker/allocator_tuning.h"
+#include "frep/worker/brick.h"
 #include "frep/io/geometry_files.h"
-#include "worker.h"
+#include "frep/worker/worker.h"
 
 int main(int argc, char** argv) {
   frep::farm::applyAllocatorPolicy();

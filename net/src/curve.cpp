@@ -1,4 +1,4 @@
-#include "curve.h"
+#include "frep/net/curve.h"
 
 #include <spdlog/spdlog.h>
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-#include "journal.h"
+#include "frep/master/journal.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "brick.h"
+#include "frep/farm/crc32.h"
 
 namespace frep::farm {
 

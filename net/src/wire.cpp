@@ -1,4 +1,4 @@
-#include "wire.h"
+#include "frep/net/wire.h"
 
 #include <zmq_addon.hpp>
 

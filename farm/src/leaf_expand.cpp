@@ -1,4 +1,4 @@
-#include "leaf_expand.h"
+#include "frep/farm/leaf_expand.h"
 
 #include <array>
 #include <cstring>

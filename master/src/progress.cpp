@@ -1,10 +1,10 @@
-#include "progress.h"
+#include "frep/master/progress.h"
 
 #include <cstdio>
 #include <memory>
 #include <mutex>
 
-#include "status_line.h"
+#include "frep/master/status_line.h"
 
 namespace frep::farm {
 

@@ -1,4 +1,4 @@
-#include "payload_arena.h"
+#include "frep/master/payload_arena.h"
 
 #include <sys/mman.h>
 

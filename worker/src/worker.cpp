@@ -1,7 +1,7 @@
 // frep-worker main loop. Threads: the I/O thread (this one) owns the DEALER socket and never
 // computes, so heartbeats keep flowing while a brick runs; the compute thread takes tasks
 // from a queue and wakes the I/O thread through an inproc PAIR when a result is ready.
-#include "worker.h"
+#include "frep/worker/worker.h"
 
 #include <spdlog/spdlog.h>
 #include <unistd.h>
@@ -18,9 +18,9 @@
 #include <thread>
 #include <zmq.hpp>
 
-#include "brick.h"
-#include "curve.h"
-#include "wire.h"
+#include "frep/worker/brick.h"
+#include "frep/net/curve.h"
+#include "frep/net/wire.h"
 
 namespace frep::farm {
 

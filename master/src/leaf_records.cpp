@@ -1,9 +1,9 @@
-#include "leaf_records.h"
+#include "frep/master/leaf_records.h"
 
 #include <stdexcept>
 #include <string>
 
-#include "brick.h"
+#include "frep/farm/brick_codec.h"
 
 namespace frep::farm {
 

@@ -1,4 +1,4 @@
-#include "local_workers.h"
+#include "frep/master/local_workers.h"
 
 #include <signal.h>
 #include <spawn.h>
