@@ -172,14 +172,15 @@ class Shape:
             self._models[key] = _compile(self, key)
         return self._models[key]
 
-    def eval(self, points):
-        return self.compile().eval(points)
+    # The Model's calls (docs/python.md), on the compiled shape; keywords pass through.
+    def eval(self, points, **kw):
+        return self.compile().eval(points, **kw)
 
-    def sample(self, lo, hi, res=128, band=3, fixed=()):
-        return self.compile().sample(lo, hi, res=res, band=band, fixed=list(fixed))
+    def sample(self, lo, hi, **kw):
+        return self.compile().sample(lo, hi, **kw)
 
-    def mesh(self, lo, hi, res=128, simplify=0.0, fixed=()):
-        return self.compile().mesh(lo, hi, res=res, simplify=simplify, fixed=list(fixed))
+    def mesh(self, lo, hi, **kw):
+        return self.compile().mesh(lo, hi, **kw)
 
     def measure(self, lo=(-10,) * 3, hi=(10,) * 3, **kw):
         return self.compile().measure(lo, hi, **kw)
@@ -188,8 +189,9 @@ class Shape:
         from .grids import dense_grid
         return dense_grid(self.compile(), lo, hi, res=res, fixed=fixed)
 
-    def to_pyopenvdb(self, lo, hi, res=128, band=3):
-        return self.sample(lo, hi, res=res, band=band).to_pyopenvdb()
+    def to_pyopenvdb(self, lo, hi, **kw):
+        """The sampled level set (sample's keywords) as a pyopenvdb.FloatGrid."""
+        return self.sample(lo, hi, **kw).to_pyopenvdb()
 
 
 def _binary(op, a, b):
