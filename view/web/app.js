@@ -5,6 +5,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { toCreasedNormals } from 'three/addons/utils/BufferGeometryUtils.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('view');
@@ -63,7 +64,9 @@ function showMesh(gltf, generation) {
   model.traverse((o) => {
     if (!o.isMesh) return;
     const coloured = !!o.geometry.attributes.color;  // s[1..3] of the model
-    if (!o.geometry.attributes.normal) o.geometry.computeVertexNormals();
+    // Smooth within 30 degrees, creased beyond: the simplifier keeps sharp edges, whose
+    // vertices' normals would otherwise shade them as one smooth surface.
+    o.geometry = toCreasedNormals(o.geometry, Math.PI / 6);
     o.material = new THREE.MeshLambertMaterial({
       color: coloured ? 0xffffff : 0xcc9e61, vertexColors: coloured, side: THREE.DoubleSide });
   });
@@ -154,21 +157,23 @@ function showSlicePlane(at) {
   draw();
 }
 
-let sliceTimer = null;
+let sliceTimer = null, sliceRequests = 0;
 function requestSlice() {
   clearTimeout(sliceTimer);
   sliceTimer = setTimeout(async () => {
-    const at = Number($('at').value);
+    const at = Number($('at').value), request = ++sliceRequests;
     $('atValue').textContent = $('axis').value + ' = ' + at.toPrecision(4);
     showSlicePlane(at);
     const response = await fetch(`/api/slice?axis=${$('axis').value}&at=${at}&res=256`);
+    const body = response.ok ? await response.blob() : await response.text();
+    if (request !== sliceRequests) return;  // a later request was made: its answer is shown
     $('sliceError').hidden = response.ok;
     if (response.ok) {
       const old = $('slice').src;
-      $('slice').src = URL.createObjectURL(await response.blob());
+      $('slice').src = URL.createObjectURL(body);
       if (old) URL.revokeObjectURL(old);
     } else {
-      $('sliceError').textContent = await response.text();
+      $('sliceError').textContent = body;
     }
   }, 120);
 }
