@@ -16,7 +16,7 @@ packages=(
   lib3mf-dev libtinygltf-dev  # the .3mf and .glb mesh writers (io/)
   assimp-utils python3-stl  # independent readers of the mesh files in tests/cli/frep_mesh_formats_test.cpp
   clang libclang-rt-14-dev
-  pybind11-dev python3-dev python3-numpy  # the Python module (python/)
+  pybind11-dev python3-dev python3-numpy python3-venv  # the Python package (python/; venv: pip install .)
   libcpp-httplib-dev  # frep view's HTTP server (cli/view_command.cpp)
 )
 test_packages=(
