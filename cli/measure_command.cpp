@@ -25,8 +25,8 @@ namespace {
 std::atomic<bool> gStop{false};
 extern "C" void onMeasureSignal(int) { gStop.store(true); }
 
-// SIGINT/SIGTERM stop the refinement after the current round (the bounds so far are valid);
-// the old handlers come back after.
+// SIGINT/SIGTERM stop the refinement within the current round (the last whole round's bounds
+// are valid; core's Interrupter, frep/interrupt/interrupter.h); the old handlers come back after.
 struct SignalScope {
   struct sigaction oldInt {}, oldTerm {};
   SignalScope() {
@@ -103,7 +103,8 @@ int runMeasure(const MeasureRequest& request) {
   options.maxBoundaryCells = uint64_t(request.maxCells);
   const bool bar = !request.json && !request.noProgress && ::isatty(2);
   gStop.store(false);
-  options.cancel = &gStop;
+  const Interrupter stop(&gStop);
+  options.interrupt = &stop;
   options.progress = [bar](const MeasureProgress& p) {
     if (bar) {
       char buf[200];
@@ -118,7 +119,12 @@ int runMeasure(const MeasureRequest& request) {
   MassProperties r;
   {
     SignalScope signals;
-    r = measureMassProperties(m.field, ibox, options);
+    try {
+      r = measureMassProperties(m.field, ibox, options);
+    } catch (const Interrupted&) {
+      if (bar) farm::StatusLine::instance().finish();
+      throw CliError(kExitInterrupted, "stopped by a signal during the first round: no bounds yet");
+    }
   }
   if (bar) farm::StatusLine::instance().finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
