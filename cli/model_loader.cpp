@@ -12,6 +12,7 @@
 
 #include "arg_parse.h"
 #include "exit_codes.h"
+#include "frep/io/file_kind.h"
 #include "frep/io/input_file.h"
 
 namespace frep::cli {
@@ -69,6 +70,12 @@ int mapCoordinates(const lang::Model& model, const std::string& text, bool toVie
 
 LoadedModel loadModel(const ModelRequest& request, bool toView) {
   const std::string source = readFile(request.path);
+  // Told by its bytes, not its name: a binary file is never lexed (its bytes would be echoed).
+  const io::FileKind kind = io::sniffFileKind(source.substr(0, 512), source.size());
+  if (kind != io::FileKind::Text)
+    throw CliError(kExitModelError, request.path + ": " + io::describeFileKind(kind) +
+                                        ", not a HyperFun model (frep mesh reads .vdb grids; frep render reads .vdb "
+                                        "grids and .ply, .obj, .stl meshes)");
   lang::CompileOptions options;
   options.object = request.object;
   lang::CompileResult compiled = lang::compile(source, request.path, options);

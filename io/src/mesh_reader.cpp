@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "frep/io/error.h"
+#include "frep/io/file_kind.h"
 #include "frep/io/input_file.h"
 
 namespace frep::io {
@@ -389,7 +390,11 @@ std::string lowerExtension(const std::string& path) {
 }
 
 Mesh parseMesh(const std::string& path, const std::string& bytes) {
-  const std::string ext = lowerExtension(path);
+  // The format by the file's bytes where they tell it (PLY, binary STL), else by its extension.
+  const FileKind kind = sniffFileKind(bytes.substr(0, 512), bytes.size());
+  std::string ext = kind == FileKind::Ply ? "ply" : kind == FileKind::StlBinary ? "stl" : lowerExtension(path);
+  if (kind != FileKind::Text && !isMeshKind(kind))
+    throw ioError(path + ": " + describeFileKind(kind) + ", not a mesh file (expected PLY, OBJ or STL)");
   if (ext != "ply" && ext != "obj" && ext != "stl") throw ioError(path + ": not a mesh file (expected .ply, .obj or .stl)");
   Mesh m = ext == "stl" ? readStl(bytes, path) : ext == "ply" ? readPly(bytes, path) : readObj(bytes, path);
   if (m.triangles.empty()) fail(path, "no triangles");
@@ -398,7 +403,8 @@ Mesh parseMesh(const std::string& path, const std::string& bytes) {
 
 Mesh readMesh(const std::string& path) {
   const std::string ext = lowerExtension(path);
-  if (ext != "ply" && ext != "obj" && ext != "stl") throw ioError(path + ": not a mesh file (expected .ply, .obj or .stl)");
+  if (ext != "ply" && ext != "obj" && ext != "stl" && !isMeshKind(sniffFile(path)))
+    throw ioError(path + ": not a mesh file (expected .ply, .obj or .stl)");
   return parseMesh(path, readInputFile(path));
 }
 

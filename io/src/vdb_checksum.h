@@ -30,4 +30,21 @@ inline std::string vdbChecksum(const std::string& bytes, size_t digitsAt) {
   return hex;
 }
 
+// The header's UUID frep sample writes: derived from the seal's 16 digits (OpenVDB stamps a random
+// one into every file it writes). A file whose seal no longer matches but whose UUID is still the
+// one its digits give kept frep's header: damaged in place, refused. A tool that rewrote the file
+// (vdb_tool, pyopenvdb keep the seal's metadata) stamped its own UUID: a foreign grid, read.
+inline std::string vdbUuidForChecksum(const std::string& digits) {
+  uint64_t h1 = 1469598103934665603ULL, h2 = 0x9e3779b97f4a7c15ULL;
+  for (const char c : digits) {
+    h1 = (h1 ^ uint8_t(c)) * 1099511628211ULL;
+    h2 = (h2 ^ uint8_t(c)) * 0x100000001b3ULL + (h2 >> 29);
+  }
+  char uuid[40];
+  std::snprintf(uuid, sizeof uuid, "%08llx-%04llx-%04llx-%04llx-%012llx", (unsigned long long)(h1 >> 32),
+                (unsigned long long)((h1 >> 16) & 0xffff), (unsigned long long)(h1 & 0xffff),
+                (unsigned long long)(h2 >> 48), (unsigned long long)(h2 & 0xffffffffffffULL));
+  return std::string(uuid, kVdbUuidLength);
+}
+
 }  // namespace frep::io

@@ -52,19 +52,25 @@ class LayoutCheck {
     }
     if (pos_ != b_.size())
       fail(std::to_string(b_.size() - pos_) + " bytes after the last grid (damaged, or not written by OpenVDB)");
-    // frep sample's files are sealed (a tool that rewrites one must drop the seal; unsealed files
-    // get the layout checks only).
-    if (checksumAt_ && b_.compare(checksumAt_, kChecksumDigits, vdbChecksum(b_, checksumAt_)) != 0)
-      fail("the contents do not match " + std::string(kGridChecksumKey) + " (the file is damaged)");
-    return checksumAt_ != 0;
+    // frep sample's files are sealed. OpenVDB's tools keep the seal's metadata when they rewrite
+    // a grid but stamp their own UUID: a seal that no longer matches under frep's UUID is damage
+    // in place, refused; under another UUID it marks a foreign grid (vdb_checksum.h).
+    mismatch_ = checksumAt_ && b_.compare(checksumAt_, kChecksumDigits, vdbChecksum(b_, checksumAt_)) != 0;
+    if (mismatch_ &&
+        b_.compare(kVdbUuidAt, kVdbUuidLength, vdbUuidForChecksum(b_.substr(checksumAt_, kChecksumDigits))) == 0)
+      fail("the contents do not match " + std::string(kGridChecksumKey) +
+           " and the header is still frep sample's (the file is damaged)");
+    return checksumAt_ != 0 && !mismatch_;
   }
+  bool mismatch() const { return mismatch_; }
 
  private:
   [[noreturn]] void fail(const std::string& why) const { throw ioError("cannot read VDB '" + path_ + "': " + why); }
   uint64_t remaining() const { return b_.size() - pos_; }
   void need(uint64_t n) const {
-    if (n > remaining()) fail("truncated at byte " + std::to_string(b_.size()) + " (needs " + std::to_string(n) +
-                              " more bytes at " + std::to_string(pos_) + ")");
+    if (n > remaining())
+      fail("truncated at byte " + std::to_string(b_.size()) + " (needs " + std::to_string(n) + " more bytes at " +
+           std::to_string(pos_) + ")");
   }
   void skip(uint64_t n) {
     need(n);
@@ -113,6 +119,7 @@ class LayoutCheck {
   std::string path_, b_;
   uint64_t pos_ = 0;
   uint64_t checksumAt_ = 0;  // the checksum's digits, if the file has them
+  bool mismatch_ = false;
 };
 
 }  // namespace
@@ -131,7 +138,9 @@ VdbLayout checkVdbLayout(const std::string& path) {
   VdbLayout layout;
   layout.bytes = uint64_t(st.st_size);
   layout.contentHash = vdbChecksum(bytes, bytes.size());  // no digits counted as '0'
-  layout.sealed = LayoutCheck(path, std::move(bytes)).run();
+  LayoutCheck check(path, std::move(bytes));
+  layout.sealed = check.run();
+  layout.sealMismatch = check.mismatch();
   return layout;
 }
 

@@ -1,6 +1,7 @@
 #include "frep/io/vdb_writer.h"
 
 #include "frep/io/vdb_grid.h"
+#include "frep/sampling/band_distance.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetRebuild.h>
@@ -63,25 +64,6 @@ void addLeaf(openvdb::FloatGrid::Accessor& acc, const LeafBlock& block, const op
       }
 }
 
-// OpenVDB stamps a random UUID into every file header; replace it by one derived from the file's
-// contents, so the same grid always gives the same bytes (farm runs are compared byte for byte).
-void makeHeaderDeterministic(std::string& bytes) {
-  constexpr size_t kUuidAt = kVdbUuidAt, kUuidLen = kVdbUuidLength;
-  bool looksLikeUuid = bytes.size() > kUuidAt + kUuidLen && bytes[kUuidAt + 8] == '-' && bytes[kUuidAt + 13] == '-' &&
-                       bytes[kUuidAt + 18] == '-' && bytes[kUuidAt + 23] == '-';
-  if (!looksLikeUuid) return;
-  uint64_t h1 = 1469598103934665603ULL, h2 = 0x9e3779b97f4a7c15ULL;
-  for (size_t i = kUuidAt + kUuidLen; i < bytes.size(); ++i) {
-    h1 = (h1 ^ uint8_t(bytes[i])) * 1099511628211ULL;
-    h2 = (h2 ^ uint8_t(bytes[i])) * 0x100000001b3ULL + (h2 >> 29);
-  }
-  char uuid[40];
-  std::snprintf(uuid, sizeof uuid, "%08llx-%04llx-%04llx-%04llx-%012llx", (unsigned long long)(h1 >> 32),
-                (unsigned long long)((h1 >> 16) & 0xffff), (unsigned long long)(h1 & 0xffff),
-                (unsigned long long)(h2 >> 48), (unsigned long long)(h2 & 0xffffffffffffULL));
-  bytes.replace(kUuidAt, kUuidLen, uuid, kUuidLen);
-}
-
 // The bytes openvdb::io::File::write would put in the file (the same Archive::write, seekable),
 // built in memory: OpenVDB's own file writer ignores a failing stream (ENOSPC, EFBIG).
 struct MemoryArchive : openvdb::io::Archive {
@@ -93,8 +75,9 @@ struct MemoryArchive : openvdb::io::Archive {
   }
 };
 
-// The checksum entry's placeholder digits replaced by the file's checksum (vdb_checksum.h). The
-// entry is found with its length prefixes, which hold NUL bytes no metadata text from argv has.
+// The checksum entry's placeholder digits replaced by the file's checksum, and the header's UUID
+// by the one the checksum gives (vdb_checksum.h). The entry is found with its length prefixes,
+// which hold NUL bytes no metadata text from argv has.
 void sealChecksum(std::string& bytes) {
   auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
   const std::string key = kGridChecksumKey;
@@ -103,7 +86,16 @@ void sealChecksum(std::string& bytes) {
   const size_t at = bytes.find(entry);
   if (at == std::string::npos) throw openvdb::IoError("the checksum entry is missing from the serialised grid");
   const size_t digits = at + entry.size() - kChecksumDigits;
-  bytes.replace(digits, kChecksumDigits, vdbChecksum(bytes, digits));
+  const std::string checksum = vdbChecksum(bytes, digits);
+  bytes.replace(digits, kChecksumDigits, checksum);
+  // OpenVDB stamps a random UUID into every file header; frep's comes from the seal (the same grid
+  // gives the same bytes: farm runs are compared byte for byte), which tells damage in place from
+  // a rewrite by another tool (vdb_checksum.h).
+  const bool looksLikeUuid = bytes.size() > kVdbUuidAt + kVdbUuidLength && bytes[kVdbUuidAt + 8] == '-' &&
+                             bytes[kVdbUuidAt + 13] == '-' && bytes[kVdbUuidAt + 18] == '-' &&
+                             bytes[kVdbUuidAt + 23] == '-';
+  if (!looksLikeUuid) throw openvdb::IoError("the serialised header has no UUID where OpenVDB 10 puts it");
+  bytes.replace(kVdbUuidAt, kVdbUuidLength, vdbUuidForChecksum(checksum));
 }
 
 // Every byte handed to the kernel and checked, then fsync and the size read back: a full disk
@@ -244,7 +236,7 @@ namespace {
 // metadata, the checksum, then every byte written and checked.
 void writeGrid(const std::string& path, openvdb::FloatGrid::Ptr grid, const GridSpec& g, int bandVoxels,
                const VdbMetadata& meta) {
-  if (meta.store != VdbStore::Raw) grid = signedDistanceGrid(*grid, bandVoxels);
+  if (meta.store != VdbStore::Raw && !meta.distanceValues) grid = signedDistanceGrid(*grid, bandVoxels);
   if (meta.store == VdbStore::Fog) openvdb::tools::sdfToFogVolume(*grid);  // class fog volume
   const float background = float(bandVoxels * g.voxel);
   const openvdb::Coord offset = latticeOffset(g);
@@ -269,6 +261,8 @@ void writeGrid(const std::string& path, openvdb::FloatGrid::Ptr grid, const Grid
   grid->insertMeta("frep_iso", openvdb::DoubleMetadata(meta.iso));
   grid->insertMeta("frep_params", openvdb::StringMetadata(meta.params));
   grid->insertMeta("frep_version", openvdb::StringMetadata(FREP_VERSION));
+  if (meta.store != VdbStore::Raw && meta.distanceValues)
+    grid->insertMeta("frep_distance", openvdb::StringMetadata(bandDistanceBound()));
 
   try {
     grid->insertMeta(kGridChecksumKey, openvdb::StringMetadata(std::string(kChecksumDigits, '0')));  // sealed below
@@ -287,7 +281,6 @@ void writeGrid(const std::string& path, openvdb::FloatGrid::Ptr grid, const Grid
     archive.setCompression(compression);
     std::string bytes = archive.bytes(openvdb::GridCPtrVec{grid});
     sealChecksum(bytes);
-    makeHeaderDeterministic(bytes);
     writeAllOrThrow(path, bytes);
   } catch (const openvdb::Exception& e) {
     throw ioError("cannot write VDB '" + path + "': " + e.what());
