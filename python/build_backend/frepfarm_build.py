@@ -9,6 +9,8 @@ Build directory: the config setting `build-dir` (pip -C build-dir=build) or the 
 variable FREPFARM_BUILD_DIR. A directory that is already configured for this source tree is
 reused as it is (only the target is brought up to date, its cache is not touched); an empty or
 new one is configured there; with neither, a temporary directory is configured and removed.
+`prebuilt=1` (or FREPFARM_PREBUILT=1) with a build directory packs the extension already built
+there and runs no build at all (the ctest does: tests never build).
 """
 import base64
 import csv
@@ -90,15 +92,18 @@ def _cache_home(build_dir):
     return None
 
 
-def _build_extension(build_dir, jobs):
+def _build_extension(build_dir, jobs, prebuilt):
     """Configures build_dir when it is not yet, builds the target, returns the extension's path."""
     home = _cache_home(build_dir)
+    if prebuilt and home is None:
+        raise BuildError("prebuilt: %s is not a configured build directory" % build_dir)
     if home is None:
         _run(["cmake", "-S", ROOT, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release", "-DFREP_BUILD_TESTS=OFF",
               "-DFREP_BUILD_BENCH=OFF", "-DPython3_EXECUTABLE=" + sys.executable])
     elif os.path.realpath(home) != os.path.realpath(ROOT):
         raise BuildError("build directory %s is configured for %s, not %s" % (build_dir, home, ROOT))
-    _run(["cmake", "--build", build_dir, "--target", TARGET, "-j", str(jobs)])
+    if not prebuilt:
+        _run(["cmake", "--build", build_dir, "--target", TARGET, "-j", str(jobs)])
     package = os.path.join(build_dir, "python", "frepfarm")
     suffix = EXTENSION_SUFFIXES[0]
     path = os.path.join(package, "frepfarm" + suffix)
@@ -161,12 +166,15 @@ def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
     tag = _tag()
     jobs = int(_setting(config_settings, "jobs", "CMAKE_BUILD_PARALLEL_LEVEL") or os.cpu_count() or 1)
     build_dir = _setting(config_settings, "build-dir", "FREPFARM_BUILD_DIR")
+    prebuilt = (_setting(config_settings, "prebuilt", "FREPFARM_PREBUILT") or "0") not in ("0", "false", "no")
+    if prebuilt and build_dir is None:
+        raise BuildError("prebuilt: give the build directory (build-dir or FREPFARM_BUILD_DIR)")
     scratch = None
     if build_dir is None:
         scratch = build_dir = tempfile.mkdtemp(prefix="frepfarm-wheel-")
     try:
         build_dir = os.path.abspath(os.path.join(ROOT, build_dir))
-        extension = _build_extension(build_dir, jobs)
+        extension = _build_extension(build_dir, jobs, prebuilt)
         with open(extension, "rb") as f:
             files = [("frepfarm/" + os.path.basename(extension), f.read(), 0o755)]
     finally:

@@ -7,8 +7,9 @@ examples run from the installed package (ctest python_pip_install).
 The venv sees Debian's packages (--system-site-packages: numpy, pyopenvdb, pytest) but holds no
 frepfarm; pip runs with --no-index, no find-links and no configuration file, inside an empty
 network namespace (`unshare -n`) where that is allowed (root), so nothing can come from the
-network. The build backend reuses BUILD_DIR (-C build-dir), which makes the install seconds.
-The installed files are checked against the wheel's RECORD by uninstalling them at the end.
+network. The build backend packs the extension already built in BUILD_DIR (build-dir and
+prebuilt=1: a test never builds), which makes the install seconds. The installed files are
+checked against the wheel's RECORD by uninstalling them at the end.
 Exit 77 (skipped) when the venv module or pip is missing.
 """
 import os
@@ -41,7 +42,8 @@ def main():
         print("network: " + ("none (unshare -n) and --no-index" if offline else
                              "--no-index only (unshare -n not permitted here)"), flush=True)
 
-        r = run(offline + [pip, "install", "--no-index", "--config-settings", "build-dir=" + build, source],
+        r = run(offline + [pip, "install", "--no-index", "--config-settings", "build-dir=" + build,
+                           "--config-settings", "prebuilt=1", source],
                 env=env, cwd=tmp)
         if r.returncode != 0:
             print("FAIL: pip install exited %d" % r.returncode)
