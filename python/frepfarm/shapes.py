@@ -317,6 +317,8 @@ def volume(source, grid_name=None):
     a .vdb path (grid_name: which grid, default the first float grid) or a pyopenvdb.FloatGrid."""
     if isinstance(source, (str, bytes, os.PathLike)):
         lit = _path_literal("volume", source)
+        if grid_name is not None and (not isinstance(grid_name, str) or '"' in grid_name or "\n" in grid_name):
+            raise ValueError("volume: grid_name must be a string without quotes or newlines, got %r" % (grid_name,))
         name = "" if grid_name is None else ', "%s"' % grid_name
         return Shape("volume(%s)" % lit, 3, [], lambda n, k, f: ["%s = frVolume(x, %s%s);" % (n, lit, name)])
     if not hasattr(source, "gridClass") or not hasattr(source, "copyFromArray"):

@@ -174,6 +174,16 @@ def test_unbounded_minkowski_operand_names_its_python_line():
     assert "shape2: formula('1 - x[1]^2 - x[2]^2'), made at %s:%d" % (__file__, line) in msg
 
 
+def test_missing_mesh_file_names_the_path_and_the_python_line():
+    line = inspect.currentframe().f_lineno + 1
+    part = fs.mesh("/nonexistent/part.stl") | fs.ball(1)
+    with pytest.raises(frepfarm.ModelError) as e:
+        part.compile()
+    msg = str(e.value)
+    assert "error: cannot open file '/nonexistent/part.stl' (No such file or directory)" in msg
+    assert 'shape1: mesh("/nonexistent/part.stl"), made at %s:%d' % (__file__, line) in msg
+
+
 # --- NumPy and pyopenvdb grids ------------------------------------------------------------------
 
 def test_dense_grid_values_and_points():
@@ -205,6 +215,10 @@ def test_pyopenvdb_level_set_as_a_primitive(tmp_path):
     # Composes like any shape: cut by a half-space.
     cut = v & fs.half_space((1, 0, 0))
     assert cut.eval([[0.5, 0, 0]])[0] < 0 < cut.eval([[-0.9, 0, 0]])[0]
+    # No file holds the grid: a .hf of it could not be read back.
+    with pytest.raises(ValueError, match="^save: the model holds a pyopenvdb grid"):
+        cut.save(str(tmp_path / "cut.hf"))
+    assert not os.listdir(tmp_path)
 
 
 def test_pyopenvdb_round_trip_keeps_the_surface():
