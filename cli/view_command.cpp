@@ -3,6 +3,7 @@
 // Debian's cpp-httplib; the page's files are view/web (docs/view.md), three.js among them from npm.
 #include <httplib.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
@@ -139,6 +140,12 @@ int runView(const ViewRequest& request) {
   SignalStop signals;  // before any thread starts, so that every thread inherits the mask
   ViewSession session(request, selfExecutable());
   httplib::Server server;
+  // SO_REUSEADDR only: httplib's default adds SO_REUSEPORT, with which a second frep view on the
+  // same port would bind too and share the connections with the first.
+  server.set_socket_options([](int sock) {
+    const int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   addRoutes(server, session, web);
   const int port = request.port == 0 ? server.bind_to_any_port(request.host)
                                      : (server.bind_to_port(request.host, request.port) ? request.port : -1);

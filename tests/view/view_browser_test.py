@@ -17,6 +17,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import urllib.error
 import urllib.request
 
 import websocket
@@ -154,6 +155,18 @@ def main():
         check("<canvas" in page, "GET / serves the page")
         three = urllib.request.urlopen(url + "node_modules/three/build/three.module.js")
         check("javascript" in three.headers["Content-Type"], "three.js is served locally as JavaScript")
+
+        # Errors of the command itself: exit codes of docs/view.md.
+        def view_exit(*args):
+            return subprocess.run([FREP, "view"] + list(args), capture_output=True, text=True, timeout=20).returncode
+        check(view_exit(os.path.join(work, "missing.hf"), "--port", "0") == 3, "a missing model: exit 3")
+        check(view_exit(model, "-b", "1,2,3,4", "--port", "0") == 2, "a bad -b: exit 2")
+        check(view_exit(model, "--port", url.rstrip("/").rsplit(":", 1)[1]) == 7, "a port in use: exit 7")
+        try:
+            urllib.request.urlopen(url + "api/slice?axis=w&at=0")
+            check(False, "a slice along axis w is refused")
+        except urllib.error.HTTPError as e:
+            check(e.code == 400, "a slice along axis w is refused with 400 (%d)" % e.code)
 
         browser = Browser(os.path.join(work, "profile"))
         browser.call("Page.navigate", url=url)
