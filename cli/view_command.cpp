@@ -134,6 +134,7 @@ int runView(const ViewRequest& request) {
   if (!fs::is_regular_file(request.model.path)) throw ioError(request.model.path + ": no such file");
   if (!request.bounds.empty()) parseBounds("-b/--bounds", request.bounds);  // bad -b: exit 2 now, not on the page
   const fs::path web = findWebDir();
+  spdlog::info("the page's files: {}", web.string());
   if (!isLoopback(request.host))
     spdlog::warn("--host {}: anyone who reaches this address sees the model and can run slices of it", request.host);
 
