@@ -73,6 +73,12 @@ def _shape(call, v, dims=None):
     return v
 
 
+def _b(shape):
+    """A shape's description inside another's, cut short: shared shapes (b | b, repeated) would
+    otherwise double it at every level."""
+    return shape.what if len(shape.what) <= 48 else shape.what[:45] + "..."
+
+
 _AXES = {"x": 1, "y": 2, "z": 3, 1: 1, 2: 2, 3: 3}
 
 
@@ -113,7 +119,7 @@ class Shape:
         return _binary("\\", self, other)
 
     def __invert__(self):
-        return Shape("~" + self.what, self.dims, [self], lambda n, k, f: ["%s = ~%s(x, a);" % (n, k[0])])
+        return Shape("~" + _b(self), self.dims, [self], lambda n, k, f: ["%s = ~%s(x, a);" % (n, k[0])])
 
     # --- transforms (methods return new shapes) ----------------------------------------------
     def translate(self, *v):
@@ -200,7 +206,7 @@ def _binary(op, a, b):
     call = {"|": "union", "&": "intersection", "\\": "difference"}[op]
     if a.dims != b.dims:
         raise ValueError("%s: shapes of %d and %d coordinates (%s, %s)" % (call, a.dims, b.dims, a.what, b.what))
-    return Shape("(%s %s %s)" % (a.what, op, b.what), a.dims, [a, b],
+    return Shape("(%s %s %s)" % (_b(a), op, _b(b)), a.dims, [a, b],
                  lambda n, k, f: ["%s = %s(x, a) %s %s(x, a);" % (n, k[0], op, k[1])])
 
 
@@ -214,7 +220,7 @@ def _mapped(child, what, lines, factor=1.0):
 
     def emit(name, kids, files):
         return copy + lines + ["%s = %s%s(xt, a);" % (name, scale, kids[0])]
-    return Shape("%s.%s" % (child.what, what), n, [child], emit)
+    return Shape("%s.%s" % (_b(child), what), n, [child], emit)
 
 
 # --- primitives -----------------------------------------------------------------------------
@@ -344,7 +350,7 @@ def formula(expression, dims=3):
 def _fn2(call, fn, a, b, *params):
     a, b = _shape(call, a), _shape(call, b, a.dims)
     p = ", ".join(_lit(v) for v in params)
-    return Shape("%s(%s, %s)" % (call, a.what, b.what), a.dims, [a, b],
+    return Shape("%s(%s, %s)" % (call, _b(a), _b(b)), a.dims, [a, b],
                  lambda n, k, f: ["%s = %s(%s(x, a), %s(x, a), %s);" % (n, fn, k[0], k[1], p)])
 
 
@@ -395,7 +401,7 @@ def offset(shape, amount):
     """f + amount (frOffset): a uniform offset for a distance field."""
     s = _shape("offset", shape)
     v = _num("offset", "amount", amount)
-    return Shape("offset(%s, %r)" % (s.what, v), s.dims, [s],
+    return Shape("offset(%s, %r)" % (_b(s), v), s.dims, [s],
                  lambda n, k, f: ["%s = frOffset(%s(x, a), %s);" % (n, k[0], _lit(v))])
 
 
@@ -403,7 +409,7 @@ def offset_normal(shape, distance):
     """f(x + d grad f / |grad f|) (frOffsetNormal): d > 0 grows the solid."""
     s = _shape("offset_normal", shape)
     v = _num("offset_normal", "distance", distance)
-    return Shape("offset_normal(%s, %r)" % (s.what, v), s.dims, [s],
+    return Shape("offset_normal(%s, %r)" % (_b(s), v), s.dims, [s],
                  lambda n, k, f: ["%s = frOffsetNormal(%s(x, a), %s);" % (n, k[0], _lit(v))])
 
 
@@ -411,7 +417,7 @@ def offset_radius(shape, radius):
     """Constant-radius offset (frOffsetR): r > 0 dilates by a ball of radius r, r < 0 erodes."""
     s = _shape("offset_radius", shape)
     r = _num("offset_radius", "radius", radius)
-    return Shape("offset_radius(%s, %r)" % (s.what, r), s.dims, [s],
+    return Shape("offset_radius(%s, %r)" % (_b(s), r), s.dims, [s],
                  lambda n, k, f: ["%s = frOffsetR(x, %s, %s);" % (n, k[0], _lit(r))])
 
 
@@ -440,7 +446,7 @@ def _object_call(call, fn, shapes, dims, before=(), after=(), options=()):
         lines = _array("o", options) if options else []
         args = ["x"] + list(before) + list(kids) + list(after) + (["o"] if options else [])
         return lines + ["%s = %s(%s);" % (name, fn, ", ".join(args))]
-    return Shape("%s(%s)" % (call, ", ".join(s.what for s in shapes)), dims, shapes, emit)
+    return Shape("%s(%s)" % (call, ", ".join(_b(s) for s in shapes)), dims, shapes, emit)
 
 
 def minkowski_sum(a, b, *more, method=None, tol=None, box=None):
@@ -510,7 +516,7 @@ def sweep(shape, times, positions, angles=None, method=None, tol=None):
         lines = _array("ts", ts) + _array("ps", ps) + (_array("rs", rs) if rs else []) + (_array("o", o) if o else [])
         args = ["x", kids[0], "ts", "ps"] + (["rs"] if rs else []) + (["o"] if o else [])
         return lines + ["%s = frSweepKeys(%s);" % (name, ", ".join(args))]
-    return Shape("sweep(%s)" % s.what, 3, [s], emit)
+    return Shape("sweep(%s)" % _b(s), 3, [s], emit)
 
 
 # --- compiling ----------------------------------------------------------------------------------
