@@ -137,6 +137,11 @@ def test_shared_operands_are_one_object():
     b = fs.ball(1)
     text = ((b | b.translate(1, 0, 0)) & b).hyperfun()
     assert text.count("frBall") == 1
+    # Reused on both sides 40 times: the ball, 40 moves and 40 unions, descriptions kept short.
+    s = b
+    for _ in range(40):
+        s = s | s.translate(0.01, 0, 0)
+    assert s.hyperfun().count("(x[3], a[1])") == 81 and len(s.what) < 120
 
 
 # --- errors ----------------------------------------------------------------------------------
