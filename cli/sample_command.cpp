@@ -21,6 +21,7 @@
 #include "frep/master/farm_master.h"
 #include "sampling_grid.h"
 #include "frep/io/vdb_writer.h"
+#include "frep/sampling/band_distance.h"
 
 namespace frep::cli {
 namespace {
@@ -87,6 +88,7 @@ int runSample(const SampleRequest& request) {
   }
   farm::JobSpec job = makeJob(m, request.model.path, grid, "sample");
   job.set_band(request.band);
+  job.set_distance(request.store != "raw");  // the workers store the band's distance (--store sdf, fog)
   if (cut.faces) setCutBox(job, cutLo, cutHi);
   spdlog::info("sampling '{}' on {}x{}x{} voxels of {}", m.model.objectName, grid.dims[0], grid.dims[1],
                grid.dims[2], grid.voxel);
@@ -107,6 +109,7 @@ int runSample(const SampleRequest& request) {
   farm::FarmReport& report = outcome.report;
   requireComplete(reportOut, report, request.farm.strict);
   report.cutFaces = cut.names();
+  if (job.distance()) report.errorBounds.push_back("stored value (signed distance): " + bandDistanceBound());
 
   io::VdbMetadata meta;
   meta.gridName = m.model.objectName;
@@ -116,7 +119,8 @@ int runSample(const SampleRequest& request) {
   meta.params = request.model.params;
   meta.sourceHash = m.model.sourceHash;
   meta.iso = request.model.iso;
-  jsonPhase("write");  // with the signed distance (levelSetRebuild) unless --store raw
+  meta.distanceValues = job.distance();
+  jsonPhase("write");
   builder->write(out.tempPath(), meta);
   out.commit();
   writeReport(reportOut, report);

@@ -12,6 +12,7 @@
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/minkowski_algebra/registry.h"
 #include "frep/primitives/ops.h"
+#include "frep/sampling/band_distance.h"
 #include "frep/lang/field.h"
 #include "frep/lang/hyperfun.h"
 
@@ -206,7 +207,17 @@ BrickOutput computeBrickOnce(const TapePtr& tape, const JobSpec& job, const std:
   opt.regionLo = lo;
   opt.regionHi = hi;
   opt.threads = threads;
-  SampleResult r = sample(tape, gridOf(job), opt);
+  // The distance reads values from the neighbouring bricks' halo: extremum values must then be
+  // functions of their point alone (cold searches), or the split would show in the output.
+  if (job.distance() && !tape->extrema().empty()) opt.pointwiseSearches = true;
+  const GridSpec grid = gridOf(job);
+  SampleResult r = sample(tape, grid, opt);
+  if (job.distance()) {
+    BandDistanceStats halo;
+    bandDistance(tape, grid, opt, r, &halo);
+    r.stats.pointEvals += halo.haloPointEvals;
+    r.stats.intervalEvals += halo.haloIntervalEvals;
+  }
   BrickOutput out;
   out.leaves = std::move(r.leaves);
   out.tiles = std::move(r.tiles);

@@ -23,16 +23,22 @@ struct VdbMetadata {
   uint64_t sourceHash = 0;  // lang::Model::sourceHash
   double iso = 0.0;
   VdbStore store = VdbStore::Sdf;
+  // Sdf and Fog: the leaves already hold the band's signed distance (the workers' estimate,
+  // core sampling/band_distance.h), stored as it is, with its bound in frep_distance; false:
+  // the distance is computed here from -f by the mesh round trip below.
+  bool distanceValues = false;
 };
 
 // Writes one FloatGrid on the world lattice (index (i, j, k) at world (i, j, k) * voxel: a pure
-// scale transform). Sdf: class level set, the exact distance to the zero set of f (meshed from
-// the samples) in a band of bandVoxels either side, background band * voxel, negative inside.
+// scale transform). Sdf: class level set, the signed distance in a band of bandVoxels either
+// side, background band * voxel, negative inside: the leaves' own (distanceValues) or the exact
+// distance to the zero set of f meshed from the samples (tools::levelSetRebuild).
 // Raw: the sampler's -f (active in its band, tiles and background at +-band * voxel). Fog:
 // the Sdf grid through tools::sdfToFogVolume, named "density". Metadata: frep_sign, frep_store,
 // frep_operation, frep_model_hash, frep_source, frep_object, frep_job, frep_units, frep_voxel,
 // frep_box_index_min/max, frep_box_min/max (world), frep_band_voxels, frep_band, frep_iso,
-// frep_params, frep_version. Throws Error(kExitIoError).
+// frep_params, frep_version, and with distanceValues frep_distance (the value's bound). Throws
+// Error(kExitIoError).
 void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta);
 
 // The same file built from a sample as it streams in (farm::SampleSink): tiles and leaves in any
