@@ -26,6 +26,7 @@
 #include "frep/meshing/mesh_grid.h"
 #include "mesh_outputs.h"
 #include "sampling_grid.h"
+#include "frep/io/file_kind.h"
 #include "frep/io/vdb_reader.h"
 
 namespace frep::cli {
@@ -109,7 +110,8 @@ int runMeshVdb(const MeshRequest& request) {
 }  // namespace
 
 int runMesh(const MeshRequest& request) {
-  if (hasVdbExtension(request.model.path)) return runMeshVdb(request);
+  if (hasVdbExtension(request.model.path) || io::sniffFile(request.model.path) == io::FileKind::Vdb)
+    return runMeshVdb(request);
   if (request.region.out.empty()) throw badArgs("-O/--out: the output mesh path (.ply, .obj, .stl, .wrl, .pov, .3mf, .glb) is required");
   std::vector<MeshOutput> outputs = resolveMeshOutputs(request);
   if (request.threads < 0) throw badArgs("--threads: expected 0 (all cores) or more, got " + std::to_string(request.threads));

@@ -20,6 +20,7 @@
 #include "frep/attributes/colour.h"
 #include "frep/evaluators/eval.h"
 #include "frep/io/atomic_output.h"
+#include "frep/io/file_kind.h"
 #include "frep/io/mesh_reader.h"
 #include "frep/io/png_writer.h"
 #include "frep/io/vdb_reader.h"
@@ -324,7 +325,9 @@ int runRender(const RenderRequest& r) {
 
 bool isMeshOrVdb(const std::string& path) {
   const std::string ext = io::lowerExtension(path);
-  return ext == "ply" || ext == "obj" || ext == "stl" || ext == "vdb";
+  const io::FileKind kind = io::sniffFile(path);  // by its bytes too: a grid or mesh named otherwise
+  return ext == "ply" || ext == "obj" || ext == "stl" || ext == "vdb" || kind == io::FileKind::Vdb ||
+         io::isMeshKind(kind);
 }
 
 int runRenderMesh(const RenderRequest& r) {
@@ -351,7 +354,9 @@ int runRenderMesh(const RenderRequest& r) {
 
   const auto t0 = std::chrono::steady_clock::now();
   Mesh mesh;
-  if (io::lowerExtension(r.model.path) == "vdb") {  // the grid's zero level set, meshed as frep mesh does
+  const io::FileKind kind = io::sniffFile(r.model.path);  // by its bytes first, then its name
+  if (kind == io::FileKind::Vdb || (io::lowerExtension(r.model.path) == "vdb" && !io::isMeshKind(kind))) {
+    // the grid's zero level set, meshed as frep mesh does
     io::SampledVdb vdb = io::readSampledVdb(r.model.path, r.model.object);
     SampledMeshOptions mo;
     mo.threads = r.threads;
