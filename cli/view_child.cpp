@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <initializer_list>
 #include <stdexcept>
 
 namespace frep::cli {
@@ -42,6 +43,9 @@ ChildResult runChild(const std::vector<std::string>& argv, const std::atomic<boo
     ::dup2(outPipe[1], 1);
     ::dup2(errPipe[1], 2);
     ::execv(args[0], args.data());
+    const char* why = std::strerror(errno);  // not async-signal-safe in theory; glibc's reads a table
+    for (const char* part : std::initializer_list<const char*>{"frep view: cannot run ", args[0], ": ", why, "\n"})
+      if (::write(2, part, std::strlen(part)) < 0) break;
     _exit(127);
   }
   ::close(outPipe[1]);

@@ -181,7 +181,8 @@ void ViewSession::runJob(uint64_t generation, std::shared_ptr<std::atomic<bool>>
   } else {
     status_ = "error";
     message_ = scrub(r.err.empty() ? "frep mesh exited " + std::to_string(r.exitCode) + " without a message" : r.err);
-    spdlog::info("save {}: frep mesh exited {}", generation, r.exitCode);
+    const std::string first = message_.substr(0, message_.find('\n'));
+    spdlog::info("save {}: frep mesh exited {}: {}", generation, r.exitCode, first);
   }
 }
 

@@ -139,9 +139,14 @@ def main():
         check(False, "chromium is installed (deploy/install-deps.sh installs it)")
         return
     work = tempfile.mkdtemp(prefix="frep-view-test-")
+    # Copies of frep and frep-worker: the build tree's may be relinked while the test runs.
+    os.makedirs(os.path.join(work, "bin"))
+    frep = os.path.join(work, "bin", "frep")
+    for name in ("frep", "frep-worker"):
+        shutil.copy2(os.path.join(os.path.dirname(FREP), name), os.path.join(work, "bin", name))
     model = os.path.join(work, "model.hf")
     save(model, SPHERE)
-    server = subprocess.Popen([FREP, "view", model, "-b", "-2,2", "--res", "40", "--workers", "2", "--port", "0"],
+    server = subprocess.Popen([frep, "view", model, "-b", "-2,2", "--res", "40", "--workers", "2", "--port", "0"],
                               stdout=subprocess.PIPE, stderr=open(os.path.join(work, "view.log"), "w"), text=True,
                               env=dict(os.environ, TMPDIR=work))  # the jobs' temporary folders
     browser = None
@@ -158,7 +163,7 @@ def main():
 
         # Errors of the command itself: exit codes of docs/view.md.
         def view_exit(*args):
-            return subprocess.run([FREP, "view"] + list(args), capture_output=True, text=True, timeout=20).returncode
+            return subprocess.run([frep, "view"] + list(args), capture_output=True, text=True, timeout=20).returncode
         check(view_exit(os.path.join(work, "missing.hf"), "--port", "0") == 3, "a missing model: exit 3")
         check(view_exit(model, "-b", "1,2,3,4", "--port", "0") == 2, "a bad -b: exit 2")
         check(view_exit(model, "--port", url.rstrip("/").rsplit(":", 1)[1]) == 7, "a port in use: exit 7")
@@ -208,7 +213,7 @@ def main():
         browser.wait("document.body.dataset.status === 'error' && document.body.dataset.generation === '3'", 30,
                      "the error is shown")
         shown = browser.eval("document.getElementById('error').textContent")
-        cli = subprocess.run([FREP, "check", model], capture_output=True, text=True).stderr
+        cli = subprocess.run([frep, "check", model], capture_output=True, text=True).stderr
         first = next((l for l in cli.splitlines() if " error: " in l), "")
         check(first.startswith(model + ":3:"), "frep check names model.hf:3:COL: " + first)
         check(first != "" and first in shown, "the page shows the same line: " + shown.splitlines()[0] if shown else "")

@@ -105,6 +105,7 @@ function showState(s) {
   showError(s.status === 'error' ? s.message : '');
   $('report').textContent = s.report;
   $('log').textContent = s.command + '\n\n' + s.log;
+  $('reportJson').textContent = s.report_json ? JSON.stringify(s.report_json, null, 1) : '';
   const interrupted = s.interrupted ? ', ' + s.interrupted + ' run(s) interrupted by newer saves' : '';
   $('timing').textContent = s.seconds ? s.seconds.toFixed(2) + ' s' + interrupted : interrupted;
   if (!bounds) {
