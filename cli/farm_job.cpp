@@ -2,8 +2,10 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <algorithm>
 #include <bitset>
 #include <fstream>
@@ -162,15 +164,34 @@ farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& 
   }
 }
 
+namespace {
+
+void writeReportBytes(io::AtomicOutput& reportOut, const farm::FarmReport& report) {
+  farm::FarmReport final = report;
+  final.peakRssBytes = farm::peakRssBytes();  // after the output was written
+  std::ofstream r(reportOut.tempPath());
+  r << final.toJson() << "\n";
+  r.close();  // a full disk shows at the flush
+  if (!r) throw ioError("cannot write the report '" + reportOut.path() + "': " + std::strerror(errno));
+}
+
+}  // namespace
+
 void writeReport(io::AtomicOutput& reportOut, const farm::FarmReport& report) {
-  {
-    farm::FarmReport final = report;
-    final.peakRssBytes = farm::peakRssBytes();  // after the output was written
-    std::ofstream r(reportOut.tempPath());
-    r << final.toJson() << "\n";
-    if (!r) throw ioError("cannot write " + reportOut.tempPath());
-  }
+  writeReportBytes(reportOut, report);
   reportOut.commit();
+}
+
+void writeReportWith(io::AtomicOutput& reportOut, const farm::FarmReport& report,
+                     const std::function<std::vector<std::string>()>& commitOutputs) {
+  writeReportBytes(reportOut, report);
+  const std::vector<std::string> outputs = commitOutputs();
+  try {
+    reportOut.commit();
+  } catch (...) {
+    for (const std::string& p : outputs) ::unlink(p.c_str());
+    throw;
+  }
 }
 
 namespace {

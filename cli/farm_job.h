@@ -3,6 +3,7 @@
 // values), running the job with failures mapped to exit codes, and the report beside the output.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,12 @@ farm::FarmOutcome runFarmJob(const farm::JobSpec& job, const farm::FarmOptions& 
 // Writes report.toJson(), with peak_rss_bytes refreshed (after the output was written), to the
 // report's temporary file and commits it.
 void writeReport(io::AtomicOutput& reportOut, const farm::FarmReport& report);
+// The outputs and the report appear together or not at all (a full disk at the report left the
+// output in place with exit 3): the report's bytes are written and synced first, then
+// commitOutputs() renames the outputs (returning their paths), then the report is renamed; if
+// that fails, the outputs are removed again.
+void writeReportWith(io::AtomicOutput& reportOut, const farm::FarmReport& report,
+                     const std::function<std::vector<std::string>()>& commitOutputs);
 
 // An interrupted or poisoned job: writes the report and throws CliError with exit 6 (resume) or
 // 5 (the poisoned bricks named). Returns when the job is complete.

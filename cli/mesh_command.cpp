@@ -243,8 +243,13 @@ int runMesh(const MeshRequest& request) {
                                   userGrid.origin[0] + userGrid.voxel * (userGrid.dims[0] - 1),
                                   userGrid.origin[1] + userGrid.voxel * (userGrid.dims[1] - 1),
                                   userGrid.origin[2] + userGrid.voxel * (userGrid.dims[2] - 1)};
-  std::vector<std::string> wrote = writeMeshOutputs(outputs, mesh, request, m.model.objectName, comment, extent, grid.voxel);
-  writeReport(reportOut, report);
+  std::vector<std::string> wrote;
+  writeReportWith(reportOut, report, [&] {
+    wrote = writeMeshOutputs(outputs, mesh, request, m.model.objectName, comment, extent, grid.voxel);
+    std::vector<std::string> paths;
+    for (const MeshOutput& o : outputs) paths.push_back(o.path);
+    return paths;
+  });
   std::remove(options.journalPath.c_str());  // the output is complete: nothing to resume
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

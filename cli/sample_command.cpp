@@ -122,8 +122,10 @@ int runSample(const SampleRequest& request) {
   meta.distanceValues = job.distance();
   jsonPhase("write");
   builder->write(out.tempPath(), meta);
-  out.commit();
-  writeReport(reportOut, report);
+  writeReportWith(reportOut, report, [&] {
+    out.commit();
+    return std::vector<std::string>{out.path()};
+  });
   std::remove(options.journalPath.c_str());  // the output is complete: nothing to resume
 
   const SampleStats& s = outcome.result.stats;

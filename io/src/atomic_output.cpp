@@ -1,5 +1,6 @@
 #include "frep/io/atomic_output.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <pthread.h>
 #include <sys/stat.h>
@@ -9,6 +10,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <string>
 
 #include "frep/io/error.h"
 
@@ -80,6 +82,28 @@ void requireReplaceable(const std::string& field, const std::string& path) {
                   "; frep writes only new or regular files (it would replace it)");
 }
 
+// The temporaries of this target left by processes that are gone (a SIGKILLed master cannot
+// remove its own): ".NAME.tmpPID" with PID no longer running. A live process's is never touched.
+void removeOrphanedTemporaries(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash + 1);
+  const std::string prefix = "." + (slash == std::string::npos ? path : path.substr(slash + 1)) + ".tmp";
+  DIR* d = ::opendir(dir.c_str());
+  if (!d) return;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string name = e->d_name;
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = pid_t(std::stol(digits));
+    if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    const std::string full = (slash == std::string::npos ? "" : dir) + name;
+    struct stat st;
+    if (::lstat(full.c_str(), &st) == 0 && S_ISREG(st.st_mode)) ::unlink(full.c_str());
+  }
+  ::closedir(d);
+}
+
 }  // namespace
 
 AtomicOutput::AtomicOutput(const std::string& field, const std::string& path) : field_(field), path_(path) {
@@ -127,6 +151,7 @@ void AtomicOutput::commit() {
     throw ioError(field_ + ": cannot rename '" + temp_ + "' to '" + path_ + "': " + std::strerror(errno));
   committed_ = true;
   if (slot_ >= 0) gPending[slot_] = 0;
+  removeOrphanedTemporaries(path_);
 }
 
 }  // namespace frep::io

@@ -56,8 +56,11 @@ TEST_F(FarmCli, MasterKilledHalfwayResumesFromItsJournal) {
   ASSERT_GE(journaled, 6u);
   ASSERT_LT(journaled, 27u);
   EXPECT_FALSE(fileExists(path("out.vdb")));
+  EXPECT_NE(listing().find(".out.vdb.tmp"), std::string::npos) << listing();  // SIGKILL: no clean-up ran
   RunResult resumed = run(sampleArgs("out.vdb") + " --workers 2 --brick 32 --resume");
   ASSERT_EQ(resumed.code, 0) << resumed.err;
+  // The dead master's temporaries go with the successful resume (issue 31).
+  EXPECT_EQ(listing().find(".tmp"), std::string::npos) << listing();
   std::string report = readText(path("out.vdb.report.json"));
   EXPECT_EQ(jsonNumber(report, "from_journal"), long(journaled)) << report;
   EXPECT_EQ(jsonNumber(report, "computed"), 27 - long(journaled));

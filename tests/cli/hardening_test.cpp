@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <sys/socket.h>
 #include <netinet/in.h>
+#include <sys/stat.h>
 #include <sys/sysmacros.h>
 
 #include <chrono>
@@ -95,6 +96,35 @@ TEST_F(Hardening, FullDiskDuringTheFinalWriteLeavesNoOutput) {
   EXPECT_EQ(resumed.code, 0) << resumed.err;
   EXPECT_NE(resumed.out.find("0 computed"), std::string::npos) << resumed.out;
   EXPECT_EQ(readText(path("full.vdb")).size(), size);
+}
+
+// A full disk when the report is written: neither the mesh nor the report appears (issue 31: the
+// mesh stayed in place with exit 3). A 16 KiB tmpfs with two pages free holds the journal and one
+// more page: the report's bytes are written before any output is renamed, so the output's write
+// fails instead and nothing is committed. Needs mount(2) (root); skipped otherwise.
+TEST_F(Hardening, FullDiskAtTheReportLeavesNeitherFile) {
+  const std::string disk = path("disk");
+  ::mkdir(disk.c_str(), 0755);
+  if (std::system(("mount -t tmpfs -o size=16k tmpfs '" + disk + "' 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "cannot mount a tmpfs here";
+  struct Unmount {
+    std::string at;
+    ~Unmount() { (void)std::system(("umount '" + at + "'").c_str()); }
+  } unmount{disk};
+  write("disk/s.hf", kSphere);                              // one page
+  write("disk/filler", std::string(4096, 'x'));             // one page: two left
+  const std::string args = "mesh disk/s.hf -b 0.8 --res 5 --workers 0 --no-progress -O disk/t.cli";
+  RunResult r = run(args);
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_FALSE(fileExists(path("disk/t.cli"))) << "the output without its report";
+  EXPECT_FALSE(fileExists(path("disk/t.cli.report.json")));
+  EXPECT_TRUE(fileExists(path("disk/t.cli.journal")));  // kept for --resume
+  std::remove(path("disk/filler").c_str());
+  RunResult resumed = run(args + " --resume");
+  EXPECT_EQ(resumed.code, 0) << resumed.err;
+  EXPECT_TRUE(fileExists(path("disk/t.cli")) && fileExists(path("disk/t.cli.report.json")));
+  const std::string names = capture("ls -A '" + disk + "'").out;
+  EXPECT_EQ(names.find(".tmp"), std::string::npos) << names;
 }
 
 // A full disk under the journal is an I/O error (3), not a farm error (7).
