@@ -21,9 +21,8 @@ void Master::onResult(zmq::socket_t& router, Incoming& in, Peer& p) {
   }
   Brick& b = bricks_[id];
   if (!holds(b, in.routingId, p, "result")) return;
-  p.inflight.erase(id);
-  b.holders.erase(in.routingId);
-  if (b.phase == BrickPhase::Done || b.phase == BrickPhase::Poisoned) {
+  leases_.release(id, in.routingId);
+  if (lease(id).phase == BrickPhase::Done || lease(id).phase == BrickPhase::Poisoned) {
     ++report_.duplicates;
     return;
   }
@@ -100,12 +99,13 @@ void Master::judge(zmq::socket_t& router, Arrival& a) {
     // this batch): ignored, as a message received after the ban would have been; the brick
     // goes back.
     revokeUnmerged(a);
-    if (b.phase == BrickPhase::Leased && b.holders.empty()) requeue(b, "worker " + a.workerId + " dropped", false);
+    if (lease(id).phase == BrickPhase::Leased && lease(id).holders.empty())
+      requeue(b, "worker " + a.workerId + " dropped", false);
     return;
   }
-  if (b.phase == BrickPhase::Done || b.phase == BrickPhase::Poisoned) {
+  if (lease(id).phase == BrickPhase::Done || lease(id).phase == BrickPhase::Poisoned) {
     ++report_.duplicates;  // another copy of this batch was merged first
-    if (b.phase == BrickPhase::Poisoned) revokeUnmerged(a);
+    if (lease(id).phase == BrickPhase::Poisoned) revokeUnmerged(a);
     return;
   }
   if (!a.ok) {
@@ -115,7 +115,7 @@ void Master::judge(zmq::socket_t& router, Arrival& a) {
     ++report_.malformed;
     std::string why = "corrupt result from " + a.workerId + ": " + (a.error.empty() ? "crc or bounds" : a.error);
     spdlog::warn("dropped a {}", why);
-    if (b.holders.empty()) requeue(b, why, true, a.workerId);
+    if (lease(id).holders.empty()) requeue(b, why, true, a.workerId);
     ban(router, a.routingId, "corrupt result for brick " + std::to_string(id));
     return;
   }
@@ -123,29 +123,29 @@ void Master::judge(zmq::socket_t& router, Arrival& a) {
   BrickOutput& out = a.out;
   countersOf(r, out);
   report_.perWorker[a.workerId].computeSeconds += r.compute_seconds();
-  brickSeconds_.push_back(r.compute_seconds());
-  auto sender = peers_.find(a.routingId);
-  if (!a.check && sender != peers_.end() && needsCheck(b, sender->second)) {
+  leases_.addBrickSeconds(r.compute_seconds());
+  auto sender = peers().find(a.routingId);
+  if (!a.check && sender != peers().end() && needsCheck(b, sender->second)) {
     // The brick must be checked since this copy arrived (its sender came under suspicion, or
     // another copy of the batch was held), and this copy was journaled unchecked and its bytes
     // let go: taken back (uncharged); the brick is computed again and checked.
     revokeUnmerged(a);
     b.verify = true;
     if (b.held) awaitAnotherWorker(b);
-    else if (b.holders.empty()) requeue(b, "it is to be checked: computed again", false);
+    else if (lease(id).holders.empty()) requeue(b, "it is to be checked: computed again", false);
     return;
   }
   if (a.check && !decide(router, a)) return;  // held until another worker agrees (or poisoned)
   if (!a.journaled && (journal_ || op_ == Operation::Sample)) keep(a);  // checked, or a later copy of the batch
   // Other holders (straggler backups) may drop the brick.
-  for (auto& [rid, t] : b.holders) {
+  for (auto& [rid, t] : lease(id).holders) {
     Envelope c;
     c.mutable_cancel()->set_brick_id(id);
     send(router, rid, c);
   }
   commit(id, std::move(out), a.workerId, true, std::move(a.kept), a.check);
   // Every other worker that failed this brick was refuted: the computation is deterministic.
-  for (const std::string& w : std::vector<std::string>(b.failedBy.begin(), b.failedBy.end()))
+  for (const std::string& w : std::vector<std::string>(lease(id).failedBy.begin(), lease(id).failedBy.end()))
     if (w != a.workerId) refute(router, w, id);
 }
 
@@ -206,16 +206,14 @@ void Master::onFailed(const Envelope& e, const std::string& rid, Peer& p) {
   }
   Brick& b = bricks_[id];
   if (!holds(b, rid, p, "failure")) return;
-  p.inflight.erase(id);
-  b.holders.erase(rid);
-  if (b.phase != BrickPhase::Leased || !b.holders.empty()) return;
+  leases_.release(id, rid);
+  if (lease(id).phase != BrickPhase::Leased || !lease(id).holders.empty()) return;
   if (e.failed().handed_back()) {
     ++report_.handedBack;
     requeue(b, e.failed().error(), false);
   } else {
     spdlog::warn("brick {} failed on {}: {}", id, p.workerId, e.failed().error());
-    ++p.failures;
-    p.failedBricks.push_back(id);
+    leases_.countFailure(p, id);
     requeue(b, e.failed().error(), true, p.workerId);
   }
 }

@@ -74,18 +74,17 @@ void Master::runFarm() {
   // futileLimit have been started since the last brick finished, none can: fail fast.
   const int futileLimit = wanted + 2 * (opt_.maxAttempts + 1);
   int futileSpawns = wanted, respawnDelayMs = 0;
-  size_t progressAtSpawn = done_ + poisoned_;
+  size_t progressAtSpawn = leases_.done() + leases_.poisonedCount();
   auto nextSpawn = Clock::now();
 
   auto lastBeat = Clock::now();
   auto lastAlive = Clock::now();
   auto lastTurn = Clock::now();
   const auto hb = std::chrono::milliseconds(opt_.heartbeatMs);
-  const auto window = std::chrono::milliseconds(opt_.heartbeatMs * opt_.liveness);
   const FrameLimit frameLimit = [this](const std::string& rid) {
-    return peers_.count(rid) || aliases_.count(rid) ? kMaxEnvelopeBytes + payloadLimit_ : kMaxHelloBytes;
+    return peers().count(rid) || aliases_.count(rid) ? kMaxEnvelopeBytes + payloadLimit_ : kMaxHelloBytes;
   };
-  while (done_ + poisoned_ < bricks_.size()) {
+  while (!leases_.over()) {
     zmq::pollitem_t item{static_cast<void*>(router), 0, ZMQ_POLLIN, 0};
     try {
       zmq::poll(&item, 1, std::chrono::milliseconds(std::max(5, opt_.heartbeatMs / 4)));
@@ -109,30 +108,24 @@ void Master::runFarm() {
     verifyArrivals(router);
     rethrowMergeError();
     auto now = Clock::now();
-    // The master's own stall (SIGSTOP, swapping, a slow disk): a turn is at most a poll
-    // (a quarter beat) and a bounded drain, so a gap longer than the liveness window means
-    // the master was deaf, not its peers silent. Refresh every peer instead of counting them
-    // dead, and move the lease timers on (steady clock: wall-clock jumps do not count).
-    if (now - lastTurn > window) {
-      ++report_.masterStalls;
-      auto gap = now - lastTurn;
+    // The master's own stall (SIGSTOP, swapping, a slow disk): every peer refreshed instead of
+    // counted dead, the lease timers moved on (LeaseTable::turn).
+    if (const auto gap = leases_.turn(lastTurn, now); gap != Clock::duration::zero()) {
       spdlog::warn("the master stalled for {:.1f} s (longer than the liveness window): its workers are not counted dead",
                    std::chrono::duration<double>(gap).count());
-      for (auto& [rid, p] : peers_) p.expiry = std::max(p.expiry, now + window);
-      for (uint64_t id : leased_) bricks_[id].firstLease += gap;
       lastAlive = now;
     }
     lastTurn = now;
-    expireDeadPeers(now);
+    leases_.expire(now);
     if (local) {
       local->reap();
-      if (done_ + poisoned_ > progressAtSpawn) {
-        progressAtSpawn = done_ + poisoned_;
+      if (leases_.done() + leases_.poisonedCount() > progressAtSpawn) {
+        progressAtSpawn = leases_.done() + leases_.poisonedCount();
         futileSpawns = 0;
         respawnDelayMs = 0;
       }
       int missing = wanted - local->running();
-      if (missing > 0 && now >= nextSpawn && done_ + poisoned_ < bricks_.size()) {
+      if (missing > 0 && now >= nextSpawn && !leases_.over()) {
         if (futileSpawns + missing > futileLimit)
           throw std::runtime_error("local workers keep dying: " + std::to_string(futileSpawns) +
                                    " started since the last brick finished (last one " + local->lastExit() +
@@ -143,11 +136,13 @@ void Master::runFarm() {
         nextSpawn = now + std::chrono::milliseconds(respawnDelayMs);
       }
     }
-    reissueOverdue(now);
-    dispatch(router, now);
+    leases_.reissueOverdue(now);
+    leases_.dispatch(now, [&](const std::string& rid, uint64_t id, uint32_t attempt) {
+      return sendTask(router, rid, id, attempt);
+    });
     if (now - lastBeat >= hb) {
       giveUpStarvedChecks(now);
-      for (auto& [rid, p] : peers_) {
+      for (auto& [rid, p] : peers()) {
         Envelope e;
         e.set_job_id(jobId_);
         e.mutable_heartbeat();
@@ -155,15 +150,15 @@ void Master::runFarm() {
       }
       lastBeat = now;
     }
-    if (!peers_.empty()) lastAlive = now;
+    if (!peers().empty()) lastAlive = now;
     else if (std::chrono::duration<double>(now - lastAlive).count() > opt_.noWorkerTimeoutSec) {
       throw std::runtime_error("no worker has been alive for " + std::to_string(opt_.noWorkerTimeoutSec) +
-                               " s (" + std::to_string(bricks_.size() - done_ - poisoned_) + " bricks left)");
+                               " s (" + std::to_string(bricks_.size() - leases_.done() - leases_.poisonedCount()) + " bricks left)");
     }
-    progress_->update(done_, report_.pointEvals, int(peers_.size()));
+    progress_->update(leases_.done(), report_.pointEvals, int(peers().size()));
   }
   // Tell every worker the job is over; local ones exit, cluster ones too.
-  for (auto& [rid, p] : peers_) {
+  for (auto& [rid, p] : peers()) {
     Envelope e;
     e.set_job_id(jobId_);
     e.mutable_bye()->set_reason(report_.interrupted ? "master stopping" : "job done");
@@ -181,8 +176,8 @@ void Master::handle(zmq::socket_t& router, Incoming& in, const std::string& err)
   if (banned_.count(in.routingId)) return;  // dropped for garbage before: ignored
   // A worker that reconnected speaks under its new routing id; late frames on the old one
   // are its frames too.
-  if (!peers_.count(in.routingId))
-    if (auto a = aliases_.find(in.routingId); a != aliases_.end() && peers_.count(a->second))
+  if (!peers().count(in.routingId))
+    if (auto a = aliases_.find(in.routingId); a != aliases_.end() && peers().count(a->second))
       in.routingId = a->second;
   if (!err.empty()) {
     ++(in.oversized ? report_.oversized : report_.malformed);
@@ -208,7 +203,7 @@ void Master::handle(zmq::socket_t& router, Incoming& in, const std::string& err)
     return;
   }
   auto now = Clock::now();
-  auto it = peers_.find(in.routingId);
+  auto it = peers().find(in.routingId);
   if (e.body_case() == Envelope::kHello) {
     const std::string wid = e.hello().worker_id().empty() ? printable(in.routingId) : e.hello().worker_id();
     if (bannedWorkers_.count(wid)) {
@@ -218,18 +213,14 @@ void Master::handle(zmq::socket_t& router, Incoming& in, const std::string& err)
       send(router, in.routingId, r);
       return;
     }
-    if (it == peers_.end() && !adoptReconnected(wid, in.routingId, e.hello()) && peers_.size() >= kMaxPeers) {
+    if (it == peers().end() && !adoptReconnected(wid, in.routingId, e.hello()) && peers().size() >= kMaxPeers) {
       ++report_.refused;
       Envelope r;
       r.mutable_reject()->set_reason("the farm is full (" + std::to_string(kMaxPeers) + " workers)");
       send(router, in.routingId, r);
       return;
     }
-    Peer& p = peers_[in.routingId];
-    p.workerId = wid;
-    p.unreachable = false;  // a new connection
-    p.threads = std::max(1u, e.hello().threads());
-    p.expiry = now + std::chrono::milliseconds(opt_.heartbeatMs * opt_.liveness);
+    Peer& p = leases_.join(in.routingId, wid, e.hello().threads(), now);
     ++report_.workersSeen;
     Envelope w;
     w.set_job_id(jobId_);
@@ -240,7 +231,7 @@ void Master::handle(zmq::socket_t& router, Incoming& in, const std::string& err)
     spdlog::info("worker {} joined ({} threads, {})", p.workerId, p.threads, e.hello().build());
     return;
   }
-  if (it == peers_.end()) {
+  if (it == peers().end()) {
     // A worker from before a master restart, or a stranger: ask for a hello first.
     if (e.body_case() == Envelope::kResult) ++report_.lateResults;
     Envelope r;
@@ -249,8 +240,7 @@ void Master::handle(zmq::socket_t& router, Incoming& in, const std::string& err)
     return;
   }
   Peer& p = it->second;
-  p.expiry = now + std::chrono::milliseconds(opt_.heartbeatMs * opt_.liveness);
-  p.proven = true;
+  leases_.heard(p, now);
   switch (e.body_case()) {
     case Envelope::kHeartbeat:
       break;
@@ -262,7 +252,7 @@ void Master::handle(zmq::socket_t& router, Incoming& in, const std::string& err)
       break;
     case Envelope::kBye:
       spdlog::info("worker {} left: {}", p.workerId, e.bye().reason());
-      dropPeer(in.routingId, Departure::Left);
+      leases_.drop(in.routingId, Departure::Left, now);
       break;
     default:
       ++report_.malformed;
@@ -277,48 +267,28 @@ void Master::handle(zmq::socket_t& router, Incoming& in, const std::string& err)
 // Keeping them leased would hold the worker's credit for results that never come: with every
 // worker reconnected, the job would wait for ever.
 bool Master::adoptReconnected(const std::string& workerId, const std::string& rid, const Hello& hello) {
-  auto old = std::find_if(peers_.begin(), peers_.end(), [&](auto& kv) { return kv.second.workerId == workerId; });
-  if (old == peers_.end()) return false;
-  std::string oldRid = old->first;
-  Peer moved = std::move(old->second);
-  peers_.erase(old);
+  std::string oldRid;
+  size_t lost = 0;
   const std::set<uint64_t> still(hello.holding().begin(), hello.holding().end());
-  std::vector<uint64_t> lost;
-  for (uint64_t id : moved.inflight) {
-    auto& h = bricks_[id].holders;
-    auto node = h.extract(oldRid);
-    if (node && still.count(id)) {
-      node.key() = rid;
-      h.insert(std::move(node));
-    } else {
-      lost.push_back(id);
-    }
-  }
-  for (uint64_t id : lost) {
-    moved.inflight.erase(id);
-    Brick& b = bricks_[id];
-    if (b.phase == BrickPhase::Leased && b.holders.empty())
-      requeue(b, "its result was lost when worker " + workerId + " reconnected", false);
-  }
-  peers_[rid] = std::move(moved);
+  if (!leases_.adopt(workerId, rid, still, Clock::now(), &oldRid, &lost)) return false;
   if (aliases_.size() >= kMaxAliases) aliases_.clear();
   aliases_[oldRid] = rid;
   ++report_.reconnects;
   spdlog::info("worker {} reconnected: it keeps {} lease(s), {} brick(s) go back to the queue", workerId,
-               peers_[rid].inflight.size(), lost.size());
+               peers()[rid].inflight.size(), lost);
   return true;
 }
 
 // A peer that sent garbage: a welcomed one is told bye and its bricks go back to the queue,
 // not charged; its routing id is ignored from now on (bounded list, oldest forgotten).
 void Master::ban(zmq::socket_t& router, const std::string& rid, const std::string& why) {
-  if (peers_.count(rid)) {
+  if (peers().count(rid)) {
     Envelope bye;
     bye.set_job_id(jobId_);
     bye.mutable_bye()->set_reason("dropped by the master: " + why);
     send(router, rid, bye);
-    spdlog::warn("worker {} dropped: {}", peers_[rid].workerId, why);
-    dropPeer(rid, Departure::Dropped);
+    spdlog::warn("worker {} dropped: {}", peers()[rid].workerId, why);
+    leases_.drop(rid, Departure::Dropped, Clock::now());
   }
   if (!banned_.insert(rid).second) return;
   ++report_.bannedPeers;
@@ -338,137 +308,15 @@ std::string Master::printable(const std::string& rid) {
 // Only the brick's leaseholder may answer for it: anything else is foreign and dropped.
 // Returns whether `rid` holds the brick; counts a foreign message otherwise.
 bool Master::holds(const Brick& b, const std::string& rid, const Peer& p, const char* what) {
-  if (b.holders.count(rid)) return true;
-  if (p.everHeld.count(b.id)) {
+  const Holding h = leases_.holding(b.id, rid, p);
+  if (h == Holding::Holder) return true;
+  if (h == Holding::FormerHolder) {
     ++report_.duplicates;  // a former holder's late copy (cancelled, re-leased or done)
     return false;
   }
   ++report_.foreignResults;
   spdlog::warn("dropped a {} for brick {} from {}, which does not hold it", what, b.id, p.workerId);
   return false;
-}
-
-void Master::expireDeadPeers(Clock::time_point now) {
-  std::vector<std::string> dead;
-  for (auto& [rid, p] : peers_)
-    if (now > p.expiry) dead.push_back(rid);
-  for (auto& rid : dead) {
-    ++report_.deadWorkers;
-    spdlog::warn("worker {} silent past its liveness window: dead, its bricks go back to the queue",
-                 peers_[rid].workerId);
-    dropPeer(rid, Departure::Dead);
-  }
-}
-
-void Master::sendTask(zmq::socket_t& router, const std::string& rid, Peer& p, Brick& b, Clock::time_point now) {
-  Envelope e;
-  e.set_job_id(jobId_);
-  Task* t = e.mutable_task();
-  t->set_brick_id(b.id);
-  t->set_attempt(++b.attempts);
-  for (int a = 0; a < 3; ++a) {
-    t->add_lo(b.lo[a]);
-    t->add_hi(b.hi[a]);
-  }
-  if (!send(router, rid, e)) {
-    // No route to the peer: its connection closed without a bye (it crashed or reconnected)
-    // and its liveness window has not run out yet. dispatch() already took a pending brick
-    // off pending_: put it back, or no one would lease it again and the job would never end
-    // (the loop keeps waiting while the other workers heartbeat). A reissued or backup copy
-    // stays leased to its other holders and goes back to the reissue queue (it was due).
-    if (b.phase == BrickPhase::Pending) (b.suspect ? suspects_ : pending_).push_front(b.id);
-    else reissue_.push_back(b.id);
-    // The peer gets nothing more; it keeps its leases until its liveness window runs out
-    // (then it is dead, expireDeadPeers) or it says hello again under a new connection (a
-    // worker whose master was stalled reconnects: adoptReconnected), so one death is
-    // judged one way, whichever way it is noticed first.
-    if (!p.unreachable) spdlog::info("worker {} unreachable: no more bricks for it", p.workerId);
-    p.unreachable = true;
-    return;
-  }
-  if (b.phase != BrickPhase::Leased) b.firstLease = now;
-  b.phase = BrickPhase::Leased;
-  leased_.insert(b.id);
-  b.holders[rid] = now;
-  p.inflight.insert(b.id);
-  p.everHeld.insert(b.id);
-}
-
-void Master::dispatch(zmq::socket_t& router, Clock::time_point now) {
-  // Cluster mode: give the expected workers a short grace period to join, so that the first
-  // bricks spread over the whole farm instead of queuing on the earliest worker.
-  if (opt_.expectWorkers > 0 && int(peers_.size()) < opt_.expectWorkers) {
-    if (peers_.empty()) return;
-    if (!firstJoin_) firstJoin_ = now;
-    if (now - *firstJoin_ < std::chrono::seconds(5)) return;
-  }
-  // Peers in routing-id order: dispatch order never changes the output, only the schedule.
-  std::vector<std::string> rids;
-  for (auto& [rid, p] : peers_) rids.push_back(rid);
-  auto holdsSuspect = [&](const Peer& p) {
-    return std::any_of(p.inflight.begin(), p.inflight.end(), [&](uint64_t id) { return bricks_[id].suspect; });
-  };
-  // Takes the first brick of `queue` that `cand` may take (its phase `phase`), passing over at
-  // most kMaxSkippedForPeer that it failed before (they stay at the front, in order).
-  auto takeFrom = [&](std::deque<uint64_t>& queue, const Peer& cand, std::optional<uint64_t>& next) {
-    std::vector<uint64_t> skipped;
-    while (!queue.empty() && !next && skipped.size() < kMaxSkippedForPeer) {
-      uint64_t id = queue.front();
-      queue.pop_front();
-      if (bricks_[id].phase != BrickPhase::Pending) continue;
-      if (mayTake(cand, bricks_[id], now)) next = id;
-      else skipped.push_back(id);
-    }
-    queue.insert(queue.begin(), skipped.begin(), skipped.end());
-  };
-  for (int round = 0; round < kCredit; ++round)
-    for (auto& rid : rids) {
-      auto it = peers_.find(rid);
-      if (it == peers_.end() || it->second.unreachable || int(it->second.inflight.size()) > round ||
-          holdsSuspect(it->second))
-        continue;
-      // A suspect brick goes only alone to a worker that has shown it is alive, a fresh one
-      // unless it has waited two liveness windows for one (onDeath).
-      const Peer& cand = it->second;
-      const bool isolates = cand.proven && cand.inflight.empty() &&
-                            (cand.finished == 0 || suspects_.empty() ||
-                             now - bricks_[suspects_.front()].suspectSince > 2 * liveWindow());
-      std::optional<uint64_t> next;
-      if (isolates) takeFrom(suspects_, cand, next);
-      std::vector<uint64_t> notHere;  // suspect copies due again, for an isolating worker
-      while (!reissue_.empty() && !next) {
-        uint64_t id = reissue_.front();
-        reissue_.pop_front();
-        if (bricks_[id].phase != BrickPhase::Leased || bricks_[id].holders.count(rid)) continue;
-        if ((bricks_[id].suspect && !isolates) || bricks_[id].failedBy.count(cand.workerId) ||
-            holdsOpinion(bricks_[id], cand.workerId))
-          notHere.push_back(id);
-        else next = id;
-      }
-      reissue_.insert(reissue_.begin(), notHere.begin(), notHere.end());
-      if (!next) takeFrom(pending_, cand, next);
-      if (!next) continue;
-      sendTask(router, rid, it->second, bricks_[*next], now);
-    }
-  // Stragglers: nothing queued and a worker idle -> the oldest long-running brick, once more.
-  if (!pending_.empty() || !suspects_.empty()) return;
-  double threshold = std::max(1.0, 2 * medianBrickSeconds());
-  for (auto& rid : rids) {
-    auto it = peers_.find(rid);
-    if (it == peers_.end() || it->second.unreachable || !it->second.inflight.empty()) continue;
-    Brick* oldest = nullptr;
-    for (uint64_t id : leased_)
-      if (Brick& b = bricks_[id]; !b.backupIssued && !b.suspect && !b.holders.count(rid) &&
-          !b.failedBy.count(it->second.workerId) && !holdsOpinion(b, it->second.workerId) &&
-          std::chrono::duration<double>(now - b.firstLease).count() > threshold &&
-          (!oldest || b.firstLease < oldest->firstLease))
-        oldest = &b;
-    if (!oldest) return;
-    oldest->backupIssued = true;
-    ++report_.stragglerReissues;
-    spdlog::info("brick {} is a straggler: issued once more to {}", oldest->id, it->second.workerId);
-    sendTask(router, rid, it->second, *oldest, now);
-  }
 }
 
 }  // namespace frep::farm::detail

@@ -76,10 +76,10 @@ FarmOutcome Master::run() {
         uint64_t v = 0;
         std::memcpy(&v, payload.data(), 8);
         if (id == kJournalVerifySeed) journalSeed = v;
-        else if (v < bricks_.size() && bricks_[v].phase == BrickPhase::Done) uncommit(v);
+        else if (v < bricks_.size() && lease(v).phase == BrickPhase::Done) uncommit(v);
         return;
       }
-      if (id >= bricks_.size() || bricks_[id].phase == BrickPhase::Done) return;
+      if (id >= bricks_.size() || lease(id).phase == BrickPhase::Done) return;
       BrickOutput out;
       KeptBrick kept;
       std::string err;
@@ -95,17 +95,17 @@ FarmOutcome Master::run() {
   setUpVerification(journalSeed);
   if (streaming_) queueCompleteSlabs();
   progress_ = std::make_unique<Progress>(opt_.progressBar, opt_.progressJson, bricks_.size());
-  if (done_ + poisoned_ < bricks_.size()) {
+  if (!leases_.over()) {
     if (opt_.workers == 0 && opt_.listen.empty()) runInProcess();
     else runFarm();
   }
-  progress_->finish(done_, report_.pointEvals, int(peers_.size()));
+  progress_->finish(leases_.done(), report_.pointEvals, int(peers().size()));
   // To the disk when a resume will read it (stopped, or bricks poisoned). A finished job's
   // journal is removed once the output is written (frep sample/mesh), usually before the
   // kernel writes it back at all: syncing it took 0.18 s of a 1.2 s job (4096 bricks,
   // 600 MB). It stays in the page cache meanwhile, so only a crash of the machine itself
   // while the output is written can lose records, which a resume recomputes.
-  if (journal_ && done_ < bricks_.size()) journal_->flush();
+  if (journal_ && leases_.done() < bricks_.size()) journal_->flush();
   return finish();
 }
 
@@ -139,7 +139,7 @@ void Master::setUpVerification(std::optional<uint64_t> journalSeed) {
                  "is merged unchecked)", opt_.noWorkerTimeoutSec);
   verifyOn_ = true;
   for (Brick& b : bricks_)
-    if (b.phase != BrickPhase::Done) b.verify = verifySelected(jobId_, seed_, b.id, fraction_);
+    if (lease(b.id).phase != BrickPhase::Done) b.verify = verifySelected(jobId_, seed_, b.id, fraction_);
 }
 
 uint32_t Master::workerIndex(const std::string& workerId) {
@@ -164,8 +164,10 @@ void Master::plan() {
         for (int a = 0; a < 3; ++a) leaves *= size_t((br.hi[a] - br.lo[a] + 7) / 8);
         br.maxLeaves = leaves;
         bricks_.push_back(br);
-        pending_.push_back(br.id);
       }
+  leases_ = LeaseTable(bricks_.size(), leasePolicy(),
+                       {[this](uint64_t id, const std::string& why, const std::string& count) { onPoisoned(id, why, count); },
+                        [this](uint64_t id, const std::string& w) { return holdsOpinion(bricks_[id], w); }});
   if (op_ == Operation::Sample) kept_.resize(bricks_.size());
   else outputs_.resize(bricks_.size());
   perSlab_ = size_t(n[1]) * size_t(n[2]);
@@ -194,12 +196,7 @@ void Master::plan() {
 void Master::commit(uint64_t id, BrickOutput&& out, const std::string& who, bool computed, KeptBrick&& kept,
             bool verified) {
   Brick& b = bricks_[id];
-  b.phase = BrickPhase::Done;
-  for (auto& [rid, t] : b.holders)  // cancelled copies no longer take a worker's credit
-    if (auto p = peers_.find(rid); p != peers_.end()) p->second.inflight.erase(id);
-  b.holders.clear();
-  leased_.erase(id);
-  ++done_;
+  leases_.complete(id);
   b.verified = verified;
   b.mergedFrom = computed ? workerIndex(who) : kFromJournal;
   if (verified) ++report_.verifiedBricks;
@@ -219,8 +216,7 @@ void Master::commit(uint64_t id, BrickOutput&& out, const std::string& who, bool
     report_.extremumUncertified += out.extremumUncertified;
     report_.extremumSignDecided += out.extremumSignDecided;
     report_.extremumWidestGap = std::max(report_.extremumWidestGap, out.extremumWidestGap);
-    for (auto& [rid, p] : peers_)
-      if (p.workerId == who) ++p.finished;
+    leases_.credit(who);
     auto& share = report_.perWorker[who];
     ++share.bricks;
     share.pointEvals += out.stats.pointEvals;
@@ -235,13 +231,12 @@ void Master::commit(uint64_t id, BrickOutput&& out, const std::string& who, bool
 // the journal only, and runJob merges the whole job once more from the journal.
 void Master::uncommit(uint64_t id) {
   Brick& b = bricks_[id];
-  if (b.phase != BrickPhase::Done) return;
+  if (lease(id).phase != BrickPhase::Done) return;
   if (journal_ && !replaying_) {
     const uint64_t v = id;
     journal_->add(kJournalRevoke, &v, 8, crc32Of(&v, 8));
   }
-  b.phase = BrickPhase::Pending;
-  --done_;
+  leases_.reopen(id, !replaying_);  // replaying: still queued from the plan
   if (b.mergedFrom == kFromJournal) {
     if (report_.bricksFromJournal) --report_.bricksFromJournal;
   } else {
@@ -264,9 +259,6 @@ void Master::uncommit(uint64_t id) {
   } else {
     outputs_[id] = BrickOutput{};
   }
-  if (replaying_) return;  // still in pending_ from plan()
-  b.backupIssued = b.leaseReissued = false;
-  pending_.push_front(id);
 }
 
 void Master::runInProcess() {
@@ -274,7 +266,7 @@ void Master::runInProcess() {
   describeErrorBounds(*tape, &report_.errorBounds);
   for (const std::string& line : describeExactTerms(job_)) report_.errorBounds.push_back(line);
   for (Brick& b : bricks_) {
-    if (b.phase == BrickPhase::Done) continue;
+    if (lease(b.id).phase == BrickPhase::Done) continue;
     if (gStop) {
       report_.interrupted = true;
       return;
@@ -292,7 +284,7 @@ void Master::runInProcess() {
       journalAndKeep(b.id, payload.data(), payload.size(), crc32Of(payload.data(), payload.size()), kept);
     }
     commit(b.id, std::move(out), "in-process", true, std::move(kept));
-    progress_->update(done_, report_.pointEvals, 1);
+    progress_->update(leases_.done(), report_.pointEvals, 1);
   }
 }
 

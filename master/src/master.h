@@ -28,6 +28,7 @@
 
 #include "frep/farm/brick_codec.h"
 #include "frep/farm/job.h"
+#include "frep/farm/lease_table.h"
 #include "frep/master/farm_master.h"
 #include "frep/master/journal.h"
 #include "frep/master/leaf_records.h"
@@ -43,7 +44,6 @@ using Clock = std::chrono::steady_clock;
 extern std::atomic<bool> gStop;
 
 constexpr size_t kMaxEnvelopeBytes = 1 << 20;  // a task or result header is a few KB at most
-constexpr int kCredit = 4;                     // bricks in flight per worker (hides latency)
 // Hostile peers (docs/farm.md, "Threat model"): an un-welcomed routing id may send only a
 // hello, checked before parsing; garbage bans its routing id. The ban list and the welcomed
 // workers are bounded so strangers cannot grow the master's state without limit.
@@ -51,14 +51,6 @@ constexpr size_t kMaxHelloBytes = 64 << 10;
 constexpr size_t kMaxBanned = 1024;     // banned routing ids remembered (oldest forgotten)
 constexpr size_t kMaxPeers = 4096;      // welcomed workers at once; a hello beyond is refused
 constexpr size_t kMaxAliases = 4096;    // routing ids of workers that reconnected
-// Failing peers (docs/farm.md, "Failing peers"): a brick is poisoned only when kIndependentFailures
-// workers (distinct worker ids) failed it; a worker that failed a brick is not given it again
-// while another could take it (Master::mayTake); a worker whose failures other workers refuted
-// (they computed the brick it failed) reach kBanAfterRefuted and more than twice the lower median
-// of the other peers' refuted failures is banned: told bye, its worker id refused from then on.
-constexpr size_t kIndependentFailures = 2;
-constexpr uint64_t kBanAfterRefuted = 3;
-constexpr size_t kMaxSkippedForPeer = 64;  // bricks a peer failed passed over per dispatch (bounded scan)
 constexpr int kRouterRcvHwm = 64;       // queued messages per connection (ZMQ_RCVHWM)
 // Verification (docs/farm.md, "Verification"): a checked brick is merged once two distinct
 // workers returned the same bytes; this many different results without two agreeing poison it
@@ -109,29 +101,10 @@ class HeldPayload {
   std::atomic<size_t>* held_ = nullptr;
 };
 
-enum class Departure { Left, Dead, Dropped };
-
-enum class BrickPhase { Pending, Leased, Done, Poisoned };
-
+// A brick of the job as the master sees it (its lease is LeaseTable's BrickLease).
 struct Brick {
   uint64_t id = 0;
   std::array<int32_t, 3> lo{}, hi{};
-  BrickPhase phase = BrickPhase::Pending;
-  int failures = 0;  // failed attempts reported by its holder (and corrupt results from it)
-  std::set<std::string> failedBy;  // worker ids of those holders (not banned ones: unban on ban)
-  Clock::time_point lastFailure{};
-  // Worker deaths (docs/farm.md, "Faults"): the first death of a worker computing it makes it
-  // suspect; a suspect is leased only alone to a worker that has shown it is alive, and each
-  // such worker that dies with it counts; killers.size() >= maxAttempts poisons it.
-  bool suspect = false;
-  Clock::time_point suspectSince{};
-  std::set<std::string> killers;      // fresh workers (nothing finished) that died with it alone
-  std::set<std::string> weakKillers;  // workers that had finished other bricks
-  uint32_t attempts = 0;
-  std::map<std::string, Clock::time_point> holders;  // routing id -> lease start
-  Clock::time_point firstLease{};
-  bool backupIssued = false, leaseReissued = false;
-  std::string lastError;
   size_t maxLeaves = 0;  // upper bound on leaves in the region (payload sanity check)
   // Verification: `verify`, merged only once two distinct workers returned the same bytes (in
   // the sample, a suspect's, or recomputed for a convicted worker); `held`, results of it wait
@@ -189,19 +162,7 @@ struct Arrival {
   bool journaled = false;  // appended to the journal (a copy not merged is then revoked there)
 };
 
-struct Peer {
-  std::string workerId;
-  uint32_t threads = 1;
-  Clock::time_point expiry;
-  std::set<uint64_t> inflight;
-  std::set<uint64_t> everHeld;  // a later copy from a former holder is a duplicate, not foreign
-  bool proven = false;          // sent something after its hello (it lives past a task)
-  bool unreachable = false;     // no route to it: no more tasks (sendTask)
-  uint64_t finished = 0;        // bricks it computed that were merged
-  uint64_t failures = 0;        // bricks it reported failed (not handed back)
-  uint64_t refuted = 0;         // ... of which another worker then computed
-  std::vector<uint64_t> failedBricks;  // the bricks it failed, to clear them if it is banned
-};
+using Peer = PeerLease;
 
 class Master {
  public:
@@ -245,6 +206,7 @@ class Master {
   static std::string printable(const std::string& rid);
 
   bool holds(const Brick& b, const std::string& rid, const Peer& p, const char* what);
+  std::map<std::string, Peer>& peers() { return leases_.peers(); }
 
   void onResult(zmq::socket_t& router, Incoming& in, Peer& p);
 
@@ -299,25 +261,15 @@ class Master {
 
   void onFailed(const Envelope& e, const std::string& rid, Peer& p);
 
-  void poison(Brick& b, const std::string& why, const std::string& count);
+  // The lease table's (leases_): a brick poisoned, and what the master keeps of it.
+  void onPoisoned(uint64_t id, const std::string& why, const std::string& count);
+  const BrickLease& lease(uint64_t id) const { return leases_.brick(id); }
+  LeasePolicy leasePolicy() const;
+  void requeue(const Brick& b, const std::string& why, bool counts, const std::string& by = {}) {
+    leases_.requeue(b.id, why, counts, Clock::now(), by);
+  }
 
-  void requeue(Brick& b, const std::string& why, bool counts, const std::string& by = {});
-
-  void onDeath(Brick& b, const Peer& p);
-
-  void dropPeer(const std::string& rid, Departure how);
-
-  void expireDeadPeers(Clock::time_point now);
-
-  double medianBrickSeconds();
-
-  void reissueOverdue(Clock::time_point now);
-
-  void sendTask(zmq::socket_t& router, const std::string& rid, Peer& p, Brick& b, Clock::time_point now);
-
-  bool mayTake(const Peer& cand, const Brick& b, Clock::time_point now) const;
-
-  void dispatch(zmq::socket_t& router, Clock::time_point now);
+  bool sendTask(zmq::socket_t& router, const std::string& rid, uint64_t id, uint32_t attempt);
 
   std::string_view keptPayload(const KeptBrick& k, size_t brick, std::string& buffer);
 
@@ -352,8 +304,7 @@ class Master {
   GridSpec grid_;
   Operation op_;
   std::vector<Brick> bricks_;
-  std::deque<uint64_t> pending_, reissue_;
-  std::deque<uint64_t> suspects_;  // pending suspect bricks (onDeath), leased only alone
+  LeaseTable leases_;  // the bricks' leases and the peers (leases.cpp)
   std::set<std::string> banned_;   // routing ids that sent garbage
   std::deque<std::string> bannedOrder_;
   std::set<std::string> bannedWorkers_;  // worker ids banned for failing what others computed
@@ -383,7 +334,6 @@ class Master {
   std::exception_ptr mergeError_;
   std::atomic<bool> mergeFailed_{false};
   std::vector<Tile> streamedTiles_;
-  std::map<std::string, Peer> peers_;
   // Verification (--verify): on (two workers can be compared), the fraction and seed of the
   // sample, the held results of the bricks under verification, the workers whose results were
   // merged (Brick::mergedFrom), the journal being replayed, a convicted worker's brick streamed.
@@ -395,17 +345,11 @@ class Master {
   std::map<std::string, uint32_t> workerIndex_;
   bool replaying_ = false;
   bool streamTainted_ = false;
-  std::vector<double> brickSeconds_;
-  double median_ = 0;    // medianBrickSeconds() of the first medianOf_ entries
-  size_t medianOf_ = 0;
-  std::set<uint64_t> leased_;  // bricks in phase Leased (timers scan only these)
   size_t payloadLimit_ = 0;
-  size_t done_ = 0, poisoned_ = 0;
   FarmReport report_;
   std::unique_ptr<Journal> journal_;
   std::unique_ptr<LocalWorkers> retired_;  // the job's local workers, sent their bye
   std::unique_ptr<Progress> progress_;
-  std::optional<Clock::time_point> firstJoin_;
   Clock::time_point start_;
 };
 

@@ -187,9 +187,9 @@ FarmOutcome Master::finish() {
   // Bricks of a convicted worker were in slabs already streamed: the journal holds the job as
   // it must be; runJob merges it once more from there (a job that did not complete writes
   // nothing anyway, and its journal is right for --resume).
-  report_.restreamed = streamTainted_ && done_ == bricks_.size() && !report_.interrupted;
+  report_.restreamed = streamTainted_ && leases_.done() == bricks_.size() && !report_.interrupted;
   report_.operation = op_ == Operation::Mesh ? "mesh" : op_ == Operation::Render ? "render" : "sample";
-  if (op_ == Operation::Render && done_ == bricks_.size()) {
+  if (op_ == Operation::Render && leases_.done() == bricks_.size()) {
     // The merge step of a render job: each tile's hits to their pixels (split-invariant, as
     // castRegion's regions give the whole image's hits).
     DepthImage& img = o.image;
@@ -206,7 +206,7 @@ FarmOutcome Master::finish() {
     }
     outputs_.clear();
   }
-  if (op_ == Operation::Mesh && done_ == bricks_.size()) {
+  if (op_ == Operation::Mesh && leases_.done() == bricks_.size()) {
     // The merge step of a mesh job: the pieces stitched by global edge key (split-invariant).
     // mergePiecesReleasing frees each piece as soon as it is stitched: the master holds about
     // one copy of the output mesh instead of three (the same mesh as mergePieces).
@@ -227,6 +227,14 @@ FarmOutcome Master::finish() {
   o.result.stats.domainErrors = report_.domainErrors;
   o.result.stats.denseEvals = uint64_t(grid_.dims[0]) * grid_.dims[1] * grid_.dims[2];
   report_.denseEvals = o.result.stats.denseEvals;
+  const LeaseStats& leases = leases_.stats();
+  report_.retries = leases.retries;
+  report_.deadWorkers = leases.deadWorkers;
+  report_.stragglerReissues = leases.stragglerReissues;
+  report_.leaseReissues = leases.leaseReissues;
+  report_.suspectBricks = leases.suspectBricks;
+  report_.masterStalls = leases.masterStalls;
+  report_.refutedFailures = leases.refutedFailures;
   report_.wallSeconds = std::chrono::duration<double>(Clock::now() - start_).count();
   report_.peakRssBytes = peakRssBytes();
   o.report = report_;

@@ -17,33 +17,21 @@ namespace frep::farm::detail {
 // refuted worker is under suspicion: every result of it is checked from now on, and the
 // bricks of it merged unchecked are computed again (recheckSuspect).
 void Master::refute(zmq::socket_t& router, const std::string& workerId, uint64_t id) {
-  ++report_.refutedFailures;
-  auto it = std::find_if(peers_.begin(), peers_.end(), [&](auto& kv) { return kv.second.workerId == workerId; });
-  if (it == peers_.end()) return;  // gone already
-  Peer& p = it->second;
-  if (++p.refuted == 1 && verifyOn_) recheckSuspect(workerId);
-  std::vector<uint64_t> others;
-  for (auto& [rid, q] : peers_)
-    if (&q != &p) others.push_back(q.refuted);
-  std::sort(others.begin(), others.end());
-  const uint64_t median = others.empty() ? 0 : others[(others.size() - 1) / 2];
-  if (p.refuted < kBanAfterRefuted || p.refuted <= 2 * median) return;
+  const LeaseTable::Refutation r = leases_.refute(workerId);
+  if (!r.known) return;  // gone already
+  if (r.first && verifyOn_) recheckSuspect(workerId);
+  if (!r.ban) return;
   spdlog::warn("worker {} banned: {} of its {} failures were computed by other workers (brick {} last)", workerId,
-               p.refuted, p.failures, id);
+               r.refuted, r.failures, id);
   ++report_.failingPeersBanned;
-  banWorker(router, workerId, "it failed " + std::to_string(p.refuted) + " bricks that other workers computed");
+  banWorker(router, workerId, "it failed " + std::to_string(r.refuted) + " bricks that other workers computed");
 }
 
 // Bans a worker id for the rest of the job: its failures and its held results no longer count
 // against or for any brick, its worker id is refused when it says hello again (bounded list),
 // and if it is connected it is told bye and its bricks go back to the queue uncharged.
 void Master::banWorker(zmq::socket_t& router, const std::string& workerId, const std::string& why) {
-  auto it = std::find_if(peers_.begin(), peers_.end(), [&](auto& kv) { return kv.second.workerId == workerId; });
-  if (it != peers_.end())
-    for (uint64_t f : it->second.failedBricks) {
-      Brick& b = bricks_[f];
-      if (b.failedBy.erase(workerId) && b.failures > 0) --b.failures;
-    }
+  leases_.forgetFailures(workerId);
   for (auto v = verifying_.begin(); v != verifying_.end();) {
     auto& ops = v->second.opinions;
     ops.erase(std::remove_if(ops.begin(), ops.end(), [&](const Opinion& o) { return o.workerId == workerId; }), ops.end());
@@ -61,7 +49,8 @@ void Master::banWorker(zmq::socket_t& router, const std::string& workerId, const
       bannedWorkerOrder_.pop_front();
     }
   }
-  if (it != peers_.end()) ban(router, it->first, why);
+  auto it = std::find_if(peers().begin(), peers().end(), [&](auto& kv) { return kv.second.workerId == workerId; });
+  if (it != peers().end()) ban(router, it->first, why);
 }
 
 // Whether `workerId` returned one of the results of `b` held now (it may not compute b again).
@@ -74,13 +63,7 @@ bool Master::holdsOpinion(const Brick& b, const std::string& workerId) const {
 
 // A brick whose result is held waits for another worker: back to the front of the queue (unless
 // a backup copy is still leased).
-void Master::awaitAnotherWorker(Brick& b) {
-  if (!b.holders.empty()) return;
-  leased_.erase(b.id);
-  b.phase = BrickPhase::Pending;
-  b.backupIssued = b.leaseReissued = false;
-  pending_.push_front(b.id);
-}
+void Master::awaitAnotherWorker(Brick& b) { leases_.awaitAnother(b.id); }
 
 // A checked result (CRC and codec verified): true when it is to be merged now, that is when it
 // has the same bytes as a held result of another worker (a majority of two: the workers whose
@@ -119,8 +102,7 @@ bool Master::decide(zmq::socket_t& router, Arrival& a) {
   if (v.opinions.size() + 1 >= kMaxOpinions) {
     verifying_.erase(a.brick);
     b.held = false;
-    leased_.erase(b.id);
-    poison(b,
+    leases_.poison(b.id,
            "workers " + others + " and " + a.workerId + " returned " + std::to_string(kMaxOpinions) +
                " different results: the computation is not deterministic across them (other builds or machines?)",
            std::to_string(kMaxOpinions) + " different results");
@@ -165,7 +147,7 @@ uint64_t Master::takeBackUnchecked(const std::string& workerId, bool evenStreame
   if (w == workerIndex_.end()) return 0;
   uint64_t n = 0;
   for (Brick& x : bricks_) {
-    if (x.phase != BrickPhase::Done || x.verified || x.mergedFrom != w->second) continue;
+    if (lease(x.id).phase != BrickPhase::Done || x.verified || x.mergedFrom != w->second) continue;
     if (!evenStreamed && streaming_ && x.id / perSlab_ < slabsQueued_) continue;
     uncommit(x.id);
     if (!evenStreamed) x.verify = true;
@@ -182,8 +164,8 @@ void Master::giveUpStarvedChecks(Clock::time_point now) {
   std::vector<uint64_t> due;
   for (auto& [id, v] : verifying_) {
     const Brick& b = bricks_[id];
-    bool someone = b.phase != BrickPhase::Pending;
-    for (auto p = peers_.begin(); !someone && p != peers_.end(); ++p)
+    bool someone = lease(id).phase != BrickPhase::Pending;
+    for (auto p = peers().begin(); !someone && p != peers().end(); ++p)
       someone = !p->second.unreachable && !holdsOpinion(b, p->second.workerId);
     if (someone) {
       v.starved = false;
@@ -202,7 +184,7 @@ void Master::giveUpStarvedChecks(Clock::time_point now) {
     std::string who;
     for (const Opinion& o : v.opinions) who += (who.empty() ? "" : ", ") + o.workerId;
     if (v.opinions.size() > 1) {
-      poison(b, "workers " + who + " returned different results and no other worker joined within " +
+      leases_.poison(b.id, "workers " + who + " returned different results and no other worker joined within " +
                     std::to_string(opt_.noWorkerTimeoutSec) + " s to decide",
              std::to_string(v.opinions.size()) + " different results");
       continue;
