@@ -510,6 +510,12 @@ def check_k8s(docs, frep_help, worker_help):
                     and r["onExitCodes"].get("operator") == "In"
                     and r["onExitCodes"].get("containerName", wc["name"]) == wc["name"] for r in rules),
                 "worker Job has no podFailurePolicy rule FailJob on exit code 78")
+        # Every onPodConditions pattern names its status: the schemas before 1.31 require it.
+        for job_name, spec in (("worker", wspec), ("master", mjob["spec"])):
+            for r in spec.get("podFailurePolicy", {}).get("rules", []):
+                for c in r.get("onPodConditions", []):
+                    require(c.get("status") == "True",
+                            f"{job_name} Job podFailurePolicy onPodConditions {c.get('type')} has no status: \"True\"")
         # Volumes: the model from a ConfigMap, the output on a PVC.
         vols = {v["name"]: v for v in mjob["spec"]["template"]["spec"].get("volumes", [])}
         mounts = {m["mountPath"].rstrip("/"): m["name"] for m in mc.get("volumeMounts", [])}
