@@ -1,6 +1,6 @@
 # `cmake --install build [--prefix P]`: the libraries frep_core, frep_lang and frep_io (static,
 # position-independent so that the Python module can take them in), their public headers, the
-# frep and frep-worker programs, a CMake package (find_package(frepfarm) -> frepfarm::core,
+# frep and frep-worker programs, the man page and bash completion, a CMake package (find_package(frepfarm) -> frepfarm::core,
 # frepfarm::lang, frepfarm::io) and a pkg-config file (frepfarm.pc). tests/consumer builds a
 # small project against an installed tree both ways.
 include(GNUInstallDirs)
@@ -21,6 +21,11 @@ install(TARGETS frep_core frep_lang_archive frep_lang frep_io EXPORT frepfarmTar
 install(TARGETS frep frep-worker RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY core/include/ lang/include/ io/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h")
+# The man page (man 1 frep) and the bash completion, where bash-completion loads a command's
+# completion on demand (share/bash-completion/completions/frep).
+install(FILES docs/frep.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+install(FILES deploy/completion/frep.bash DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions
+        RENAME frep)
 
 install(EXPORT frepfarmTargets NAMESPACE frepfarm:: DESTINATION ${FREP_CMAKE_DIR})
 # OpenVDB ships a find module, not a package config: the config file looks where it was found

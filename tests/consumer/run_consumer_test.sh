@@ -16,6 +16,15 @@ for f in bin/frep bin/frep-worker include/frep/lang/hyperfun.h include/frep/io/v
          include/frep/evaluators/eval.h; do
   [ -e "$prefix/$f" ] || { echo "not installed: $f"; exit 1; }
 done
+# The man page renders, and the completion completes frep's verbs.
+man1="$(find "$prefix" -path '*/man1/frep.1')"
+[ -n "$man1" ] || { echo "not installed: man1/frep.1"; exit 1; }
+man -l "$man1" 2>/dev/null | grep -q "frep" || { echo "man -l $man1 shows nothing"; exit 1; }
+completion="$prefix/share/bash-completion/completions/frep"
+[ -e "$completion" ] || { echo "not installed: share/bash-completion/completions/frep"; exit 1; }
+verbs="$(bash -c "source '$completion'; COMP_WORDS=(frep me); COMP_CWORD=1; COMP_LINE='frep me'; COMP_POINT=7; \$(complete -p frep | sed -E 's/.*-F ([^ ]+).*/\1/') frep me frep; echo \"\${COMPREPLY[*]}\"")"
+case " $verbs " in *" mesh "*) ;; *) echo "the installed completion offers '$verbs' for 'frep me'"; exit 1 ;; esac
+echo "man page and completion installed ($verbs)"
 "$prefix/bin/frep" --version
 "$prefix/bin/frep-worker" --help >/dev/null
 
