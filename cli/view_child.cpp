@@ -3,6 +3,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/prctl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -37,7 +38,11 @@ ChildResult runChild(const std::vector<std::string>& argv, const std::atomic<boo
   if (pid == 0) {  // the child: only async-signal-safe calls until exec
     sigset_t none;
     sigemptyset(&none);
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &dfl, nullptr);  // no handler of ours before exec
     ::sigprocmask(SIG_SETMASK, &none, nullptr);  // frep view blocks SIGINT/SIGTERM in its threads
+    ::setpgid(0, 0);                             // its own group, so that SIGKILL reaches the processes it starts too
     const int devNull = ::open("/dev/null", O_RDONLY);
     if (devNull >= 0) ::dup2(devNull, 0);
     ::dup2(outPipe[1], 1);
@@ -53,17 +58,20 @@ ChildResult runChild(const std::vector<std::string>& argv, const std::atomic<boo
   ChildResult r;
   pollfd fds[2] = {{outPipe[0], POLLIN, 0}, {errPipe[0], POLLIN, 0}};
   std::string* sinks[2] = {&r.out, &r.err};
-  int open = 2;
-  std::chrono::steady_clock::time_point termSent;
-  bool killed = false;
-  while (open > 0) {
+  int open = 2, status = 0;
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point termSent, ended;
+  bool killed = false, exited = false;
+  // Until both pipes close, or 200 ms after the child ended: a process it started (a local
+  // worker) may hold them open a while longer.
+  while (open > 0 && !(exited && Clock::now() - ended > std::chrono::milliseconds(200))) {
     if (cancel && cancel->load() && !r.cancelled) {
       r.cancelled = true;
       ::kill(pid, SIGTERM);
-      termSent = std::chrono::steady_clock::now();
+      termSent = Clock::now();
     }
-    if (r.cancelled && !killed && std::chrono::steady_clock::now() - termSent > std::chrono::seconds(2)) {
-      ::kill(pid, SIGKILL);  // a child that ignores the interrupt contract
+    if (r.cancelled && !killed && !exited && Clock::now() - termSent > std::chrono::seconds(2)) {
+      ::kill(-pid, SIGKILL);  // a child that ignores the interrupt contract, and what it started
       killed = true;
     }
     if (::poll(fds, 2, 50) < 0 && errno != EINTR) break;
@@ -79,12 +87,14 @@ ChildResult runChild(const std::vector<std::string>& argv, const std::atomic<boo
         --open;
       }
     }
+    if (!exited && ::waitpid(pid, &status, WNOHANG) == pid) exited = true, ended = Clock::now();
   }
   for (auto& f : fds)
     if (f.fd >= 0) ::close(f.fd);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
-  if (r.cancelled) r.stopSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - termSent).count();
+  if (!exited)
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+  if (r.cancelled) r.stopSeconds = std::chrono::duration<double>(Clock::now() - termSent).count();
+  if (exited && r.cancelled) r.stopSeconds = std::chrono::duration<double>(ended - termSent).count();
   r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
   return r;
 }
