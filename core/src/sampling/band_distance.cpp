@@ -122,8 +122,8 @@ class HaloSampler {
 std::string bandDistanceBound() {
   return "second-order estimate from the sampled lattice: f's Taylor expansion to second order (central "
          "differences) solved for its zero along the gradient; exact where f is linear, and where f is quadratic "
-         "along straight gradient lines (a ball's r^2 - |x|^2); not certified elsewhere (a kink of min/max within a "
-         "voxel: up to about a voxel)";
+         "along straight gradient lines (a ball's r^2 - |x|^2); not certified elsewhere: near a crease of min/max or "
+         "R-function combinations it underestimates, by up to the band's width";
 }
 
 void bandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOptions& opt, SampleResult& r,
