@@ -183,14 +183,13 @@ ClearanceResult clearance(const Tape& ta, const Tape& tb, const Interval* box, c
     }
     heap.pop();
     ++r.pairs;
-    if ((opt.stopWhenSeparated && p.lb > 0.0) || p.lb >= upper - tol) {
+    if (p.lb >= upper - tol) {
       lower = p.lb;
       break;
     }
     const std::vector<Interval>&ba = A.box(p.a), &bb = B.box(p.b);
     const double wa = maxWidth(ba), wb = maxWidth(bb);
-    // A separation proof needs witnesses only to stop on solids that meet: near the bottom.
-    if (!opt.stopWhenSeparated || std::max(wa, wb) <= 4.0 * minSize) tryPair(p.a, p.b);
+    tryPair(p.a, p.b);
     if (p.lb >= upper - tol) {
       lower = p.lb;
       break;
@@ -231,7 +230,6 @@ ClearanceResult clearance(const Tape& ta, const Tape& tb, const Interval* box, c
   r.lower = std::min(lower, upper);
   r.upper = upper;
   r.converged = std::isfinite(upper) && !stuck && r.upper - r.lower <= tol;
-  if (opt.stopWhenSeparated && r.lower > 0.0) r.converged = true;
   return r;
 }
 

@@ -1,6 +1,6 @@
 // Certified penetration depth (issue 33): the shortest translation separating two solids,
 // enclosed by proving every nearer translation box colliding (interval arithmetic) and one
-// translation separated (clearance.cpp). The set of colliding translations is the Minkowski
+// translation separated (mayIntersect, relations.h). The set of colliding translations is the Minkowski
 // sum B ⊕ (-A) (Roerdink-Minkowski eq. 1); the depth is its boundary's distance to the origin.
 #include <algorithm>
 #include <cmath>
@@ -9,6 +9,7 @@
 
 #include "frep/evaluators/eval.h"
 #include "frep/relations/clearance.h"
+#include "frep/relations/relations.h"
 
 namespace frep {
 
@@ -19,6 +20,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 struct TBox {
   double lb;  // distance from the origin
   std::vector<Interval> t;
+  std::vector<double> hint;  // the point of A that came nearest to proving the parent
   bool operator>(const TBox& o) const { return lb > o.lb; }
 };
 
@@ -40,7 +42,7 @@ PenetrationResult penetration(const Expr& a, const Expr& b, uint32_t n, const In
   const std::vector<std::vector<double>> cand = samplePoints(*ta, box, size_t(std::max(opt.candidates, 1)));
   if (cand.empty()) return r;  // A has no point in the box: nothing overlaps
   const double tol = opt.tolerance;
-  const double minT = tol / (4.0 * std::sqrt(double(n)));
+  const double minT = tol / (2.0 * std::sqrt(double(n)));
   double reach = 0.0;
   for (uint32_t i = 0; i < n; ++i) reach += box[i].width() * box[i].width();
   reach = std::sqrt(reach);  // a translation this long moves A out of the box
@@ -61,10 +63,10 @@ PenetrationResult penetration(const Expr& a, const Expr& b, uint32_t n, const In
   };
   // Moves p over A towards larger fb(p + c) (gradient steps, put back onto A when they leave
   // it): sampled points fall short of A's extreme points, which decide the deep translations.
-  auto climb = [&](std::vector<double> p, const std::vector<double>& c) {
-    double f = depthAt(p, c), h = 1e-2 * reach;
+  auto climb = [&](std::vector<double> p, const std::vector<double>& c, double h, int iters) {
+    double f = depthAt(p, c);
     std::vector<double> q(n);
-    for (int it = 0; it < 40 && h > 1e-9 * reach; ++it) {
+    for (int it = 0; it < iters && h > 1e-9 * reach; ++it) {
       for (uint32_t i = 0; i < n; ++i) x[i] = p[i] + c[i];
       ge.eval(*tb, x.data(), g.data());
       double gn = 0.0;
@@ -82,46 +84,49 @@ PenetrationResult penetration(const Expr& a, const Expr& b, uint32_t n, const In
     }
     return p;
   };
-  // T is proved colliding by a point a of A with fb > 0 on all of a + T.
-  auto colliding = [&](const std::vector<Interval>& T) {
+  // T is proved colliding by a point a of A with fb > 0 on all of a + T. hint: the point the
+  // parent box climbed to (children near the boundary start there instead of rescanning).
+  auto colliding = [&](const std::vector<Interval>& T, std::vector<double>& hint) {
     for (const std::vector<double>& p : recent)
       if (proves(p, T)) return true;
     std::vector<double> c(n);
-    for (uint32_t i = 0; i < n; ++i) c[i] = T[i].mid();
-    size_t best = 0;
-    double bestDepth = -kInf;
-    for (size_t k = 0; k < cand.size(); ++k) {
-      const double f = depthAt(cand[k], c);
-      if (f > bestDepth) bestDepth = f, best = k;
-    }
-    if (!(bestDepth > 0.0)) return false;  // no sampled point lands in B: leave it to smaller T
-    // Climbing pays only on boxes small enough for the interval test to pass.
     double w = 0.0;
-    for (const Interval& t : T) w = std::max(w, t.width());
-    std::vector<std::vector<double>> tries{cand[best]};
-    if (w <= 64.0 * minT) tries.push_back(climb(cand[best], c));
-    for (const std::vector<double>& p : tries)
-      if (proves(p, T)) {
-        recent.insert(recent.begin(), p);
-        if (recent.size() > 8) recent.pop_back();
-        return true;
+    for (uint32_t i = 0; i < n; ++i) c[i] = T[i].mid(), w = std::max(w, T[i].width());
+    // Climbing pays only on boxes small enough for the interval test to pass.
+    const bool small = w <= 64.0 * minT;
+    // A parent's climbed point is near the optimum already: a short climb from it.
+    double h = 4.0 * w;
+    int iters = 10;
+    if (hint.empty() || !small) {
+      h = 1e-2 * reach;
+      iters = 40;
+      size_t best = 0;
+      double bestDepth = -kInf;
+      for (size_t k = 0; k < cand.size(); ++k) {
+        const double f = depthAt(cand[k], c);
+        if (f > bestDepth) bestDepth = f, best = k;
       }
-    return false;
+      if (!(bestDepth > 0.0)) return false;  // no sampled point lands in B: leave it to smaller T
+      hint = cand[best];
+      if (proves(hint, T)) return true;
+    }
+    if (!small) return false;
+    hint = climb(hint, c, h, iters);
+    if (!proves(hint, T)) return false;
+    recent.insert(recent.begin(), hint);
+    if (recent.size() > 8) recent.pop_back();
+    return true;
   };
   double lower = kInf;
-  // A separated translation in T's direction, proved by clearance.
+  // A separated translation in T's direction, proved disjoint by subdivision.
   int attempts = 0;
-  auto trySeparate = [&](const std::vector<Interval>& T) {
+  auto trySeparate = [&](const std::vector<Interval>& T, double len) -> bool {
     std::vector<double> c(n);
     double cn = 0.0;
     for (uint32_t i = 0; i < n; ++i) c[i] = T[i].mid(), cn += c[i] * c[i];
     cn = std::sqrt(cn);
-    if (!(cn > 0.0)) return;
-    // As far as the tolerance allows past the lower bound, in T's direction: the separation
-    // left to prove is then as thick as it can be.
-    const double len = lower + 0.9 * tol;
-    if (!(len > cn)) return;
-    if (len >= r.upper) return;
+    if (!(cn > 0.0)) return false;
+    if (len >= r.upper) return false;
     ++attempts;
     std::vector<Expr> moved;
     std::vector<Interval> grown(n);
@@ -130,16 +135,24 @@ PenetrationResult penetration(const Expr& a, const Expr& b, uint32_t n, const In
       moved.push_back(Expr::x(i) - c[i]);
       grown[i] = Interval(std::min(box[i].lo, box[i].lo + c[i]), std::max(box[i].hi, box[i].hi + c[i]));
     }
+    // One subdivision of space, pruning boxes outside either solid (mayIntersect), proves the
+    // thin separation with far fewer boxes than pairs of boxes would.
     TapePtr tm = Tape::compile(remap(a, moved), n);
-    ClearanceOptions co;
-    co.tolerance = tol / 4.0;
-    co.maxPairs = 200000;
-    co.stopWhenSeparated = true;
-    ClearanceResult sep = clearance(*tm, *tb, grown.data(), co);
-    if (sep.lower > 0.0) r.upper = len, r.translation = c;
+    const IntersectionResult sep = mayIntersect(*tm, *tb, grown.data(), tol / 8.0);
+    if (sep.contact != Contact::Disjoint) return false;
+    r.upper = len, r.translation = c;
+    return true;
   };
 
+  // Until a nearer one is proved: A moved by the box's narrowest width along its axis leaves
+  // the box, so (the solids lying in the box) it is at most touching B.
   r.upper = kInf;
+  for (uint32_t i = 0; i < n; ++i)
+    if (box[i].width() < r.upper) {
+      r.upper = box[i].width();
+      r.translation.assign(n, 0.0);
+      r.translation[i] = r.upper;
+    }
   std::priority_queue<TBox, std::vector<TBox>, std::greater<TBox>> heap;
   heap.push({0.0, std::vector<Interval>(n, Interval(-reach, reach))});
   while (!heap.empty()) {
@@ -150,11 +163,15 @@ PenetrationResult penetration(const Expr& a, const Expr& b, uint32_t n, const In
       lower = std::min(lower, T.lb);
       break;
     }
-    if (r.boxes > opt.maxBoxes || attempts > 64) {
+    if (r.boxes > opt.maxBoxes || attempts > 24) {
       lower = std::min(lower, T.lb);
+      // Out of budget: the nearest box unproved gives the direction; the separation is looked
+      // for at doubling distances past the lower bound.
+      for (double step = tol; lower + step < r.upper; step *= 2.0)
+        if (trySeparate(T.t, lower + step)) break;
       break;
     }
-    if (colliding(T.t)) continue;
+    if (colliding(T.t, T.hint)) continue;
     uint32_t axis = 0;
     for (uint32_t i = 1; i < n; ++i)
       if (T.t[i].width() > T.t[axis].width()) axis = i;
@@ -171,7 +188,9 @@ PenetrationResult penetration(const Expr& a, const Expr& b, uint32_t n, const In
     // The nearest small box not proved colliding is the lower bound; the boxes after it only
     // look for a separation.
     lower = std::min(lower, T.lb);
-    trySeparate(T.t);
+    // As far past the lower bound as the tolerance allows: the separation left to prove is then
+    // as thick as it can be.
+    trySeparate(T.t, lower + 0.9 * tol);
   }
   if (lower == kInf) lower = reach;  // every translation within reach proved colliding
   r.lower = std::min(lower, r.upper);

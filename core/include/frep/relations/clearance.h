@@ -13,10 +13,9 @@
 namespace frep {
 
 struct ClearanceOptions {
-  double tolerance = 1e-3;         // stop when upper - lower <= tolerance (absolute)
-  double minSize = 0.0;            // smallest box edge split (0: tolerance / 16)
-  uint64_t maxPairs = 4000000;     // budget of box pairs examined
-  bool stopWhenSeparated = false;  // stop as soon as lower > 0 (a certified separation)
+  double tolerance = 1e-3;      // stop when upper - lower <= tolerance (absolute)
+  double minSize = 0.0;         // smallest box edge split (0: tolerance / 16)
+  uint64_t maxPairs = 4000000;  // budget of box pairs examined
 };
 
 // dist(A ∩ box, B ∩ box) = min |p - q| over p in A, q in B, both in the box (n intervals).
@@ -38,11 +37,12 @@ ClearanceResult clearance(const Tape& a, const Tape& b, const Interval* box, con
 // translation boxes T nearest the origin first:
 //   lower: every T nearer than it is proved colliding: a point a with fa(a) >= 0 and
 //          fb(a + T) > 0 on the whole interval box, so a + t lies in B's interior for all t in T;
-//   upper: |t| of a translation whose separation is proved by clearance (lower > 0), checked
-//          over the box grown by |t| (the solids are taken to lie in the box).
+//   upper: |t| of a translation whose separation is proved by subdivision (mayIntersect says
+//          Disjoint) over the box grown by t, or at first the box's narrowest width (A moved
+//          out of the box); the solids are taken to lie in the box.
 struct PenetrationOptions {
   double tolerance = 1e-3;  // stop when upper - lower <= tolerance
-  uint64_t maxBoxes = 400000;
+  uint64_t maxBoxes = 200000;
   int candidates = 3000;  // points of A tried as the colliding point a
 };
 struct PenetrationResult {
