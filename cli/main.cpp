@@ -4,10 +4,12 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <iostream>
 
 #include "commands.h"
 #include "json_events.h"
+#include "suggest.h"
 #include "frep/master/status_line.h"
 #include "exit_codes.h"
 #include "frep/io/geometry_files.h"
@@ -280,10 +282,12 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    std::string message = e.what();
-    if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')  // CLI11 would say "required"
-      message = "unknown verb '" + std::string(argv[1]) + "'; the verbs are check, eval, slice, sample, mesh, pov, relate, measure, render, view and keygen";
+    // An unknown verb or option with its closest name; a JSON error event when --json was given.
+    const std::string message = parseErrorMessage(app, e.what(), argc, argv);
     std::cerr << "frep: error: " << message << "\nRun 'frep --help' for usage.\n";
+    if (std::find_if(argv + 1, argv + argc, [](const char* a) { return std::string(a) == "--json"; }) != argv + argc)
+      enableJsonEvents();
+    jsonError(kExitBadArgs, message);
     return kExitBadArgs;
   }
 
