@@ -62,7 +62,7 @@ class Browser:
              "--no-first-run", "--remote-allow-origins=*", "about:blank"],
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         port_file = os.path.join(profile, "DevToolsActivePort")
-        deadline = time.time() + 20
+        deadline = time.time() + 40  # a first start under a loaded machine
         while not os.path.exists(port_file) or not open(port_file).read().strip():
             if time.time() > deadline:
                 raise RuntimeError("chromium did not start its DevTools server")
@@ -176,7 +176,7 @@ def main():
         browser = Browser(os.path.join(work, "profile"))
         browser.call("Page.navigate", url=url)
         # 1. The sphere: drawn, with the exact silhouette's area.
-        if not browser.wait("document.body.dataset.drawn === '1'", 30, "the sphere is drawn"):
+        if not browser.wait("document.body.dataset.drawn === '1'", 45, "the sphere is drawn"):
             return
         rect = browser.eval("JSON.parse(JSON.stringify(document.getElementById('view').getBoundingClientRect()))")
         img = browser.screenshot("view_sphere.png")
@@ -199,7 +199,7 @@ def main():
         # 2. An edit: the sphere becomes a bigger box, drawn without reloading the page.
         t0 = time.time()
         save(model, BOX)
-        if not browser.wait("document.body.dataset.drawn === '2'", 30, "the box is drawn after the save"):
+        if not browser.wait("document.body.dataset.drawn === '2'", 45, "the box is drawn after the save"):
             return
         print("save to drawn: %.2f s" % (time.time() - t0))
         area2, centre2, corners2 = stats(browser.screenshot("view_box.png"), rect)
@@ -226,7 +226,7 @@ def main():
         time.sleep(1.0)
         t0 = time.time()
         save(model, SPHERE)
-        ok = browser.wait("document.body.dataset.drawn === '5'", 30, "the save after the slow model is drawn")
+        ok = browser.wait("document.body.dataset.drawn === '5'", 45, "the save after the slow model is drawn")
         state = json.load(urllib.request.urlopen(url + "api/state"))
         print("interrupting save to drawn: %.2f s; interrupted runs: %d" % (time.time() - t0, state["interrupted"]))
         check(ok and state["interrupted"] >= 1, "the slow job was interrupted (%d)" % state["interrupted"])
