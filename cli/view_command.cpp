@@ -86,6 +86,23 @@ class SignalStop {
 
 void noStore(httplib::Response& res) { res.set_header("Cache-Control", "no-store"); }
 
+// Bound to loopback, only requests addressed to loopback are answered: a web page elsewhere
+// whose domain name resolves to 127.0.0.1 (DNS rebinding) is refused, as Jupyter and webpack's
+// dev server do. Another --host serves any name.
+void refuseForeignHosts(httplib::Server& server, const std::string& host, int port) {
+  if (!isLoopback(host)) return;
+  const std::string p = ":" + std::to_string(port);
+  const std::vector<std::string> allowed{"127.0.0.1" + p, "localhost" + p, "[::1]" + p, host + p};
+  server.set_pre_routing_handler([allowed](const httplib::Request& req, httplib::Response& res) {
+    const std::string h = req.get_header_value("Host");
+    for (const auto& a : allowed)
+      if (h == a) return httplib::Server::HandlerResponse::Unhandled;
+    res.status = 403;
+    res.set_content("frep view answers only requests to this machine's loopback address\n", "text/plain");
+    return httplib::Server::HandlerResponse::Handled;
+  });
+}
+
 void addRoutes(httplib::Server& server, ViewSession& session, const fs::path& web) {
   for (const auto& [ext, type] : {std::pair{"js", "text/javascript"},
                                   {"mjs", "text/javascript"},
@@ -153,6 +170,7 @@ int runView(const ViewRequest& request) {
   if (port <= 0)
     throw CliError(kExitFarmError, "--host/--port: cannot listen on " + request.host + ":" +
                                        std::to_string(request.port) + " (in use, or not an address of this machine)");
+  refuseForeignHosts(server, request.host, port);
   const std::string host = request.host.find(':') != std::string::npos ? "[" + request.host + "]" : request.host;
   std::cout << "frep view: http://" << host << ":" << port << "/ shows " << request.model.path
             << " (updated on every save; Ctrl-C stops)" << std::endl;

@@ -167,6 +167,11 @@ def main():
         check(view_exit(os.path.join(work, "missing.hf"), "--port", "0") == 3, "a missing model: exit 3")
         check(view_exit(model, "-b", "1,2,3,4", "--port", "0") == 2, "a bad -b: exit 2")
         check(view_exit(model, "--port", url.rstrip("/").rsplit(":", 1)[1]) == 7, "a port in use: exit 7")
+        try:  # DNS rebinding: another site's name resolving to 127.0.0.1
+            urllib.request.urlopen(urllib.request.Request(url + "api/state", headers={"Host": "evil.example"}))
+            check(False, "a request for another host name is refused")
+        except urllib.error.HTTPError as e:
+            check(e.code == 403, "a request for another host name is refused with 403 (%d)" % e.code)
         try:
             urllib.request.urlopen(url + "api/slice?axis=w&at=0")
             check(False, "a slice along axis w is refused")
