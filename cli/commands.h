@@ -29,13 +29,16 @@ struct RegionRequest {
   std::string out;     // -O/--out
 };
 
-// frep relate A B: intersection and inclusion certified over a box, point membership.
+// frep relate A B: intersection, inclusion, clearance and penetration depth certified over a
+// box, point membership.
 struct RelateRequest {
   ModelRequest a, b;
   std::string bounds;      // -b text; "" = hfp's ±10
   double minSize = 0;      // smallest box edge of the subdivision; 0 = 1e-4 of the box
   std::string at;          // --at X,Y,Z: also classify this point
   double tolerance = 1e-9; // |f| <= tolerance: on the surface
+  double distanceTol = 0;  // width of the clearance / penetration bounds; 0 = 1e-3 of the box
+  bool json = false;       // one JSON object on stdout
 };
 int runRelate(const RelateRequest& request);
 

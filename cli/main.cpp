@@ -217,7 +217,7 @@ int main(int argc, char** argv) {
   relateCmd->add_option("--min-size", relate.minSize, "Smallest box edge of the subdivision (default 1e-4 of the box)");
   relateCmd->add_option("--at", relate.at, "Also classify the point X,Y,Z against both");
   relateCmd->add_option("--distance-tol", relate.distanceTol,
-                        "Width of the clearance and penetration bounds (default 1e-4 of the box)");
+                        "Width of the clearance and penetration bounds (default 1e-3 of the box)");
   relateCmd->add_flag("--json", relate.json, "One JSON object on stdout");
   MeasureRequest measure;
   CLI::App* measureCmd = app.add_subcommand("measure", "Certified volume, surface area, centroid and inertia tensor of a model "
