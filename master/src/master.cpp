@@ -7,6 +7,7 @@
 #include <random>
 
 #include "frep/farm/crc32.h"
+#include "frep/interrupt/interrupter.h"
 #include "frep/worker/brick.h"
 #include "master.h"
 
@@ -265,6 +266,10 @@ void Master::runInProcess() {
   TapePtr tape = compileJobModel(job_);
   describeErrorBounds(*tape, &report_.errorBounds);
   for (const std::string& line : describeExactTerms(job_)) report_.errorBounds.push_back(line);
+  // A stop signal ends the brick being computed too: its searches and parallel chunks check the
+  // core's interrupter (frep/interrupt/interrupter.h), so a brick of many seconds stops at once.
+  const Interrupter stop(&gStop);
+  InterruptScope scope(&stop);
   for (Brick& b : bricks_) {
     if (lease(b.id).phase == BrickPhase::Done) continue;
     if (gStop) {
@@ -273,7 +278,13 @@ void Master::runInProcess() {
     }
     rethrowMergeError();
     auto t0 = Clock::now();
-    BrickOutput out = computeBrick(tape, job_, b.lo, b.hi, opt_.threads);
+    BrickOutput out;
+    try {
+      out = computeBrick(tape, job_, b.lo, b.hi, opt_.threads);
+    } catch (const Interrupted&) {
+      report_.interrupted = true;  // the bricks before it are in the journal
+      return;
+    }
     report_.perWorker["in-process"].computeSeconds += std::chrono::duration<double>(Clock::now() - t0).count();
     KeptBrick kept;
     if (journal_ || op_ == Operation::Sample) {
