@@ -18,10 +18,10 @@ struct ChildResult {
 };
 
 // Runs argv[0] with arguments argv[1..] (no shell) in a process group of its own, signals
-// unblocked and stdin closed, and waits for it, polling `cancel` (may be null) every 50 ms. Throws std::runtime_error
-// when it cannot be started. A farm job stops within about 0.1 s of SIGTERM; an in-process run
-// (--workers 0) does not poll the signal, and its output is a private temporary file that is
-// thrown away, so SIGKILL (to its whole group) after 2 s is safe.
+// unblocked and stdin closed, and waits for it, polling `cancel` (may be null) every 50 ms.
+// Throws std::runtime_error when it cannot be started. frep mesh stops within about 0.1 s of
+// SIGTERM; one that does not gets SIGKILL (to its whole group) 2 s later, which is safe since
+// its output is a private temporary file that is thrown away.
 ChildResult runChild(const std::vector<std::string>& argv, const std::atomic<bool>* cancel);
 
 // The path of the running executable (/proc/self/exe), for running frep's own verbs.

@@ -139,6 +139,13 @@ def main():
         check(False, "chromium is installed (deploy/install-deps.sh installs it)")
         return
     work = tempfile.mkdtemp(prefix="frep-view-test-")
+    try:
+        run(work)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def run(work):
     # Copies of frep and frep-worker: the build tree's may be relinked while the test runs.
     os.makedirs(os.path.join(work, "bin"))
     frep = os.path.join(work, "bin", "frep")
@@ -249,7 +256,6 @@ def main():
         check(not leftover, "no temporary folder of a job is left: %s" % leftover)
         if failures:
             print("frep view's log:\n" + open(os.path.join(work, "view.log")).read())
-        shutil.rmtree(work, ignore_errors=True)
 
 
 if __name__ == "__main__":
