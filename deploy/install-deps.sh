@@ -26,10 +26,11 @@ test_packages=(
   slurm-wlm munge  # tests/deploy/slurm_e2e.sh: a real single-node Slurm (about 16 s to install)
   chromium python3-websocket python3-pil  # tests/view: frep view's page in headless Chromium
 )
-# npm installs three.js for frep view's page (deploy/build.sh); Debian's npm, unless node's own
-# packages (e.g. NodeSource's nodejs, which conflicts with it) already provide the command.
-command -v npm >/dev/null || packages+=(npm)
 [ "${1:-}" = --build-only ] || packages+=("${test_packages[@]}")
+# npm installs three.js for frep view's page (deploy/build.sh; not the Docker image's build, which
+# builds the programs only): Debian's npm, unless node's own packages (e.g. NodeSource's nodejs,
+# which conflicts with it) already provide the command.
+[ "${1:-}" = --build-only ] || command -v npm >/dev/null || packages+=(npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
