@@ -3,7 +3,8 @@
 // box decided, which is bit-identical to the full tape there, so the result does not depend on
 // the pruning, the tile size or the thread count. With signOnly, tiles whose interval decides
 // the sign are not evaluated at all (their pixels get +inf / -inf): the cost then follows the
-// boundary, not the area.
+// boundary, not the area; with floatSigns, the evaluated leaves run in float where the sign is
+// certified, in double elsewhere.
 #pragma once
 
 #include <cstdint>
@@ -26,13 +27,22 @@ struct PlaneLattice {
 struct PlaneStats {
   uint64_t pointEvals = 0;     // pixels evaluated
   uint64_t intervalEvals = 0;  // tiles classified
+  uint64_t intervalInstrs = 0; // sum over classified tiles of their tape's length
   uint64_t tapeInstrs = 0;     // sum over evaluated batches of the pruned tape's length
   uint64_t tapeBatches = 0;
   uint64_t decidedPixels = 0;  // pixels whose sign a tile decided (signOnly: not evaluated)
+  uint64_t floatPixels = 0;    // floatSigns: pixels whose float value's sign was certified
+  uint64_t doublePixels = 0;   // floatSigns: pixels evaluated in double (|f_float| <= bound, or no bound)
 };
 
 struct PlaneOptions {
   bool signOnly = false;
+  // With signOnly: leaves are evaluated in float, a pixel keeps its float value only where
+  // |f_float| exceeds a certified bound on its distance to the double value
+  // (frep/evaluators/float_error.h), the rest are recomputed in double. Every pixel then has
+  // the sign of the double path (the sign image is the same, bit for bit); the values of
+  // certified pixels are the float ones. Tapes the bound does not cover stay in double.
+  bool floatSigns = false;
   int threads = 0;  // 0: TBB's default, 1: serial
 };
 

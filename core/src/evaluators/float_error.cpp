@@ -1,0 +1,149 @@
+// Forward error analysis of a tape over a box (float_error.h), one pass in tape order. Each
+// register carries an enclosure [lo, hi] of its exact real value (outward-rounded interval
+// arithmetic) and two absolute error bounds, ef for the float evaluation and ed for the double
+// one, both measured from the exact value, so |f_float - f_double| <= ef + ed at the result.
+// Rounding model (Higham, Accuracy and Stability of Numerical Algorithms, eq. 2.4, with an
+// absolute term for underflow): fl(x op y) = (x op y)(1 + d) + t, |d| <= u, |t| <= tiny, for
+// + - * sqrt, with u = 2^-24 (float) or 2^-53 (double); tiny = 2^-126 also covers flush-to-zero.
+// The batch evaluator's fused chains run the same ops in the same order (eval_batch.cpp, built
+// with -ffp-contract=off), so the model holds for them too.
+#include "frep/evaluators/float_error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace frep {
+namespace {
+
+constexpr double kUf = 0x1p-24, kUd = 0x1p-53;
+constexpr double kTinyF = 0x1p-126, kTinyD = 0x1p-1022;
+// Beyond this a float value might overflow: no bound.
+constexpr double kMaxMagnitude = 1e30;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Outward steps for values computed in double with round-to-nearest: a relative margin of a few
+// ulps plus an absolute one for subnormal results.
+inline double dn(double x) { return x - std::fabs(x) * 0x1p-50 - 0x1p-1000; }
+inline double up(double x) { return x + std::fabs(x) * 0x1p-50 + 0x1p-1000; }
+// The error formulas sum and multiply a handful of nonnegative terms, each rounding <= 2^-53
+// relative: this factor restores an upper bound.
+inline double upErr(double e) { return e * (1.0 + 0x1p-45); }
+
+inline double mag(double lo, double hi) { return std::max(std::fabs(lo), std::fabs(hi)); }
+
+bool supported(Op op, double imm) {
+  switch (op) {
+    case Op::Add:
+    case Op::Sub:
+    case Op::Mul:
+    case Op::Neg:
+    case Op::Abs:
+    case Op::Min:
+    case Op::Max:
+    case Op::Sqrt:
+    case Op::Copy:
+      return true;
+    case Op::PowI:
+      return imm == 2.0;
+    default:
+      return false;
+  }
+}
+
+}  // namespace
+
+bool FloatErrorBound::supports(const Tape& tape) {
+  if (tape.hasExtrema()) return false;
+  for (const Instr& ins : tape.code())
+    if (!supported(ins.op, ins.imm)) return false;
+  return true;
+}
+
+double FloatErrorBound::bound(const Tape& tape, const Interval* box) {
+  regs_.resize(tape.numRegs());
+  const auto& uni = tape.uniforms();
+  for (size_t r = 0; r < uni.size(); ++r) {
+    const double c = uni[r];
+    // float(c) - c is exact in double (both on c's binade grid, |difference| < 2^-24 |c|)
+    regs_[r] = {c, c, std::fabs(double(float(c)) - c), 0.0};
+  }
+  for (uint32_t v = 0; v < tape.numVars(); ++v) {
+    const Interval& x = box[v];
+    if (!(mag(x.lo, x.hi) < kMaxMagnitude)) return kInf;
+    regs_[tape.varReg(v)] = {x.lo, x.hi, upErr(kUf * mag(x.lo, x.hi) + kTinyF), 0.0};
+  }
+  for (const Instr& ins : tape.code()) {
+    if (!supported(ins.op, ins.imm)) return kInf;
+    const Reg a = regs_[ins.a];
+    const Reg b = opArity(ins.op) > 1 ? regs_[ins.b] : a;
+    const double ma = mag(a.lo, a.hi), mb = mag(b.lo, b.hi);
+    Reg o = a;
+    // Rounded result: propagated error pf / pd, then the op's own rounding of a value whose
+    // magnitude is at most |exact| + propagated error.
+    auto rounded = [&](double pf, double pd) {
+      const double m = mag(o.lo, o.hi);
+      o.ef = upErr(pf + kUf * (m + pf) + kTinyF);
+      o.ed = upErr(pd + kUd * (m + pd) + kTinyD);
+    };
+    switch (ins.op) {
+      case Op::Add:
+        o.lo = dn(a.lo + b.lo), o.hi = up(a.hi + b.hi);
+        rounded(a.ef + b.ef, a.ed + b.ed);
+        break;
+      case Op::Sub:
+        o.lo = dn(a.lo - b.hi), o.hi = up(a.hi - b.lo);
+        rounded(a.ef + b.ef, a.ed + b.ed);
+        break;
+      case Op::Mul: {
+        const double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
+        o.lo = dn(*std::min_element(p, p + 4)), o.hi = up(*std::max_element(p, p + 4));
+        // |a'b' - ab| <= |a| |b' - b| + |b| |a' - a| + |a' - a| |b' - b|
+        rounded(ma * b.ef + mb * a.ef + a.ef * b.ef, ma * b.ed + mb * a.ed + a.ed * b.ed);
+        break;
+      }
+      case Op::PowI: {  // squares only (supported)
+        const double l2 = a.lo * a.lo, h2 = a.hi * a.hi;
+        o.lo = a.lo >= 0 || a.hi <= 0 ? dn(std::min(l2, h2)) : 0.0;
+        o.hi = up(std::max(l2, h2));
+        // |a'^2 - a^2| = |a' - a| |a' + a| <= e (2|a| + e)
+        rounded(a.ef * (2 * ma + a.ef), a.ed * (2 * ma + a.ed));
+        break;
+      }
+      case Op::Sqrt: {
+        // sqrt(max(a, 0)): the clamp is 1-Lipschitz; |sqrt(c') - sqrt(c)| <= sqrt(|c' - c|),
+        // and <= |c' - c| / sqrt(c) when c >= lo > 0.
+        const double clo = std::max(a.lo, 0.0), chi = std::max(a.hi, 0.0);
+        o.lo = clo > 0 ? dn(std::sqrt(clo)) : 0.0, o.hi = up(std::sqrt(chi));
+        auto prop = [&](double e) {
+          const double s = up(std::sqrt(e));
+          return o.lo > 0 ? std::min(s, e / o.lo) : s;
+        };
+        rounded(prop(a.ef), prop(a.ed));
+        break;
+      }
+      case Op::Neg:
+        o.lo = -a.hi, o.hi = -a.lo;
+        break;
+      case Op::Abs:
+        o.lo = a.lo >= 0 ? a.lo : a.hi <= 0 ? -a.hi : 0.0, o.hi = ma;
+        break;
+      case Op::Min:
+      case Op::Max:
+        // min and max move by at most the larger of their inputs' errors, with no rounding
+        o.lo = ins.op == Op::Min ? std::min(a.lo, b.lo) : std::max(a.lo, b.lo);
+        o.hi = ins.op == Op::Min ? std::min(a.hi, b.hi) : std::max(a.hi, b.hi);
+        o.ef = std::max(a.ef, b.ef), o.ed = std::max(a.ed, b.ed);
+        break;
+      default:  // Copy
+        break;
+    }
+    // Every float value stays below kMaxMagnitude + ef: far from overflow (NaN fails too).
+    if (!(mag(o.lo, o.hi) + o.ef < kMaxMagnitude)) return kInf;
+    regs_[ins.out] = o;
+  }
+  const Reg& r = regs_[tape.resultReg()];
+  return upErr(r.ef + r.ed);
+}
+
+}  // namespace frep
