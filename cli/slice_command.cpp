@@ -84,6 +84,10 @@ int runSlice(const SliceRequest& request) {
   lattice.step = grid.voxel, lattice.width = width, lattice.height = height;
   PlaneOptions options;
   options.signOnly = request.mask || g.colourSections;
+  // --mask reads signs only, so float with the certified double fallback gives the same image
+  // (also for a union of sections: the max of values of the right signs has the right sign); the
+  // section colours compare values across sections, so they stay in double.
+  options.floatSigns = request.mask && !g.colourSections;
   PlaneStats stats;
   double evalMs = 0, lo = INFINITY, hi = -INFINITY;
   size_t nans = 0, instrs = 0;
