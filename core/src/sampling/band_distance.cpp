@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "frep/evaluators/eval.h"
+#include "sampling/parallel_chunks.h"
 
 namespace frep {
 namespace {
@@ -185,7 +186,7 @@ void bandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOptions
   const double h = grid.voxel;
   const std::vector<float>& value = f.s.value;
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (LeafBlock& l : r.leaves)
+  auto estimateLeaf = [&](LeafBlock& l) {
     for (int n = 0; n < kLeafVoxels; ++n) {
       if (!l.isActive(n)) continue;
       const int64_t c[3] = {l.origin[0] + (n >> 6), l.origin[1] + ((n >> 3) & 7), l.origin[2] + (n & 7)};
@@ -257,6 +258,12 @@ void bandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOptions
         l.active[size_t(n >> 6)] &= ~bit;
       }
     }
+  };
+  // Leaves in parallel (in-process runs sample a brick on every core): each writes only its own
+  // values and reads the array, so the result does not depend on the threads.
+  parallelChunks(r.leaves.size(), 16, opt.threads, [&](size_t first, size_t last) {
+    for (size_t li = first; li != last; ++li) estimateLeaf(r.leaves[li]);
+  });
 }
 
 }  // namespace frep
