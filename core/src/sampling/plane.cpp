@@ -1,6 +1,6 @@
 // Quadtree evaluation of a plane lattice (see plane.h).
 //
-// The image is cut into fixed 128-pixel tiles (the parallel grain, independent of the thread
+// The image is cut into fixed 256-pixel tiles (the parallel grain, independent of the thread
 // count); each tile is classified by interval arithmetic over the box of its pixel centres,
 // its tape pruned to what that box decided, and split in four until a tile holds at most one
 // batch (16 x 16 pixels), which is evaluated with its pruned tape. Pixel coordinates are
