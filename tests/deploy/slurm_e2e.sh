@@ -129,6 +129,39 @@ else same_output churn || { fail "churn: output differs from --workers 0"; show_
      grep -q "restart 1 of" "$tmp"/jobs/churn/frep-*-worker-*.log || fail "churn: no worker was restarted"
 fi
 
+# The other verbs (FREP_VERB): mesh and render on the farm, measure on one task; each output
+# byte for byte (measure: the same JSON) what the verb writes in-process.
+verb_job() {  # name verb out ntasks [args...]
+  local name="$1" verb="$2" out="$3" ntasks="$4"; shift 4
+  local dir="$tmp/jobs/$name" rc=0
+  mkdir -p "$dir"
+  (cd "$dir" && env FREP_VERB="$verb" FREP_PORT="$(port)" timeout 150 sbatch --wait --quiet --nodes=1 \
+     --ntasks="$ntasks" --cpus-per-task=1 --time=5 --output="$dir/batch.log" "$src/deploy/slurm/frep.sbatch" \
+     "$model" "$dir/$out" "$@") >"$dir/sbatch.out" 2>&1 || rc=$?
+  echo "$rc"
+}
+frep mesh "$model" -g 32 -b 1.6 --brick 32 --workers 0 --out "$tmp/reference.ply" >/dev/null 2>&1 || fail "mesh --workers 0 failed"
+frep render "$model" -b 1.6 --size 96x96 --workers 0 --out "$tmp/reference.png" >/dev/null 2>&1 || fail "render --workers 0 failed"
+frep measure "$model" -b 1.6 --json --no-progress --threads 1 >"$tmp/reference.json" 2>/dev/null || fail "measure failed"
+for spec in "mesh out.ply 3 -g 32 -b 1.6 --brick 32" "render out.png 3 -b 1.6 --size 96x96" \
+            "measure out.json 1 -b 1.6"; do
+  read -r verb out ntasks args <<<"$spec"
+  start=$SECONDS
+  # shellcheck disable=SC2086
+  rc=$(verb_job "$verb" "$verb" "$out" "$ntasks" $args)
+  echo "job $verb (FREP_VERB=$verb): exit $rc in $((SECONDS - start)) s"
+  if [ "$rc" != 0 ]; then fail "$verb job exited $rc"; show_logs "$verb"; continue; fi
+  ref="$tmp/reference.${out##*.}"
+  if [ "$verb" = measure ]; then  # the wall time differs run to run: compare the numbers
+    python3 -c 'import json,sys; a,b=(json.load(open(f)) for f in sys.argv[1:]); [d.pop(k,None) for d in (a,b) for k in ("seconds","wall_seconds","time")]; sys.exit(a!=b)' \
+      "$ref" "$tmp/jobs/$verb/$out" && echo "measure: out.json has the in-process numbers" \
+      || { fail "measure: out.json differs from the in-process run"; show_logs measure; }
+  else
+    cmp "$ref" "$tmp/jobs/$verb/$out" && echo "$verb: $out identical to --workers 0 (bytes)" \
+      || { fail "$verb: output differs from --workers 0"; show_logs "$verb"; }
+  fi
+done
+
 bad="$tmp/bad.hf"
 printf 'my_model(x[3], a[1]) {\n  my_model = 1 - x[1]^2 +;\n}\n' >"$bad"
 start=$SECONDS
