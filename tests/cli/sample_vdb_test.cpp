@@ -100,6 +100,25 @@ TEST_F(FrepTest, SampleWritesASignedDistanceByDefault) {
     ++active;
   }
   EXPECT_GT(active, 1000u);
+  // The workers' distance (core band_distance.h), with its bound, not the master's mesh trip.
+  EXPECT_NE(grid->metaValue<std::string>("frep_distance").find("second-order estimate"), std::string::npos);
+}
+
+TEST_F(FrepTest, DefaultStoreIsTheSameBytesInProcessAndOnOneOrTwoWorkers) {
+  // Each brick's distance reads a halo from its neighbours: a block with a ball and blended
+  // edges, on bricks of 16 (two workers) and 64 (in-process, one worker), gives one file.
+  write("b.hf",
+        "my_model(x[3], a[1]) {\n  array c[3];\n  c = [-0.6, -0.6, -0.4];\n  blk = hfBlock(x, c, 1.2, 1.2, 0.8);\n"
+        "  ball = 0.16 - (x[1] - 0.5)^2 - x[2]^2 - (x[3] - 0.4)^2;\n  my_model = hfBlendUni(blk, ball, 0.05, 0.1, 0.1);\n}\n");
+  const std::string box = " -b -1,-1,-1,1,1,1 --res 40 ";
+  ASSERT_EQ(run("sample b.hf" + box + "--workers 0 -O w0.vdb").code, 0);
+  ASSERT_EQ(run("sample b.hf" + box + "--workers 1 -O w1.vdb").code, 0);
+  RunResult r = run("sample b.hf" + box + "--workers 2 --brick 16 -O w2.vdb");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string bytes = readText(path("w0.vdb"));
+  EXPECT_GT(bytes.size(), 10000u);
+  EXPECT_TRUE(bytes == readText(path("w1.vdb")));
+  EXPECT_TRUE(bytes == readText(path("w2.vdb")));
 }
 
 TEST_F(FrepTest, SampleBoxIsRoundedOutwardToTheWorldLattice) {
