@@ -157,6 +157,31 @@ TEST(LeaseTable, ASuspectGoesAloneToAFreshPeerAndFreshKillersPoisonIt) {
   EXPECT_EQ(f.table.brick(0).lastError, "worker w-k2 died while computing it");
 }
 
+TEST(LeaseTable, WorkersThatFinishedBricksCountHalfAsKillers) {
+  LeasePolicy policy;
+  policy.maxAttempts = 1;  // one fresh killer poisons; a worker that finished others is churn
+  Fixture f(4, policy);
+  f.join("a");
+  f.dispatch();
+  f.now += seconds(10);
+  f.table.expire(f.now);  // brick 0 suspect
+  for (int i = 0; i < 2; ++i) {
+    const std::string rid = "old" + std::to_string(i);
+    f.join(rid);
+    f.table.credit("w-" + rid);   // it has finished a brick
+    f.now += milliseconds(6001);  // a suspect waits two windows for a fresh worker, then takes this one
+    f.sent.clear();
+    f.dispatch();
+    ASSERT_EQ(f.sent.size(), 1u);
+    EXPECT_EQ(f.sent[0], std::make_pair(rid, uint64_t(0)));
+    f.now += seconds(10);
+    f.table.expire(f.now);
+    EXPECT_EQ(f.table.brick(0).weakKillers.size(), size_t(i + 1));
+    EXPECT_EQ(f.poisoned.count(0), size_t(i));  // 2 x maxAttempts of them poison it
+  }
+  EXPECT_EQ(f.poisoned[0], "2 workers died computing it alone");
+}
+
 TEST(LeaseTable, PeersThatNeverProvedAliveAreNotChargedForTheirDeath) {
   Fixture f(1);
   for (int i = 0; i < 10; ++i) {
@@ -166,6 +191,8 @@ TEST(LeaseTable, PeersThatNeverProvedAliveAreNotChargedForTheirDeath) {
     f.table.expire(f.now);
   }
   // Hello-and-vanish peers: they are never given the suspect (not proven), so no death counts.
+  ASSERT_EQ(f.sent.size(), 1u);  // only the first, before it was suspect
+  EXPECT_EQ(f.sent[0], std::make_pair(std::string("v0"), uint64_t(0)));
   EXPECT_TRUE(f.poisoned.empty());
   EXPECT_TRUE(f.table.brick(0).killers.empty());
   EXPECT_EQ(f.table.brick(0).phase, BrickPhase::Pending);
@@ -274,11 +301,18 @@ TEST(LeaseTable, AnIdlePeerGetsTheOldestStragglerOnce) {
   ASSERT_EQ(f.sent.size(), 1u);
   EXPECT_EQ(f.sent[0], std::make_pair(std::string("b"), uint64_t(0)));
   EXPECT_EQ(f.table.stats().stragglerReissues, 1u);
+  // Once: another idle peer gets the next straggler, not brick 0 again.
+  f.join("c");
+  f.sent.clear();
+  f.dispatch();
+  ASSERT_EQ(f.sent.size(), 1u);
+  EXPECT_EQ(f.sent[0], std::make_pair(std::string("c"), uint64_t(1)));
+  f.finish("c", 1);
   f.finish("b", 0);
   f.sent.clear();
-  f.dispatch();  // brick 1 is the next straggler; brick 0 is done
+  f.dispatch();  // brick 2 is the last straggler; 0 and 1 are done
   ASSERT_EQ(f.sent.size(), 1u);
-  EXPECT_EQ(f.sent[0].second, 1u);
+  EXPECT_EQ(f.sent[0].second, 2u);
 }
 
 TEST(LeaseTable, AnUnreachablePeerGetsNothingMoreAndTheBrickStaysQueued) {
