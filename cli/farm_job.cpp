@@ -14,7 +14,7 @@
 #include <zmq.hpp>
 
 #include "arg_parse.h"
-#include "frep/worker/brick.h"
+#include "frep/farm/job.h"
 #include "exit_codes.h"
 #include "frep/master/journal.h"
 

@@ -10,7 +10,7 @@
 
 #include "frep/worker/allocator_tuning.h"
 #include "arg_parse.h"
-#include "frep/worker/brick.h"
+#include "frep/farm/job.h"
 #include "frep/io/world_lattice.h"
 #include "frep/io/atomic_output.h"
 #include "commands.h"
