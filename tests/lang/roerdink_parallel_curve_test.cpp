@@ -1,4 +1,4 @@
-// Roerdink-Minkowski Fig. 7 and Appendix A: the Minkowski sum of the parabolic region
+// Roerdink-Minkowski Fig. 7 and Appendix A (and Fig. 8 below): the Minkowski sum of the parabolic region
 // y >= a x^2 and a disc of radius r (frMinkowski's certified search, the 2D operands having no
 // closed form in the basic set). Its boundary is the outer branch of the parabola's parallel
 // curve, a degree-6 algebraic curve (Appendix A, the equation after eq. 27): each boundary
@@ -64,6 +64,37 @@ TEST(RoerdinkParallelCurve, ParabolaPlusDiscFollowsAppendixA) {
     const double below = parallelCurve(x, lo - kBound), above = parallelCurve(x, hi + kBound);
     EXPECT_LT(below * above, 0) << "x " << x << " boundary y " << lo << " P " << below << " " << above;
   }
+}
+
+// Fig. 8: the elliptic region (x/2)^2 + y^2 <= 1 plus a disc of radius 0.5. Its boundary is the
+// outer branch of the ellipse's parallel curve (a toroid, degree 8): the points e(t) + r n(t),
+// n the unit outward normal. Each must separate the computed sum's inside from its outside
+// within 1e-5 along the normal.
+TEST(RoerdinkParallelCurve, EllipsePlusDiscIsTheToroidBranch) {
+  Model m = compileOk(
+      "ell(x[2], a[1]) { ell = 1 - (x[1] / 2)^2 - x[2]^2; }\n"
+      "disc(x[2], a[1]) { disc = 0.25 - x[1]^2 - x[2]^2; }\n"
+      "my_model(x[2], a[1]) { array o[2]; o = [0, 1e-7]; my_model = frMinkowski(x, ell, disc, o); }");
+  ASSERT_TRUE(hasExtremum(m.field));
+  TapePtr tape = Tape::compile(m.field, 2);
+  PointEvaluator ev;
+  auto f = [&](double x, double y) {
+    const double p[2] = {x, y};
+    return ev.eval(*tape, p);
+  };
+  constexpr double kBound = 1e-5;
+  for (double t = 0; t < 6.28; t += 0.3) {
+    const double ex = 2 * std::cos(t), ey = std::sin(t);
+    double nx = std::cos(t) / 2, ny = std::sin(t);  // gradient of (x/2)^2 + y^2, halved
+    const double nn = std::hypot(nx, ny);
+    nx /= nn, ny /= nn;
+    const double qx = ex + kR * nx, qy = ey + kR * ny;
+    EXPECT_GE(f(qx - kBound * nx, qy - kBound * ny), 0) << t;
+    EXPECT_LT(f(qx + kBound * nx, qy + kBound * ny), 0) << t;
+  }
+  // On the x axis the boundary lies in (2.49, 2.5 + 1e-5]: a 2% smaller disc would fail.
+  EXPECT_LT(f(2 + 0.5 + kBound, 0), 0);
+  EXPECT_GE(f(2 + 0.49, 0), 0);
 }
 
 }  // namespace
