@@ -2,10 +2,11 @@
 // mesher on what it accepts, as frep mesh in.vdb does (fuzz_target.h). OpenVDB itself is not
 // instrumented; frepfarm's checks in front of it must refuse whatever would make it misbehave.
 // The first byte's low bit asks to re-seal the file (recompute its frep_grid_checksum), as an
-// attacker can: crafted files. That mode needs FREP_FUZZ_VDB_CRAFTED=1 and is off in CI: it finds
-// a heap overflow inside OpenVDB's block decompression that the checks cannot see yet (a negative
-// stored block size, docs/cli.md "Fuzzing"). CI fuzzes damage to sealed files: inputs that the
-// reader's own layout check (vdb_layout.h) still finds sealed, i.e. the seal's entry survived
+// attacker can: crafted files. That mode needs FREP_FUZZ_VDB_CRAFTED=1 and is off in CI: it found
+// a heap overflow inside OpenVDB's block decompression (a negative stored block size), which now
+// happens only in the child process the reader parses files in (io/src/vdb_isolation.h; not yet
+// re-run under the sanitizers, docs/cli.md "Fuzzing"). CI fuzzes damage to sealed files: inputs
+// that the reader's own layout check (vdb_layout.h) still finds sealed, i.e. the seal's entry survived
 // where the reader looks for it.
 #include <unistd.h>
 
@@ -51,8 +52,8 @@ void frep::fuzz::vdb(const uint8_t* data, size_t size) {
   }
   try {
     // Damage mode: a file whose seal entry itself was damaged (moved out of the grid's metadata,
-    // or its key or length changed) reads as another tool's unsealed file, whose grids OpenVDB
-    // parses unchecked: the open gap of docs/cli.md, not fuzzed in CI.
+    // or its key or length changed) reads as another tool's unsealed file, whose grids only
+    // OpenVDB checks (in the reader's child process): not fuzzed in CI.
     if (!crafted && !io::checkVdbLayout(path).sealed) {
       std::remove(path.c_str());
       return;
