@@ -244,3 +244,41 @@ TEST(MeshConvexSum, TetrahedronErodedByABoxIsTheShrunkTetrahedron) {
   Expr none;
   EXPECT_FALSE(minkowski::meshConvexDifference(min(X(), Y()), axisBox(clo, chi), 3, &none));
 }
+
+TEST(MeshConvexSum, SignOnlyBatchesClassifyEveryPointAsTheValues) {
+  // The simplifier's batches ask only inside/outside (BatchEvaluator::setFieldSignsOnly): the
+  // sum skips its distance to the boundary pieces there, and must keep every class, of the sum
+  // and of the difference (whose inside is the negated outside).
+  const V3 clo{-0.1, -0.2, -0.15}, chi{0.3, 0.05, 0.1};
+  Expr sum, diff;
+  ASSERT_TRUE(minkowski::meshConvexSum(axisBox(clo, chi), lPrism(0.4), 3, &sum));
+  ASSERT_TRUE(minkowski::meshConvexDifference(lPrism(0.4), axisBox(clo, chi), 3, &diff));
+  for (const Expr* e : {&sum, &diff}) {
+    TapePtr tape = Tape::compile(*e, 3);
+    BatchEvaluator<double> values, signs;
+    signs.setFieldSignsOnly(true);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-0.8, 2.8);
+    int in = 0, out = 0, cheaper = 0;
+    for (int round = 0; round < 12; ++round) {
+      const size_t n = BatchEvaluator<double>::kBatch;
+      values.reserve(*tape);
+      signs.reserve(*tape);
+      for (size_t i = 0; i < n; ++i) {
+        const double p[3] = {u(rng), u(rng), 0.5 * u(rng)};
+        for (uint32_t k = 0; k < 3; ++k) values.in(k)[i] = signs.in(k)[i] = p[k];
+      }
+      const double* f = values.eval(*tape, n);
+      const double* s = signs.eval(*tape, n);
+      for (size_t i = 0; i < n; ++i) {
+        if (f[i] == 0) continue;  // on the surface either class is right
+        ASSERT_EQ(s[i] >= 0, f[i] >= 0) << f[i] << " vs " << s[i];
+        (f[i] >= 0 ? in : out) += 1;
+        cheaper += s[i] != f[i];
+      }
+    }
+    EXPECT_GT(in, 20);
+    EXPECT_GT(out, 20);
+    EXPECT_GT(cheaper, 20);  // the distance was skipped, not computed anyway
+  }
+}

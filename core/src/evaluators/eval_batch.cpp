@@ -105,7 +105,7 @@ void countDomainErrors(const Instr& ins, const T* a, const T* b, size_t count, D
 // An Op::Field instruction: the object evaluates all lanes at once in double (its output may
 // alias an input, so through a side buffer).
 template <typename T>
-void runField(const FieldFunction& fn, const Instr& ins, T* regs, size_t n) {
+void runField(const FieldFunction& fn, const Instr& ins, T* regs, size_t n, bool signsOnly = false) {
   constexpr size_t B = BatchEvaluator<T>::kBatch;
   thread_local std::vector<double> buf;
   buf.resize(4 * B);
@@ -114,7 +114,10 @@ void runField(const FieldFunction& fn, const Instr& ins, T* regs, size_t n) {
   const T* b = regs + size_t(ins.b) * B;
   const T* c = regs + size_t(ins.c) * B;
   for (size_t i = 0; i < n; ++i) u[i] = double(a[i]), v[i] = double(b[i]), w[i] = double(c[i]);
-  fn.values(u, v, w, out, n);
+  if (signsOnly)
+    fn.signs(u, v, w, out, n);
+  else
+    fn.values(u, v, w, out, n);
   T* o = regs + size_t(ins.out) * B;
   for (size_t i = 0; i < n; ++i) o[i] = T(out[i]);
 }
@@ -394,8 +397,12 @@ const T* BatchEvaluator<T>::eval(const Tape& tape, size_t count) {
   auto at = [&](size_t k) { return sinCos ? sinCos + k : nullptr; };
   const auto* fields = tape.fields().data();
   const uint32_t nu = tape.numUniforms();
+  // The result's field call in sign-only mode runs apart (after the rest of the tape).
+  const bool signTail = fieldSignsOnly_ && !code.empty() && code.back().op == Op::Field &&
+                        code.back().out == tape.resultReg();
+  const size_t size = code.size() - (signTail ? 1 : 0);
   if (!tape.hasExtrema()) {
-    runTape<T>(code.data(), sinCos, code.size(), regs_.data(), n, domain_, count, fields, nu);
+    runTape<T>(code.data(), sinCos, size, regs_.data(), n, domain_, count, fields, nu);
   } else {
     // Straight-line segments between extremum instructions run vectorised as usual.
     size_t start = 0;
@@ -405,8 +412,9 @@ const T* BatchEvaluator<T>::eval(const Tape& tape, size_t count) {
       runExtremum(tape, code[k], count);
       start = k + 1;
     }
-    runTape<T>(code.data() + start, at(start), code.size() - start, regs_.data(), n, domain_, count, fields, nu);
+    runTape<T>(code.data() + start, at(start), size - start, regs_.data(), n, domain_, count, fields, nu);
   }
+  if (signTail) runField(*fields[size_t(code.back().imm)], code.back(), regs_.data(), n, true);
   return regs_.data() + size_t(tape.resultReg()) * kBatch;
 }
 

@@ -24,6 +24,7 @@ Simplifier::Simplifier(Work&& work, const TapePtr& tape, const GridSpec& grid, c
   if (tape_->numVars() > 3 && opt_.fixedCoords.size() < tape_->numVars() - 3)
     throw std::invalid_argument("simplifyMesh: the model has " + std::to_string(tape_->numVars()) +
                                 " coordinates; give values for x[4..] (fixedCoords)");
+  batch_.setFieldSignsOnly(true);  // crossed() reads the class of each value alone
 }
 
 // Collapses until no candidate is left; then work(), vertexAlive() and triangleAlive() hold

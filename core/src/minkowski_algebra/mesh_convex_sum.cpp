@@ -270,6 +270,13 @@ class MeshConvexSumField : public DistanceField {
     const double f = sumField(p, nullptr);
     return complement_ ? -f : f;
   }
+  void signs(const double* u, const double* v, const double* w, double* out, size_t n) const override {
+    for (size_t i = 0; i < n; ++i) {
+      const double p[3] = {u[i], v[i], w[i]};
+      const double f = sumClass(p);
+      out[i] = complement_ ? -f : f;
+    }
+  }
   double gradient(const double p[3], double g[3]) const override {
     double q[3];
     const double f = sumField(p, q);
@@ -431,6 +438,19 @@ class MeshConvexSumField : public DistanceField {
   // f_A: the sign certificates need no more), which saves the query of A near the surface;
   // outside, dist(x, sum) <= dist(x - b0, A) bounds the boundary pieces' search.
   double sumField(const double* p, double* q) const {
+    const double inside = insideValue(p);
+    if (inside >= 0) return inside;
+    return -soup_->distance(p, q, -inside);
+  }
+  // sumField's class without the distance to the pieces: outside, its value is -dist <= 0,
+  // which reads as outside except on a piece (-0, inside), where either class is right.
+  double sumClass(const double* p) const {
+    const double inside = insideValue(p);
+    return inside >= 0 || std::isnan(inside) ? inside : -INFINITY;
+  }
+  // The largest c_T, or f_A's value at p - b0 when no cell holds p: sumField's value where it
+  // is >= 0, else negative and dist(x, sum) <= its magnitude.
+  double insideValue(const double* p) const {
     double g = -INFINITY;
     cellBvh_.containing(p, [&](uint32_t i) {
       const Cell& c = cells_[i];
@@ -443,9 +463,7 @@ class MeshConvexSumField : public DistanceField {
     });
     if (g >= 0) return g;
     const double shifted[3] = {p[0] - b0_[0], p[1] - b0_[1], p[2] - b0_[2]};
-    const double inA = complement_ ? -a_->value(shifted) : a_->value(shifted);
-    if (inA >= 0) return inA;
-    return -soup_->distance(p, q, -inA);
+    return complement_ ? -a_->value(shifted) : a_->value(shifted);
   }
   bool sameGeometry(const DistanceField& o) const override {
     const auto& m = static_cast<const MeshConvexSumField&>(o);

@@ -74,11 +74,15 @@ class BatchEvaluator {
   // runs ExtremumSolver::solveSign, so only the sign of each value is that of the cold search
   // (what the mesher reads from its sample), at a fraction of the cost away from the surface.
   void setExtremumSignsOnly(bool on) { signsOnly_ = on; }
+  // true: a field call that is the tape's last instruction and result gives only the class of
+  // each value (FieldFunction::signs): for callers that read insideValue() alone.
+  void setFieldSignsOnly(bool on) { fieldSignsOnly_ = on; }
 
  private:
   DomainCounts* domain_ = nullptr;
   bool warmStarts_ = true;
   bool signsOnly_ = false;
+  bool fieldSignsOnly_ = false;
   void bind(const Tape& tape);
   void runExtremum(const Tape& tape, const Instr& ins, size_t count);
   std::vector<T> regs_;  // numRegs * kBatch, register-major

@@ -32,6 +32,14 @@ class FieldFunction {
   virtual double value(const double p[3]) const = 0;
   // n points in structure-of-arrays form; the default calls value() per point.
   virtual void values(const double* u, const double* v, const double* w, double* out, size_t n) const;
+  // Values of which only the class is kept: inside (>= 0), outside (< 0) or NaN as values()
+  // gives, except that a value of 0 (a point on the surface, where either class is right) may
+  // read as outside. For callers that read nothing else (the simplifier's inside/outside
+  // pairs); a field whose value costs more than its class (a distance outside a sum)
+  // overrides it. The default is values().
+  virtual void signs(const double* u, const double* v, const double* w, double* out, size_t n) const {
+    values(u, v, w, out, n);
+  }
   // Returns the value and writes the three partial derivatives.
   virtual double gradient(const double p[3], double g[3]) const = 0;
   virtual Interval bound(const Interval box[3]) const = 0;
