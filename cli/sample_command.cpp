@@ -88,7 +88,9 @@ int runSample(const SampleRequest& request) {
   }
   farm::JobSpec job = makeJob(m, request.model.path, grid, "sample");
   job.set_band(request.band);
-  job.set_distance(request.store != "raw");  // the workers store the band's distance (--store sdf, fog)
+  // The workers store the band's distance estimate (--store sdf, fog); sdf-exact redistances the
+  // merged samples on the master instead (the exact distance to their meshed zero set).
+  job.set_distance(request.store == "sdf" || request.store == "fog");
   if (cut.faces) setCutBox(job, cutLo, cutHi);
   spdlog::info("sampling '{}' on {}x{}x{} voxels of {}", m.model.objectName, grid.dims[0], grid.dims[1],
                grid.dims[2], grid.voxel);
@@ -115,7 +117,9 @@ int runSample(const SampleRequest& request) {
   meta.gridName = m.model.objectName;
   meta.job = jobDescription(m, grid, request.band, request.store);
   meta.source = baseName(request.model.path);
-  meta.store = request.store == "raw" ? io::VdbStore::Raw : request.store == "fog" ? io::VdbStore::Fog : io::VdbStore::Sdf;
+  meta.store = request.store == "raw"   ? io::VdbStore::Raw
+               : request.store == "fog" ? io::VdbStore::Fog
+                                        : io::VdbStore::Sdf;  // sdf, sdf-exact
   meta.params = request.model.params;
   meta.sourceHash = m.model.sourceHash;
   meta.iso = request.model.iso;

@@ -15,7 +15,7 @@ _frep_options() {
     mesh) echo "-h --help $model $region --tolerance --no-sharp --open-rim --format --up --wrl --stl --stlb --pov --cli --gs --timing $farm" ;;
     render) echo "-h --help $model -b --bounds -O --out --size --azimuth --elevation --distance --zoom --eye --target --up --perspective --fov --background --colour --color --frames --no-footprint $geometric $farm" ;;
     pov) echo "-h --help -o --object -O --out --thin" ;;
-    relate) echo "-h --help --object-a --object-b -b --bounds --min-size --at" ;;
+    relate) echo "-h --help --object-a --object-b -b --bounds --min-size --at --distance-tol --json" ;;
     measure) echo "-h --help $model -b --bounds --tolerance --threads --max-cells --json --no-progress" ;;
     view) echo "-h --help $model -b --bounds --res -g --grid --workers --host --port" ;;
     keygen) echo "-h --help --force" ;;
@@ -36,7 +36,7 @@ _frep() {
   done
   case "$prev" in
     --log-level) COMPREPLY=($(compgen -W "trace debug info warn error critical off" -- "$cur")); return ;;
-    --store) COMPREPLY=($(compgen -W "sdf raw fog" -- "$cur")); return ;;
+    --store) COMPREPLY=($(compgen -W "sdf sdf-exact raw fog" -- "$cur")); return ;;
     --axis) COMPREPLY=($(compgen -W "x y z" -- "$cur")); return ;;
     --format) COMPREPLY=($(compgen -W "ply obj stl stl-ascii wrl pov 3mf glb cli cli-binary" -- "$cur")); return ;;
     --wrl|--stl|--stlb|--pov|--cli) COMPREPLY=($(compgen -f -- "$cur")); return ;;

@@ -2,6 +2,11 @@
 // The only test file that includes OpenVDB (slow headers).
 #include <openvdb/openvdb.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
 #include "frep_runner.h"
 
 using namespace frep_cli_test;
@@ -119,6 +124,44 @@ TEST_F(FrepTest, DefaultStoreIsTheSameBytesInProcessAndOnOneOrTwoWorkers) {
   EXPECT_GT(bytes.size(), 10000u);
   EXPECT_TRUE(bytes == readText(path("w1.vdb")));
   EXPECT_TRUE(bytes == readText(path("w2.vdb")));
+}
+
+TEST_F(FrepTest, SdfExactStoreIsTheBoxDistanceWhereTheEstimateIsNot) {
+  // A box written the HyperFun way (hfBlock: R-function intersections of slabs) is not a
+  // distance, so the default store's per-brick estimate falls short; sdf-exact redistances the
+  // merged samples on the master: the exact distance to their meshed zero set, for any worker
+  // count.
+  write("b.hf",
+        "my_model(x[3], a[1]) {\n  array c[3];\n  c = [-0.5, -0.5, -0.5];\n"
+        "  my_model = hfBlock(x, c, 1, 1, 1);\n}\n");
+  const std::string box = " -b 1 --res 41 ";
+  RunResult r = run("sample b.hf" + box + "--store sdf-exact --workers 0 -O e0.vdb");
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(run("sample b.hf" + box + "--store sdf-exact --workers 2 --brick 16 -O e2.vdb").code, 0);
+  ASSERT_EQ(run("sample b.hf" + box + "--workers 0 -O d.vdb").code, 0);
+  EXPECT_TRUE(readText(path("e0.vdb")) == readText(path("e2.vdb")));
+  // The exact distance to the cube [-0.5, 0.5]^3.
+  auto cube = [](const openvdb::Vec3d& p) {
+    const double qx = std::abs(p.x()) - 0.5, qy = std::abs(p.y()) - 0.5, qz = std::abs(p.z()) - 0.5;
+    const double ox = std::max(qx, 0.0), oy = std::max(qy, 0.0), oz = std::max(qz, 0.0);
+    return std::sqrt(ox * ox + oy * oy + oz * oz) + std::min(std::max(qx, std::max(qy, qz)), 0.0);
+  };
+  // The error's median and 95th percentile in the band, in voxels. The meshed zero set chamfers
+  // the edges, so the largest errors of sdf-exact are the mesher's, near the edges; the
+  // estimate's reach the faces as well (f there is an R-function of slabs, not a distance).
+  auto errors = [&](const std::string& file) {
+    openvdb::FloatGrid::Ptr grid = readGrid(path(file));
+    std::vector<double> e;
+    for (auto it = grid->cbeginValueOn(); it; ++it)
+      if (std::abs(*it) < 0.9 * grid->background()) e.push_back(std::abs(*it - cube(grid->indexToWorld(it.getCoord()))));
+    std::sort(e.begin(), e.end());
+    const double v = grid->voxelSize().x();
+    return e.size() < 1000 ? std::array<double, 2>{1e9, 1e9} : std::array<double, 2>{e[e.size() / 2] / v, e[e.size() * 95 / 100] / v};
+  };
+  const auto exact = errors("e0.vdb"), estimate = errors("d.vdb");
+  EXPECT_LT(exact[0], 0.01) << "sdf-exact's median, voxels";
+  EXPECT_LT(exact[0], estimate[0]) << "medians";
+  EXPECT_LT(exact[1], estimate[1]) << "95th percentiles";
 }
 
 TEST_F(FrepTest, SampleBoxIsRoundedOutwardToTheWorldLattice) {

@@ -72,7 +72,7 @@ version = subprocess.run([WORKER, "--version"], capture_output=True, text=True)
 check(version.returncode == 0 and version.stdout.startswith("frep-worker "), "frep-worker --version: " + version.stdout.strip())
 
 # Values: --store, --log-level, --axis; a model path completes to .hf files.
-check(complete("frep", "sample", "--store", "") == {"sdf", "raw", "fog"}, "completion of --store values")
+check(complete("frep", "sample", "--store", "") == {"sdf", "sdf-exact", "raw", "fog"}, "completion of --store values")
 check("debug" in complete("frep", "--log-level", "d"), "completion of --log-level values")
 check(complete("frep", "slice", "m.hf", "--axis", "") == {"x", "y", "z"}, "completion of --axis values")
 
