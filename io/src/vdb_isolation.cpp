@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -47,6 +48,14 @@ std::string readAll(int fd) {
   std::string message;
   try {
     write("/proc/self/fd/" + std::to_string(fd));
+    // OpenVDB does not check its stream: a copy cut short by the file size limit (ulimit -f,
+    // which holds for a memfd too) must be an I/O error here, not a damaged copy later.
+    struct rlimit limit;
+    struct stat st;
+    if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY && ::fstat(fd, &st) == 0 &&
+        uint64_t(st.st_size) >= uint64_t(limit.rlim_cur))
+      throw ioError("cannot write the copy frep reads it from: the file size limit (ulimit -f, " +
+                    std::to_string(uint64_t(limit.rlim_cur)) + " bytes) is reached");
     ::_exit(0);
   } catch (const Error& e) {
     code = e.code;
