@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "frep/evaluators/eval.h"
 #include "frep/evaluators/interval.h"
@@ -80,6 +81,29 @@ Expr frHull(std::vector<Arg>& a) {
     n = int(v);
   }
   const std::vector<Box> boxes = cover(a[1].value, a[1].name);
+  // The boxes in chunks of 64 and the chunks in groups of 64 (the cover lists siblings together,
+  // so both are compact), each with its bounding box: a group or chunk whose bounding box's
+  // support is at most the best value found is skipped. Its boxes' values cannot exceed it (the
+  // same sums of larger terms, and rounding is monotone), so h is the same as scanning every
+  // box, for a fraction of the work.
+  constexpr size_t kChunk = 64;
+  auto boundsOf = [](const std::vector<Box>& items) {
+    std::vector<Box> out;
+    for (size_t c = 0; c < items.size(); c += kChunk) {
+      Box b = items[c];
+      for (size_t k = c + 1; k < std::min(items.size(), c + kChunk); ++k)
+        for (size_t d = 0; d < 3; ++d)
+          b[d] = Interval(std::min(b[d].lo, items[k][d].lo), std::max(b[d].hi, items[k][d].hi));
+      out.push_back(b);
+    }
+    return out;
+  };
+  const std::vector<Box> chunks = boundsOf(boxes), groups = boundsOf(chunks);
+  auto supportOf = [](const Box& b, const double* u) {
+    double v = 0;
+    for (int d = 0; d < 3; ++d) v += u[d] * (u[d] >= 0 ? b[size_t(d)].hi : b[size_t(d)].lo);
+    return v;
+  };
   const std::vector<Expr>& xs = *a[0].array;
   Expr result;
   bool first = true;
@@ -97,10 +121,15 @@ Expr frHull(std::vector<Arg>& a) {
         for (double& c : u) c /= norm;
         // Upper bound of the support: the largest u·p over the corners of the covering boxes.
         double h = -1e300;
-        for (const Box& b : boxes) {
-          double v = 0;
-          for (int d = 0; d < 3; ++d) v += u[d] * (u[d] >= 0 ? b[size_t(d)].hi : b[size_t(d)].lo);
-          h = std::max(h, v);
+        for (size_t g = 0; g < groups.size(); ++g)  // values reached: the first skip threshold
+          h = std::max(h, supportOf(boxes[g * kChunk * kChunk], u));
+        for (size_t g = 0; g < groups.size(); ++g) {
+          if (!(supportOf(groups[g], u) > h)) continue;
+          for (size_t c = g * kChunk; c < std::min(chunks.size(), (g + 1) * kChunk); ++c) {
+            if (!(supportOf(chunks[c], u) > h)) continue;
+            for (size_t k = c * kChunk; k < std::min(boxes.size(), (c + 1) * kChunk); ++k)
+              h = std::max(h, supportOf(boxes[k], u));
+          }
         }
         Expr plane = Expr(h) - (u[0] * xs[0] + u[1] * xs[1] + u[2] * xs[2]);
         result = first ? plane : min(result, plane);
