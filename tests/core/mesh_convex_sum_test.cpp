@@ -264,8 +264,13 @@ TEST(MeshConvexSum, SignOnlyBatchesClassifyEveryPointAsTheValues) {
       const size_t n = BatchEvaluator<double>::kBatch;
       values.reserve(*tape);
       signs.reserve(*tape);
+      // Clusters of 8 points within 0.02 of each other (half B's inradius about its centroid):
+      // the sum reuses the class of a point in no cell for its neighbours.
+      std::uniform_real_distribution<double> jitter(-0.01, 0.01);
+      double c[3] = {0, 0, 0};
       for (size_t i = 0; i < n; ++i) {
-        const double p[3] = {u(rng), u(rng), 0.5 * u(rng)};
+        if (i % 8 == 0) c[0] = u(rng), c[1] = u(rng), c[2] = 0.5 * u(rng);
+        const double p[3] = {c[0] + jitter(rng), c[1] + jitter(rng), c[2] + jitter(rng)};
         for (uint32_t k = 0; k < 3; ++k) values.in(k)[i] = signs.in(k)[i] = p[k];
       }
       const double* f = values.eval(*tape, n);

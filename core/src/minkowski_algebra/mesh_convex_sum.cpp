@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -180,7 +181,15 @@ class MeshConvexSumField : public DistanceField {
   MeshConvexSumField(const Mesh& a, std::shared_ptr<const MeshField> aField, const Convex& b, bool complement,
                      std::string name)
       : a_(std::move(aField)), complement_(complement), name_(std::move(name)) {
-    b0_ = b.v[0];
+    // b0: B's vertex centroid, an interior point; every cell T ⊕ B then holds the r-neighbourhood
+    // of T + b0 (r: b0's distance to B's facets), so a point in no cell is at least r from
+    // ∂A + b0 and its class under f_A(x - b0) holds within r of it (sumClass's memo).
+    for (const V3& p : b.v) b0_ = {b0_[0] + p[0], b0_[1] + p[1], b0_[2] + p[2]};
+    b0_ = {b0_[0] / double(b.v.size()), b0_[1] / double(b.v.size()), b0_[2] / double(b.v.size())};
+    memoRadius_ = INFINITY;
+    for (const V3& n : b.faceN) memoRadius_ = std::min(memoRadius_, b.support(n) - dot(n, b0_));
+    if (!(memoRadius_ > 0) || !std::isfinite(memoRadius_)) memoRadius_ = 0;
+    memoRadius_ *= 0.5;  // half: rounding of the cells' tests cannot matter
     double scale = std::max(extentOf(a.v), extentOf(b.v));
     const double tol = 1e-9 * scale;
     // Edge directions of B, one per parallel class.
@@ -299,6 +308,20 @@ class MeshConvexSumField : public DistanceField {
   bool complement_;
   std::string name_;
   V3 b0_{};
+  double memoRadius_ = 0;
+  uint64_t id_ = nextFieldId();  // the memo's key: an address may be reused by another field
+  struct SignMemo {
+    uint64_t owner;
+    double x[3];
+    bool inside;
+  };
+  static constexpr int kSignMemos = 4;
+  static thread_local SignMemo tSignMemo[kSignMemos];
+  static thread_local int tSignMemoNext;
+  static uint64_t nextFieldId() {
+    static std::atomic<uint64_t> next{1};
+    return next++;
+  }
   std::vector<std::array<double, 4>> planes_;  // u . x <= h
   struct Cell {
     uint32_t first, count;
@@ -443,14 +466,38 @@ class MeshConvexSumField : public DistanceField {
     return -soup_->distance(p, q, -inside);
   }
   // sumField's class without the distance to the pieces: outside, its value is -dist <= 0,
-  // which reads as outside except on a piece (-0, inside), where either class is right.
+  // which reads as outside except on a piece (-0, inside), where either class is right. A point
+  // in no cell within memoRadius_ of one classified before has its class (see the constructor).
   double sumClass(const double* p) const {
-    const double inside = insideValue(p);
-    return inside >= 0 || std::isnan(inside) ? inside : -INFINITY;
+    const double g = cellsValue(p);
+    if (g >= 0) return g;
+    SignMemo* slot = nullptr;
+    if (memoRadius_ > 0)
+      for (SignMemo& m : tSignMemo) {
+        if (m.owner != id_) continue;
+        const double dx = p[0] - m.x[0], dy = p[1] - m.x[1], dz = p[2] - m.x[2];
+        if (dx * dx + dy * dy + dz * dz < memoRadius_ * memoRadius_) return m.inside ? memoRadius_ : -INFINITY;
+      }
+    const double shifted[3] = {p[0] - b0_[0], p[1] - b0_[1], p[2] - b0_[2]};
+    const double inA = complement_ ? -a_->value(shifted) : a_->value(shifted);
+    if (std::isnan(inA)) return sumField(p, nullptr);
+    if (memoRadius_ > 0) {
+      slot = &tSignMemo[tSignMemoNext];
+      tSignMemoNext = (tSignMemoNext + 1) % kSignMemos;
+      *slot = {id_, {p[0], p[1], p[2]}, inA >= 0};
+    }
+    return inA >= 0 ? inA : -INFINITY;
   }
   // The largest c_T, or f_A's value at p - b0 when no cell holds p: sumField's value where it
   // is >= 0, else negative and dist(x, sum) <= its magnitude.
   double insideValue(const double* p) const {
+    const double g = cellsValue(p);
+    if (g >= 0) return g;
+    const double shifted[3] = {p[0] - b0_[0], p[1] - b0_[1], p[2] - b0_[2]};
+    return complement_ ? -a_->value(shifted) : a_->value(shifted);
+  }
+  // max_T c_T(p) over the cells whose box holds p (-inf: none).
+  double cellsValue(const double* p) const {
     double g = -INFINITY;
     cellBvh_.containing(p, [&](uint32_t i) {
       const Cell& c = cells_[i];
@@ -461,15 +508,16 @@ class MeshConvexSumField : public DistanceField {
       }
       g = std::max(g, m);
     });
-    if (g >= 0) return g;
-    const double shifted[3] = {p[0] - b0_[0], p[1] - b0_[1], p[2] - b0_[2]};
-    return complement_ ? -a_->value(shifted) : a_->value(shifted);
+    return g;
   }
   bool sameGeometry(const DistanceField& o) const override {
     const auto& m = static_cast<const MeshConvexSumField&>(o);
     return m.complement_ == complement_ && m.planes_ == planes_ && m.a_->sameContent(*a_);
   }
 };
+
+thread_local MeshConvexSumField::SignMemo MeshConvexSumField::tSignMemo[MeshConvexSumField::kSignMemos] = {};
+thread_local int MeshConvexSumField::tSignMemoNext = 0;
 
 void scaleMesh(Mesh& m, double s) {
   if (s == 1) return;
