@@ -63,16 +63,6 @@ Partials partials(Op op, double a, double b, double value, double imm) {
   }
 }
 
-bool isPiecewiseConstant(Op op) {
-  switch (op) {
-    case Op::Floor: case Op::Ceil: case Op::Trunc: case Op::Not: case Op::Lt: case Op::Le:
-    case Op::Gt: case Op::Ge: case Op::Eq: case Op::Ne: case Op::And: case Op::Or:
-      return true;
-    default:
-      return false;
-  }
-}
-
 inline double term(double partial, double d) { return d == 0.0 ? 0.0 : partial * d; }
 
 }  // namespace

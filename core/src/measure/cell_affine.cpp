@@ -120,16 +120,6 @@ void collapse(const Row& r, Interval out[3]) {
   }
 }
 
-bool isPiecewiseConstant(Op op) {
-  switch (op) {
-    case Op::Floor: case Op::Ceil: case Op::Trunc: case Op::Not: case Op::Lt: case Op::Le:
-    case Op::Gt: case Op::Ge: case Op::Eq: case Op::Ne: case Op::And: case Op::Or:
-      return true;
-    default:
-      return false;
-  }
-}
-
 uint64_t constId(double v) {
   uint64_t bits;
   if (v == 0.0) v = 0.0;  // -0 and +0 are one constant

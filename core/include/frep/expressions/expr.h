@@ -48,6 +48,16 @@ enum class Op : uint8_t {
 
 const char* opName(Op op);
 int opArity(Op op);
+// Floor, ceil, trunc, comparisons and logic: constant between jumps (derivative 0 where defined).
+inline bool isPiecewiseConstant(Op op) {
+  switch (op) {
+    case Op::Floor: case Op::Ceil: case Op::Trunc: case Op::Not: case Op::Lt: case Op::Le:
+    case Op::Gt: case Op::Ge: case Op::Eq: case Op::Ne: case Op::And: case Op::Or:
+      return true;
+    default:
+      return false;
+  }
+}
 
 // Floor applied to the argument of log/log10 (documented domain convention).
 constexpr double kLogFloor = 1e-300;
