@@ -44,6 +44,17 @@ my_model(x[3], a[1]) {
 }
 )";
 
+// A ball of radius 0.8 sampled on 64^3 voxels of [-1, 1]^3 (band 3).
+inline JobSpec sphereJob() {
+  JobSpec j;
+  j.set_operation("sample");
+  j.set_model_source("my_model(x[3], a[1]) { my_model = 0.64 - x[1]^2 - x[2]^2 - x[3]^2; }");
+  j.set_model_name("sphere.hf");
+  setGrid(j, GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 64));
+  j.set_band(3);
+  return j;
+}
+
 inline JobSpec partJob(const std::string& operation, int res) {
   JobSpec j;
   j.set_operation(operation);

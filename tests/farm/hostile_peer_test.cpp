@@ -18,16 +18,6 @@ using namespace farmtest;
 
 namespace {
 
-JobSpec sphereJob() {
-  JobSpec j;
-  j.set_operation("sample");
-  j.set_model_source("my_model(x[3], a[1]) { my_model = 0.64 - x[1]^2 - x[2]^2 - x[3]^2; }");
-  j.set_model_name("sphere.hf");
-  setGrid(j, GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 64));  // 8 bricks of 32
-  j.set_band(3);
-  return j;
-}
-
 FarmOptions clusterOptions() {
   FarmOptions o;
   o.brickVoxels = 32;

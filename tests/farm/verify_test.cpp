@@ -22,16 +22,7 @@ using namespace farmtest;
 
 namespace {
 
-// A sphere on 64^3 voxels in bricks of 16: 64 bricks, 4 x-slabs of 16.
-JobSpec sphereJob() {
-  JobSpec j;
-  j.set_operation("sample");
-  j.set_model_source("my_model(x[3], a[1]) { my_model = 0.64 - x[1]^2 - x[2]^2 - x[3]^2; }");
-  j.set_model_name("sphere.hf");
-  setGrid(j, GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 64));
-  j.set_band(3);
-  return j;
-}
+// sphereJob() (64^3 voxels) in bricks of 16: 64 bricks, 4 x-slabs of 16.
 constexpr int kBricks = 64, kPerSlab = 16;
 
 FarmOptions clusterOptions(double verify, uint64_t seed = 0) {
