@@ -471,20 +471,17 @@ class MeshConvexSumField : public DistanceField {
   double sumClass(const double* p) const {
     const double g = cellsValue(p);
     if (g >= 0) return g;
-    SignMemo* slot = nullptr;
     if (memoRadius_ > 0)
       for (SignMemo& m : tSignMemo) {
         if (m.owner != id_) continue;
         const double dx = p[0] - m.x[0], dy = p[1] - m.x[1], dz = p[2] - m.x[2];
         if (dx * dx + dy * dy + dz * dz < memoRadius_ * memoRadius_) return m.inside ? memoRadius_ : -INFINITY;
       }
-    const double shifted[3] = {p[0] - b0_[0], p[1] - b0_[1], p[2] - b0_[2]};
-    const double inA = complement_ ? -a_->value(shifted) : a_->value(shifted);
+    const double inA = translateValue(p);
     if (std::isnan(inA)) return sumField(p, nullptr);
     if (memoRadius_ > 0) {
-      slot = &tSignMemo[tSignMemoNext];
+      tSignMemo[tSignMemoNext] = {id_, {p[0], p[1], p[2]}, inA >= 0};
       tSignMemoNext = (tSignMemoNext + 1) % kSignMemos;
-      *slot = {id_, {p[0], p[1], p[2]}, inA >= 0};
     }
     return inA >= 0 ? inA : -INFINITY;
   }
@@ -492,7 +489,10 @@ class MeshConvexSumField : public DistanceField {
   // is >= 0, else negative and dist(x, sum) <= its magnitude.
   double insideValue(const double* p) const {
     const double g = cellsValue(p);
-    if (g >= 0) return g;
+    return g >= 0 ? g : translateValue(p);
+  }
+  // f_A(p - b0), negated for the complement: the translate A + b0's field.
+  double translateValue(const double* p) const {
     const double shifted[3] = {p[0] - b0_[0], p[1] - b0_[1], p[2] - b0_[2]};
     return complement_ ? -a_->value(shifted) : a_->value(shifted);
   }
