@@ -99,9 +99,27 @@ Model loadModel(const std::string& path, const std::string& object, const std::v
   return compileModel(text, path, object, params, iso);
 }
 
+// NumPy is optional (pip's extra frepfarm[numpy]): the calls that return arrays say so by name
+// instead of failing inside pybind11's array conversion with a bare "No module named 'numpy'".
+void requireNumpy(const char* call) {
+  try {
+    py::module_::import("numpy");
+  } catch (py::error_already_set& e) {
+    if (!e.matches(PyExc_ImportError)) throw;
+    const std::string msg = std::string(call) +
+                            " works on NumPy arrays, and numpy is not installed: pip install 'frepfarm[numpy]' "
+                            "(or numpy; the calls that return no array work without it)";
+    PyErr_SetString(PyExc_ModuleNotFoundError, msg.c_str());
+    throw py::error_already_set();
+  }
+}
+
 // f at each row of an (N, dims) array, by the batch evaluator (256 points per call).
-py::array_t<double> evalPoints(const Model& m, py::array_t<double, py::array::c_style | py::array::forcecast> points,
-                               py::object progress) {
+py::array_t<double> evalPoints(const Model& m, py::object pointsIn, py::object progress) {
+  requireNumpy("Model.eval");
+  auto points = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(pointsIn);
+  if (!points)
+    throw py::type_error("points: expected an array of numbers of shape (N, " + std::to_string(m.dims) + ")");
   if (points.ndim() == 1 && points.shape(0) == m.dims) points = points.reshape({py::ssize_t(1), py::ssize_t(m.dims)});
   if (points.ndim() != 2 || points.shape(1) != m.dims)
     throw py::value_error("points: expected an array of shape (N, " + std::to_string(m.dims) + ") for object '" +
@@ -202,7 +220,8 @@ py::object toPyOpenVdb(const Volume& v) {
   return grid;
 }
 
-py::array_t<double> rows(const std::vector<std::array<double, 3>>& v) {
+py::array_t<double> rows(const std::vector<std::array<double, 3>>& v, const char* call) {
+  requireNumpy(call);
   py::array_t<double> a({py::ssize_t(v.size()), py::ssize_t(3)});
   if (!v.empty()) std::copy(v.data()->data(), v.data()->data() + 3 * v.size(), a.mutable_data());
   return a;
@@ -384,9 +403,10 @@ PYBIND11_MODULE(frepfarm, mod) {
       .def("to_pyopenvdb", &toPyOpenVdb, "A pyopenvdb.FloatGrid (through a temporary .vdb file)");
 
   py::class_<PyMesh>(mod, "Mesh", "A watertight, outward-oriented triangle mesh")
-      .def_property_readonly("vertices", [](const PyMesh& m) { return rows(m.mesh.positions); })
-      .def_property_readonly("normals", [](const PyMesh& m) { return rows(m.mesh.normals); })
+      .def_property_readonly("vertices", [](const PyMesh& m) { return rows(m.mesh.positions, "Mesh.vertices"); })
+      .def_property_readonly("normals", [](const PyMesh& m) { return rows(m.mesh.normals, "Mesh.normals"); })
       .def_property_readonly("triangles", [](const PyMesh& m) {
+        requireNumpy("Mesh.triangles");
         py::array_t<uint32_t> a({py::ssize_t(m.mesh.triangles.size()), py::ssize_t(3)});
         if (!m.mesh.triangles.empty())
           std::copy(m.mesh.triangles.data()->data(), m.mesh.triangles.data()->data() + 3 * m.mesh.triangles.size(),

@@ -53,6 +53,9 @@ def _metadata(meta):
     if "requires-python" in meta:
         lines.append("Requires-Python: " + meta["requires-python"])
     lines += ["Requires-Dist: " + d for d in meta.get("dependencies", [])]
+    for extra, deps in sorted(meta.get("optional-dependencies", {}).items()):  # core metadata 2.1
+        lines.append("Provides-Extra: " + extra)
+        lines += ['Requires-Dist: %s; extra == "%s"' % (d, extra) for d in deps]
     lines += ["License: " + meta["license"]["text"]] if "text" in meta.get("license", {}) else []
     return "\n".join(lines) + "\n"
 

@@ -1,5 +1,15 @@
-"""Models to NumPy grids (docs/python.md): f on every point of a regular lattice of a box."""
-import numpy as np
+"""Models to NumPy grids (docs/python.md): f on every point of a regular lattice of a box.
+NumPy is imported when a grid is made, so `import frepfarm` works without it (an optional extra)."""
+
+
+def _numpy(call):
+    try:
+        import numpy
+    except ImportError:
+        raise ModuleNotFoundError("%s works on NumPy arrays, and numpy is not installed: pip install "
+                                  "'frepfarm[numpy]' (or numpy; the calls that return no array work without it)"
+                                  % call, name="numpy") from None
+    return numpy
 
 
 class DenseGrid:
@@ -12,17 +22,20 @@ class DenseGrid:
 
     def points(self):
         """The (nx, ny, nz, 3) world points of the lattice."""
+        np = _numpy("DenseGrid.points")
         axes = [self.origin[a] + self.voxel * np.arange(self.values.shape[a]) for a in range(3)]
         return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)
 
     def inside_volume(self):
         """Lattice points with f >= 0 times the voxel volume."""
+        np = _numpy("DenseGrid.inside_volume")
         return float(np.count_nonzero(self.values >= 0)) * self.voxel ** 3
 
 
 def dense_grid(model, lo, hi, res=64, fixed=()):
     """f of a frepfarm.Model on the lattice of `res` points along the box's longest edge, from lo
     (up to hi on every axis): a DenseGrid. fixed: x[4] and above of higher-dimensional models."""
+    np = _numpy("grid")
     lo = np.asarray(lo, dtype=np.float64)
     hi = np.asarray(hi, dtype=np.float64)
     if lo.shape != (3,) or hi.shape != (3,) or not np.all(np.isfinite(lo)) or not np.all(np.isfinite(hi)):
