@@ -8,20 +8,14 @@
 #include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/Prune.h>
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
+#include <climits>
 #include <cmath>
-
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
-#include <sstream>
 #include <stdexcept>
 
 #include "frep/io/error.h"
+#include "sealed_vdb_file.h"
 #include "vdb_checksum.h"
 
 #ifndef FREP_VERSION
@@ -64,74 +58,13 @@ void addLeaf(openvdb::FloatGrid::Accessor& acc, const LeafBlock& block, const op
       }
 }
 
-// The bytes openvdb::io::File::write would put in the file (the same Archive::write, seekable),
-// built in memory: OpenVDB's own file writer ignores a failing stream (ENOSPC, EFBIG).
-struct MemoryArchive : openvdb::io::Archive {
-  std::string bytes(const openvdb::GridCPtrVec& grids) const {
-    std::ostringstream os(std::ios_base::out | std::ios_base::binary);
-    write(os, grids, /*seekable=*/true);
-    if (!os) throw openvdb::IoError("cannot serialise the grid");
-    return os.str();
+// The file openvdb::io::File::write would write (the same Archive::write, seekable), with every
+// write checked (OpenVDB's own file writer ignores a failing stream: ENOSPC, EFBIG).
+struct FileArchive : openvdb::io::Archive {
+  void writeTo(std::ostream& os, const openvdb::GridCPtrVec& grids) const {
+    write(os, grids, /*seekable=*/true);  // a failed write: writeSealedVdb names its error
   }
 };
-
-// The checksum entry's placeholder digits replaced by the file's checksum, and the header's UUID
-// by the one the checksum gives (vdb_checksum.h). The entry is found with its length prefixes,
-// which hold NUL bytes no metadata text from argv has.
-void sealChecksum(std::string& bytes) {
-  auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
-  const std::string key = kGridChecksumKey;
-  const std::string entry = u32(uint32_t(key.size())) + key + u32(6) + "string" + u32(uint32_t(kChecksumDigits)) +
-                            std::string(kChecksumDigits, '0');
-  const size_t at = bytes.find(entry);
-  if (at == std::string::npos) throw openvdb::IoError("the checksum entry is missing from the serialised grid");
-  const size_t digits = at + entry.size() - kChecksumDigits;
-  const std::string checksum = vdbChecksum(bytes, digits);
-  bytes.replace(digits, kChecksumDigits, checksum);
-  // OpenVDB stamps a random UUID into every file header; frep's comes from the seal (the same grid
-  // gives the same bytes: farm runs are compared byte for byte), which tells damage in place from
-  // a rewrite by another tool (vdb_checksum.h).
-  const bool looksLikeUuid = bytes.size() > kVdbUuidAt + kVdbUuidLength && bytes[kVdbUuidAt + 8] == '-' &&
-                             bytes[kVdbUuidAt + 13] == '-' && bytes[kVdbUuidAt + 18] == '-' &&
-                             bytes[kVdbUuidAt + 23] == '-';
-  if (!looksLikeUuid) throw openvdb::IoError("the serialised header has no UUID where OpenVDB 10 puts it");
-  bytes.replace(kVdbUuidAt, kVdbUuidLength, vdbUuidForChecksum(checksum));
-}
-
-// Every byte handed to the kernel and checked, then fsync and the size read back: a full disk
-// fails here (exit 3) and AtomicOutput never renames a truncated file into place.
-void writeAllOrThrow(const std::string& path, const std::string& bytes) {
-  auto fail = [&](const char* what) {
-    throw ioError("cannot write VDB '" + path + "': " + what + ": " + std::strerror(errno));
-  };
-  int fd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_NOFOLLOW | O_CLOEXEC);
-  if (fd < 0) fail("open");
-  size_t done = 0;
-  while (done < bytes.size()) {
-    ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      if (n == 0) errno = ENOSPC;
-      int err = errno;
-      ::close(fd);
-      errno = err;
-      fail("write");
-    }
-    done += size_t(n);
-  }
-  struct stat st;
-  if (::fsync(fd) != 0 || ::fstat(fd, &st) != 0) {
-    int err = errno;
-    ::close(fd);
-    errno = err;
-    fail("fsync");
-  }
-  if (::close(fd) != 0) fail("close");
-  if (uint64_t(st.st_size) != bytes.size()) {
-    errno = EIO;
-    fail(("size " + std::to_string(st.st_size) + " instead of " + std::to_string(bytes.size())).c_str());
-  }
-}
 
 std::string hex(uint64_t v) {
   char buf[19];
@@ -149,6 +82,8 @@ struct GridAssembly {
   openvdb::Coord offset;
   openvdb::FloatGrid::Ptr grid;
   openvdb::FloatGrid::Accessor acc;
+  bool eager = true;  // prune final leaves as they come (addLeaves)
+  int64_t finalBelow = INT64_MIN;  // world x below which every leaf was pruned if inactive
   GridAssembly(const GridSpec& lattice, int band)
       : g(lattice),
         bandVoxels(band),
@@ -160,8 +95,36 @@ struct GridAssembly {
   void addTiles(const std::vector<Tile>& tiles) {
     for (const Tile& t : tiles) addTile(grid->tree(), t, t.inside ? -background : background, extent, offset);
   }
+  // Leaves in nondecreasing x (the farm's slabs, a sample's sorted leaves; tiles at or past the
+  // leaves added: LevelSetBuilder::addTiles): after each call, the tree's leaves that end at or
+  // below the last leaf's x are final, and those without an active voxel are pruned at once, as
+  // pruneLevelSet will at the end (a tile of the sign of its first value; the levels above see
+  // the same tiles in finish()). Else the leaves that misaligned tiles fill in (the sampler's
+  // 8-grid is offset from OpenVDB's by the lattice's origin) lived until the end: ~0.9 GB at 1024^3.
   void addLeaves(const std::vector<LeafBlock>& leaves) {
-    for (const LeafBlock& b : leaves) addLeaf(acc, b, offset);
+    for (const LeafBlock& b : leaves) {
+      if (eager && int64_t(b.origin[0]) + offset[0] < finalBelow)
+        throw std::logic_error("GridAssembly: a leaf at x " + std::to_string(b.origin[0]) + " after leaves past it");
+      addLeaf(acc, b, offset);
+    }
+    if (eager && !leaves.empty()) pruneFinalLeaves(int64_t(leaves.back().origin[0]) + offset[0]);
+  }
+  // Prunes the inactive leaves that end at or below world index x (nothing will be added there).
+  void pruneFinalLeaves(int64_t x) {
+    if (x < finalBelow + openvdb::FloatTree::LeafNodeType::DIM) return;  // no new column of leaves
+    acc.clear();  // it may cache a leaf pruned below
+    for (auto upper = grid->tree().root().beginChildOn(); upper; ++upper) {
+      if (upper->origin().x() >= x) continue;
+      for (auto lower = upper->beginChildOn(); lower; ++lower) {
+        const int64_t lo = lower->origin().x();
+        if (lo >= x || lo + lower->DIM <= finalBelow) continue;  // none of its leaves newly final
+        for (auto leaf = lower->beginChildOn(); leaf; ++leaf) {
+          if (int64_t(leaf->origin().x()) + leaf->DIM > x || !leaf->isInactive()) continue;
+          lower->addTile(leaf.pos(), openvdb::math::isNegative(leaf->getFirstValue()) ? -background : background, false);
+        }
+      }
+    }
+    finalBelow = x;
   }
   openvdb::FloatGrid::Ptr finish() {
     acc.clear();
@@ -180,6 +143,8 @@ struct LevelSetBuilder::Tree : GridAssembly {
 
 openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result) {
   GridAssembly tree(result.grid, result.bandVoxels);
+  tree.eager = std::is_sorted(result.leaves.begin(), result.leaves.end(),
+                              [](const LeafBlock& a, const LeafBlock& b) { return a.origin[0] < b.origin[0]; });
   tree.addTiles(result.tiles);
   tree.addLeaves(result.leaves);
   return tree.finish();
@@ -266,7 +231,7 @@ void writeGrid(const std::string& path, openvdb::FloatGrid::Ptr grid, const Grid
 
   try {
     grid->insertMeta(kGridChecksumKey, openvdb::StringMetadata(std::string(kChecksumDigits, '0')));  // sealed below
-    MemoryArchive archive;
+    FileArchive archive;
     // Every voxel's value is stored, not only the active ones (no COMPRESS_ACTIVE_MASK): with
     // the mask, a leaf's inactive values are rebuilt as +-background when the leaf is loaded,
     // and under OpenVDB's delayed loading (its default for files) the load reads the background
@@ -279,9 +244,9 @@ void writeGrid(const std::string& path, openvdb::FloatGrid::Ptr grid, const Grid
     if (openvdb::io::Archive::hasBloscCompression()) compression |= openvdb::io::COMPRESS_BLOSC;
     else compression |= openvdb::io::COMPRESS_ZIP;
     archive.setCompression(compression);
-    std::string bytes = archive.bytes(openvdb::GridCPtrVec{grid});
-    sealChecksum(bytes);
-    writeAllOrThrow(path, bytes);
+    // Straight to the file and sealed there: the serialised grid (62 MB at 1024^3) is not held
+    // in memory on top of the tree.
+    detail::writeSealedVdb(path, [&](std::ostream& os) { archive.writeTo(os, openvdb::GridCPtrVec{grid}); });
   } catch (const openvdb::Exception& e) {
     throw ioError("cannot write VDB '" + path + "': " + e.what());
   }
