@@ -15,7 +15,9 @@ for (const { file, doc } of objects) {
   const modulePath = path.join(modelsDir, group === "v1" ? "v1" : group, `${doc.kind}.js`);
   let Model;
   try {
-    Model = (await import(pathToFileURL(modulePath).href))[doc.kind];
+    const mod = await import(pathToFileURL(modulePath).href);
+    Model = mod[doc.kind] ?? mod.default?.[doc.kind]; // 5.x is ESM; 4.x CommonJS
+    if (!Model) throw new Error(`${modulePath} exports no ${doc.kind}`);
   } catch (e) {
     console.log(`FAIL ${what}: no schema for this apiVersion/kind in kubernetes-models (${e.message})`);
     failures++;
