@@ -1,7 +1,8 @@
 // HyperFun compiled vs interpreted: a model in HyperFun's sample style (nine soft-object terms
 // summed by a while loop, written with plain formulas so the interpreter is not slowed by
-// library calls), evaluated by a direct AST interpreter (lang/interpret.h, the baseline) and by
-// the compiled tape (point and batch evaluators), on the same points in the same run.
+// library calls), evaluated by a direct AST interpreter (frep/lang/frontend/interpret.h, the
+// baseline) and by the compiled tape (point and batch evaluators), on the same points in the same
+// run.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -9,7 +10,7 @@
 
 #include "frep/evaluators/eval.h"
 #include "frep/lang/hyperfun.h"
-#include "frep/lang/interpret.h"
+#include "frep/lang/frontend/interpret.h"
 
 using namespace frep;
 

@@ -14,7 +14,7 @@
 #include "frep/io/error.h"
 #include "frep/io/input_file.h"
 #include "frep/io/mesh_reader.h"
-#include "frep/lang/library.h"
+#include "frep/lang/library/library.h"
 
 namespace frep::io {
 

@@ -14,7 +14,7 @@
 
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/expr.h"
-#include "frep/lang/library.h"
+#include "frep/lang/library/library.h"
 #include "frep/expressions/tape.h"
 
 namespace hftest {

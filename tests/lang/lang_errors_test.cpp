@@ -1,5 +1,5 @@
 // Every kind of syntax and semantic error: its message at the exact line and column.
-#include "frep/lang/diagnostics.h"
+#include "frep/lang/frontend/diagnostics.h"
 #include "lang/lang_test_util.h"
 
 namespace frep::lang::testing {

@@ -7,10 +7,10 @@
 #include <cstdlib>
 #include <random>
 
-#include "frep/lang/diagnostics.h"
-#include "frep/lang/interpret.h"
-#include "frep/lang/lexer.h"
-#include "frep/lang/library.h"
+#include "frep/lang/frontend/diagnostics.h"
+#include "frep/lang/frontend/interpret.h"
+#include "frep/lang/frontend/lexer.h"
+#include "frep/lang/library/library.h"
 #include "lang/lang_test_util.h"
 
 namespace frep::lang::testing {

@@ -1,8 +1,8 @@
 // The tree-walking interpreter, and the compiled models checked against it point by point.
 #include <cmath>
 
-#include "frep/lang/interpret.h"
-#include "frep/lang/library.h"
+#include "frep/lang/frontend/interpret.h"
+#include "frep/lang/library/library.h"
 #include "lang/lang_test_util.h"
 
 namespace frep::lang::testing {

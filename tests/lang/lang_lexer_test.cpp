@@ -1,7 +1,7 @@
 // Tokens, numbers, comments, line/column tracking.
 #include <gtest/gtest.h>
 
-#include "frep/lang/lexer.h"
+#include "frep/lang/frontend/lexer.h"
 
 namespace frep::lang {
 namespace {

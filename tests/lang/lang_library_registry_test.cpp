@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cctype>
 
-#include "frep/lang/library.h"
+#include "frep/lang/library/library.h"
 
 namespace frep::lang {
 namespace {

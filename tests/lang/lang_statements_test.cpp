@@ -1,7 +1,7 @@
 // Statements, arrays, loops, branches, objects and library calls, lowered and evaluated.
 #include <cmath>
 
-#include "frep/lang/library.h"
+#include "frep/lang/library/library.h"
 #include "lang/lang_test_util.h"
 
 namespace frep::lang::testing {

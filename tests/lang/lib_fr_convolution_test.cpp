@@ -1,10 +1,10 @@
-// frConv<Kernel><Skeleton> (lang/src/lib_fr_convolution.cpp): the language calls reach the core
+// frConv<Kernel><Skeleton> (lang/src/library/fr_convolution.cpp): the language calls reach the core
 // convolution (frep/primitives/convolution.h, tested against numerical integration in
 // tests/core/convolution_test.cpp) with the right arguments, the arc's rotation and degrees, and
 // the diagnostics. Exact values where the integral is elementary.
 #include <cmath>
 
-#include "frep/lang/library.h"
+#include "frep/lang/library/library.h"
 #include "lang/lang_test_util.h"
 
 namespace frep::lang::testing {

@@ -1,4 +1,4 @@
-// The fr* extremum extensions (lang/src/lib_fr_extremum.cpp): object operands, automatic
+// The fr* extremum extensions (lang/src/library/fr_extremum.cpp): object operands, automatic
 // bounding boxes, and the exact answers of issue 6 at a few points each (coarse tolerances).
 #include <algorithm>
 #include <array>

@@ -1,5 +1,5 @@
 // frHull against closed forms: the hull of two balls is a capsule, the hull of a box is the box,
-// both within the bound the function states (lib_fr_hull.cpp, docs/language.md).
+// both within the bound the function states (lang/src/library/fr_hull.cpp, docs/language.md).
 #include <algorithm>
 #include <cmath>
 #include <random>

@@ -1,10 +1,10 @@
-// frPolygon, frBezierCurve, frBezierSurface in models (lib_fr_hybrid.cpp): values against the
+// frPolygon, frBezierCurve, frBezierSurface in models (lang/src/library/fr_hybrid.cpp): values against the
 // distance to the same geometry, areas by counting, and the errors at file:line:column. frMesh and
 // frVolume read files through frep_io: tests/cli/unit/geometry_files_test.cpp.
 #include <cmath>
 
 #include "frep/geometry/distance_fields.h"
-#include "frep/lang/library.h"
+#include "frep/lang/library/library.h"
 #include "lang/lang_test_util.h"
 
 namespace frep::lang::testing {

@@ -1,5 +1,5 @@
 // Roerdink's basic set as fr* primitives and the exact path of frMinkowski / frMinkowskiSum /
-// frMinkowskiDiff (lang/src/lib_fr_minkowski.cpp): no extremum node when every operand is in
+// frMinkowskiDiff (lang/src/library/fr_minkowski.cpp): no extremum node when every operand is in
 // the basic set, the search otherwise; exact values at points.
 #include <cmath>
 
