@@ -34,15 +34,17 @@ openvdb::Coord latticeOffset(const GridSpec& g) {
 
 // A sampler tile, clipped to the grid's leaf-aligned extent (a brick's root cube may reach past
 // it) so that the tree, once pruned, does not depend on how the job was split into bricks.
-void addTile(openvdb::FloatTree& tree, const Tile& tile, float value, const std::array<int32_t, 3>& extent,
-             const openvdb::Coord& offset) {
+// False when it lies entirely past the grid.
+bool tileBox(const Tile& tile, const std::array<int32_t, 3>& extent, const openvdb::Coord& offset,
+             openvdb::CoordBBox& box) {
   openvdb::Coord lo, hi;
   for (int a = 0; a < 3; ++a) {
-    if (tile.origin[a] >= extent[a]) return;  // entirely past the grid
+    if (tile.origin[a] >= extent[a]) return false;
     lo[a] = tile.origin[a] + offset[a];
     hi[a] = std::min(tile.origin[a] + tile.size, extent[a]) - 1 + offset[a];
   }
-  tree.fill(openvdb::CoordBBox(lo, hi), value, false);
+  box = openvdb::CoordBBox(lo, hi);
+  return true;
 }
 
 void addLeaf(openvdb::FloatGrid::Accessor& acc, const LeafBlock& block, const openvdb::Coord& offset) {
@@ -84,6 +86,8 @@ struct GridAssembly {
   openvdb::FloatGrid::Accessor acc;
   bool eager = true;  // prune final leaves as they come (addLeaves)
   int64_t finalBelow = INT64_MIN;  // world x below which every leaf was pruned if inactive
+  int64_t filledBelow = INT64_MIN;  // world x below which every tile added is filled in
+  std::vector<std::pair<openvdb::CoordBBox, float>> pending;  // the rest of the tiles, in order
   GridAssembly(const GridSpec& lattice, int band)
       : g(lattice),
         bandVoxels(band),
@@ -92,8 +96,63 @@ struct GridAssembly {
         offset(latticeOffset(lattice)),
         grid((openvdb::initialize(), openvdb::FloatGrid::create(background))),
         acc(grid->getAccessor()) {}
+  // Eager, a tile is filled in only up to the x the leaves have reached (fillTo), the rest as
+  // the leaves come: a large tile's misaligned faces would otherwise fill dense leaves along its
+  // whole length at once (151 MB at once at 1024^3). Filling a box in pieces cut along x sets
+  // the same voxels, in the same order as the other tiles; where it leaves other nodes than one
+  // fill, they are inactive and uniform, and pruneLevelSet makes them the same tiles.
   void addTiles(const std::vector<Tile>& tiles) {
-    for (const Tile& t : tiles) addTile(grid->tree(), t, t.inside ? -background : background, extent, offset);
+    for (const Tile& t : tiles) {
+      openvdb::CoordBBox box;
+      if (!tileBox(t, extent, offset, box)) continue;
+      const float value = t.inside ? -background : background;
+      if (!eager) {
+        grid->tree().fill(box, value, false);
+        continue;
+      }
+      if (box.min().x() < filledBelow) {
+        openvdb::CoordBBox now = box;
+        now.max().x() = int32_t(std::min<int64_t>(box.max().x(), filledBelow - 1));
+        grid->tree().fill(now, value, false);
+        if (box.max().x() < filledBelow) continue;
+        box.min().x() = int32_t(filledBelow);
+      }
+      pending.emplace_back(box, value);
+    }
+  }
+  // The pending tiles filled in below world x (a multiple of a leaf's size: no leaf is cut).
+  void fillTo(int64_t x) {
+    if (x <= filledBelow) return;
+    acc.clear();
+    size_t kept = 0;
+    for (auto& [box, value] : pending) {
+      openvdb::CoordBBox now = box;
+      if (now.min().x() < x) {
+        now.max().x() = int32_t(std::min<int64_t>(now.max().x(), x - 1));
+        grid->tree().fill(now, value, false);
+        if (box.max().x() < x) continue;
+        box.min().x() = int32_t(x);
+      }
+      pending[kept++] = {box, value};
+    }
+    pending.resize(kept);
+    filledBelow = x;
+  }
+  // The pending tiles filled in below world x (a multiple of 8) and what is final there pruned,
+  // 64 voxels of x at a time: the dense leaves a tile's misaligned faces fill in live for one
+  // step (a gap of tiles without leaves, or those past the last leaf, filled at once: 0.1 GB).
+  void fillAndPrune(int64_t x) {
+    while (filledBelow < x) {
+      int64_t from = filledBelow;
+      if (from == INT64_MIN) {  // nothing filled yet: from the first pending tile
+        from = x;
+        for (const auto& p : pending) from = std::min<int64_t>(from, p.first.min().x());
+        from &= ~int64_t(7);
+      }
+      const int64_t step = std::min(x, from + 64);
+      fillTo(step);
+      pruneFinalLeaves(step);
+    }
   }
   // Leaves in nondecreasing x (the farm's slabs, a sample's sorted leaves; tiles at or past the
   // leaves added: LevelSetBuilder::addTiles): after each call, the tree's leaves that end at or
@@ -102,6 +161,15 @@ struct GridAssembly {
   // the same tiles in finish()). Else the leaves that misaligned tiles fill in (the sampler's
   // 8-grid is offset from OpenVDB's by the lattice's origin) lived until the end: ~0.9 GB at 1024^3.
   void addLeaves(const std::vector<LeafBlock>& leaves) {
+    if (eager && !leaves.empty()) {
+      int64_t lo = INT64_MAX, end = INT64_MIN;
+      for (const LeafBlock& b : leaves) {
+        lo = std::min(lo, int64_t(b.origin[0]) + offset[0]);
+        end = std::max(end, int64_t(b.origin[0]) + offset[0] + kLeafDim);
+      }
+      fillAndPrune(lo & ~int64_t(7));  // what lies before these leaves is final
+      fillTo((end + 7) & ~int64_t(7));  // the tiles under them
+    }
     for (const LeafBlock& b : leaves) {
       if (eager && int64_t(b.origin[0]) + offset[0] < finalBelow)
         throw std::logic_error("GridAssembly: a leaf at x " + std::to_string(b.origin[0]) + " after leaves past it");
@@ -127,6 +195,12 @@ struct GridAssembly {
     finalBelow = x;
   }
   openvdb::FloatGrid::Ptr finish() {
+    if (eager) {
+      int64_t end = INT64_MIN;
+      for (const auto& p : pending) end = std::max(end, int64_t(p.first.max().x()) + 1);
+      fillAndPrune((end + 7) & ~int64_t(7));
+    }
+    fillTo(INT64_MAX);
     acc.clear();
     openvdb::tools::pruneLevelSet(grid->tree());  // canonical tree: the same whatever the brick layout
     grid->setTransform(openvdb::math::Transform::createLinearTransform(g.voxel));
