@@ -139,7 +139,7 @@ struct GridAssembly {
     filledBelow = x;
   }
   // The pending tiles filled in below world x (a multiple of 8) and what is final there pruned,
-  // 64 voxels of x at a time: the dense leaves a tile's misaligned faces fill in live for one
+  // one leaf of x at a time: the dense leaves a tile's misaligned faces fill in live for one
   // step (a gap of tiles without leaves, or those past the last leaf, filled at once: 0.1 GB).
   void fillAndPrune(int64_t x) {
     while (filledBelow < x) {
@@ -149,7 +149,7 @@ struct GridAssembly {
         for (const auto& p : pending) from = std::min<int64_t>(from, p.first.min().x());
         from &= ~int64_t(7);
       }
-      const int64_t step = std::min(x, from + 64);
+      const int64_t step = std::min(x, from + 8);
       fillTo(step);
       pruneFinalLeaves(step);
     }
