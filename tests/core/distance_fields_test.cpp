@@ -4,8 +4,12 @@
 // points that break parity tests (rays through vertices, lines along edges).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <random>
+#include <vector>
 
 #include "frep/evaluators/eval.h"
 #include "frep/geometry/distance_fields.h"
@@ -316,6 +320,45 @@ TEST(MeshField, DistanceMatchesBruteForceOnRandomPoints) {
   }
 }
 
+
+// The query prunes by the thread's previous nearest triangle (warm start) and by each triangle's
+// plane: neither may change an answer. Lattice points of a cube (many exact ties between faces,
+// edges and corners) and random points near a torus, queried in order, then shuffled, then
+// interleaved with a second mesh: value, gradient and closest-point choice bit for bit the same.
+TEST(MeshField, AnswersDoNotDependOnTheOrderOfQueries) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.2, 1.2);
+  const Soup cubeSoup = cube(0.5), torusSoup = torus(0.8, 0.3, 40, 24);
+  MeshField c(cubeSoup.xyz, cubeSoup.tris, "cube"), t(torusSoup.xyz, torusSoup.tris, "torus");
+  std::vector<std::array<double, 3>> pts;
+  for (int i = -6; i <= 6; ++i)
+    for (int j = -6; j <= 6; ++j)
+      for (int k = -6; k <= 6; ++k) pts.push_back({0.125 * i, 0.125 * j, 0.125 * k});
+  for (int i = 0; i < 3000; ++i) pts.push_back({u(rng), u(rng), 0.4 * u(rng)});
+  struct Answer {
+    double f, g[3];
+  };
+  auto ask = [](const MeshField& m, const std::array<double, 3>& p) {
+    Answer a;
+    a.f = m.gradient(p.data(), a.g);
+    return a;
+  };
+  auto same = [](const Answer& a, const Answer& b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+  };
+  std::vector<Answer> cubeFirst, torusFirst;
+  for (const auto& p : pts) cubeFirst.push_back(ask(c, p));
+  for (const auto& p : pts) torusFirst.push_back(ask(t, p));
+  std::vector<size_t> order(pts.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::shuffle(order.begin(), order.end(), rng);
+  for (size_t i : order) {
+    ASSERT_TRUE(same(ask(c, pts[i]), cubeFirst[i])) << "cube point " << i;
+    ASSERT_TRUE(same(ask(t, pts[i]), torusFirst[i])) << "torus point " << i;
+  }
+  for (size_t i = 0; i < pts.size(); i += 97)  // and against the brute force
+    ASSERT_NEAR(std::fabs(torusFirst[i].f), bruteDist3D(torusSoup, pts[i].data()), 1e-12);
+}
 TEST(MeshField, SignMatchesWindingNumberOnVertexRaysAndEdgeLines) {
   std::mt19937 rng(13);
   for (const Soup& s : {cube(0.5), torus(0.8, 0.3, 24, 16), starPrism()}) {

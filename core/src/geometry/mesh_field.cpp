@@ -3,6 +3,7 @@
 // BVH instead of the paper's scan of every triangle; sign from the closest feature's
 // angle-weighted pseudonormal on closed meshes and from the generalised winding number on open
 // ones, instead of the ray parity of eq. 7 (distance_fields.h).
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -146,10 +147,18 @@ MeshField::MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::s
     }
   }
   bvh_.build(boxes);
-  corners_.resize(9 * nt);  // each triangle's corners in one cache-friendly block for the queries
-  for (size_t t = 0; t < nt; ++t)
+  // Each triangle's corners in one block, in the hierarchy's leaf order: a query reads the
+  // triangles of a leaf from consecutive memory.
+  corners_.resize(9 * nt);
+  slotPlanes_.resize(4 * nt);
+  for (size_t slot = 0; slot < nt; ++slot) {
+    const size_t t = bvh_.order()[slot];
     for (int c = 0; c < 3; ++c)
-      for (int k = 0; k < 3; ++k) corners_[9 * t + 3 * c + k] = xyz_[3 * tris_[3 * t + c] + k];
+      for (int k = 0; k < 3; ++k) corners_[9 * slot + 3 * c + k] = xyz_[3 * tris_[3 * t + c] + k];
+    double* pl = &slotPlanes_[4 * slot];
+    for (int k = 0; k < 3; ++k) pl[k] = faceN_[3 * t + k];  // zero for a degenerate triangle
+    pl[3] = dot(pl, &corners_[9 * slot]);
+  }
   uint64_t h = 0xcbf29ce484222325ULL;
   for (double d : xyz_) {
     uint64_t b;
@@ -197,18 +206,51 @@ void MeshField::orientConsistently() {
   }
 }
 
+// The nearest triangle of this thread's previous query on the same mesh (queries come in
+// nearby runs: a brick's points, a triangle's error samples), keyed by the field's id.
+namespace {
+struct WarmTriangle {
+  uint64_t field = 0;
+  uint32_t slot = 0;
+};
+thread_local WarmTriangle tWarm;
+std::atomic<uint64_t> gNextMeshFieldId{1};
+}  // namespace
+
+uint64_t MeshField::newId() { return gNextMeshFieldId++; }
+
 int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, double& best2, double start2) const {
   double bq[3] = {0, 0, 0};
   best2 = start2;
   bestRegion = 0;
-  const int64_t t = bvh_.nearest(p, [&](uint32_t i, double cur) {
+  // Warm start: the previous nearest triangle's distance (a little above, so that triangle
+  // itself still counts) bounds the search. Only boxes and triangles that could not hold the
+  // nearest one are pruned by it, in the same near-first order, so the triangle found and its
+  // ties are those of a cold search.
+  if (tWarm.field == id_) {
     double qq[3];
     int region;
-    const double* c = &corners_[9 * size_t(i)];
+    const double* c = &corners_[9 * size_t(tWarm.slot)];
+    best2 = std::min(best2, triangleDist2(p, c, c + 3, c + 6, qq, region) * (1 + 2e-9) + 1e-300);
+  }
+  uint32_t bestSlot = 0;
+  const int64_t t = bvh_.nearest(p, [&](uint32_t slot, uint32_t, double cur) {
+    // The distance to the triangle's plane is a lower bound: a triangle whose plane is
+    // farther than the best so far cannot win. The slack (absolute, for the plane's rounding,
+    // and relative) keeps the nearest triangle and its ties those of the full test.
+    const double* pl = &slotPlanes_[4 * size_t(slot)];
+    const double slack = 1e-13 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) + std::abs(pl[3]));
+    const double h = std::abs(dot(pl, p) - pl[3]) - slack;
+    if (h > 0 && h * h > cur * (1 + 1e-9)) return std::numeric_limits<double>::infinity();
+    double qq[3];
+    int region;
+    const double* c = &corners_[9 * size_t(slot)];
     const double d2 = triangleDist2(p, c, c + 3, c + 6, qq, region);
-    if (d2 < cur) bq[0] = qq[0], bq[1] = qq[1], bq[2] = qq[2], bestRegion = region;
+    if (d2 < cur || cur == std::numeric_limits<double>::infinity())
+      bq[0] = qq[0], bq[1] = qq[1], bq[2] = qq[2], bestRegion = region, bestSlot = slot;
     return d2;
   }, best2);
+  if (t >= 0) tWarm = {id_, bestSlot};
   if (q) q[0] = bq[0], q[1] = bq[1], q[2] = bq[2];
   return t;
 }

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "frep/geometry/field.h"
@@ -39,6 +40,8 @@ class Bvh {
   template <typename F>
   void containing(const double* p, F&& visit) const;
   size_t numNodes() const { return nodes_.size(); }
+  // Primitive of each leaf slot (leaves hold consecutive slots): for data stored in slot order.
+  const std::vector<uint32_t>& order() const { return order_; }
   // A lower bound of the distance between box q and every primitive: the least distance from q
   // to a leaf's box (0 when q touches one).
   double boxGap(const Box& q) const;
@@ -134,7 +137,10 @@ class MeshField : public DistanceField {
   std::vector<uint32_t> tris_;
   std::vector<double> faceN_, vertN_, edgeN_;  // pseudonormals
   std::vector<uint32_t> triEdge_;              // 3 edge ids per triangle (edge k: v[k]-v[k+1])
-  std::vector<double> corners_;                // 9 coordinates per triangle (a copy of xyz_ by tris_)
+  std::vector<double> corners_;                // 9 coordinates per triangle, in bvh_.order()
+  std::vector<double> slotPlanes_;             // unit normal and offset per triangle, same order
+  uint64_t id_ = newId();                      // the warm start's key (an address may be reused)
+  static uint64_t newId();
   double setError_ = 0;
   Bvh bvh_;
   MeshCheck check_;
@@ -189,16 +195,27 @@ template <typename F>
 int64_t Bvh::nearest(const double* p, F&& dist2, double& best2) const {
   int64_t best = -1;
   if (nodes_.empty()) return best;
-  uint32_t stack[128];
+  // Each entry keeps its box's squared gap, computed once when its parent was opened (the
+  // same value and the same near-first order as computing it again when popped).
+  struct Entry {
+    uint32_t node;
+    double gap2;
+  };
+  Entry stack[128];
   int sp = 0;
-  stack[sp++] = 0;
+  stack[sp++] = {0, boxDist2(nodes_[0].box, p)};
   while (sp > 0) {
-    const NodeB& n = nodes_[stack[--sp]];
-    const double gap2 = boxDist2(n.box, p);
-    if (gap2 > best2 || (gap2 == best2 && best >= 0)) continue;  // a tie cannot be nearer
+    const Entry e = stack[--sp];
+    if (e.gap2 > best2 || (e.gap2 == best2 && best >= 0)) continue;  // a tie cannot be nearer
+    const NodeB& n = nodes_[e.node];
     if (n.count > 0) {
       for (uint32_t k = n.first; k < n.first + n.count; ++k) {
-        const double d = dist2(order_[k], best2);
+        // The callback may take the leaf slot too (primitives stored in slot order).
+        double d;
+        if constexpr (std::is_invocable_v<F, uint32_t, uint32_t, double>)
+          d = dist2(k, order_[k], best2);
+        else
+          d = dist2(order_[k], best2);
         if (d < best2 || (best < 0 && best2 == INFINITY)) {
           best2 = d;
           best = order_[k];
@@ -208,11 +225,11 @@ int64_t Bvh::nearest(const double* p, F&& dist2, double& best2) const {
     }
     const double dl = boxDist2(nodes_[n.left].box, p), dr = boxDist2(nodes_[n.right].box, p);
     if (dl <= dr) {
-      stack[sp++] = n.right;
-      stack[sp++] = n.left;
+      stack[sp++] = {n.right, dr};
+      stack[sp++] = {n.left, dl};
     } else {
-      stack[sp++] = n.left;
-      stack[sp++] = n.right;
+      stack[sp++] = {n.left, dl};
+      stack[sp++] = {n.right, dr};
     }
   }
   return best;
