@@ -22,7 +22,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "frep/worker/allocator_tuning.h"
+#include "frep/farm/allocator_tuning.h"
 #include "frep/worker/brick.h"
 #include "frep/master/farm_master.h"
 #include "frep/net/wire.h"

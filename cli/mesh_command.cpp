@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <iostream>
 
-#include "frep/worker/allocator_tuning.h"
+#include "frep/farm/allocator_tuning.h"
 #include "arg_parse.h"
-#include "frep/worker/brick.h"
+#include "frep/worker/job_model.h"
 #include "frep/io/atomic_output.h"
 #include "commands.h"
 #include "exit_codes.h"

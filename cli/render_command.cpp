@@ -28,7 +28,7 @@
 #include "frep/render/rasterize.h"
 #include "frep/render/raycast.h"
 #include "frep/render/shade.h"
-#include "frep/worker/brick.h"
+#include "frep/worker/job_model.h"
 #include "geometric_types.h"
 
 namespace frep::cli {

@@ -8,7 +8,7 @@
 #include <iostream>
 #include <optional>
 
-#include "frep/worker/allocator_tuning.h"
+#include "frep/farm/allocator_tuning.h"
 #include "arg_parse.h"
 #include "frep/farm/job.h"
 #include "frep/io/world_lattice.h"

@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include "frep/net/curve.h"
-#include "frep/worker/brick.h"
+#include "frep/worker/job_model.h"
 #include "master.h"
 
 namespace frep::farm::detail {

@@ -9,7 +9,7 @@
 #include "frep/farm/crc32.h"
 #include "frep/meshing/mesh_merge.h"
 #include "frep/master/leaf_order.h"
-#include "frep/worker/allocator_tuning.h"
+#include "frep/farm/allocator_tuning.h"
 #include "master.h"
 
 namespace frep::farm::detail {

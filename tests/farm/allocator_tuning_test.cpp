@@ -1,4 +1,4 @@
-// adviseHugePages (worker/allocator_tuning.h), the hint the allocator policy gives the heap.
+// adviseHugePages (frep/farm/allocator_tuning.h), the hint the allocator policy gives the heap.
 #include <gtest/gtest.h>
 #include <sys/mman.h>
 
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "frep/worker/allocator_tuning.h"
+#include "frep/farm/allocator_tuning.h"
 
 using frep::farm::adviseHugePages;
 

@@ -7,7 +7,7 @@
 
 #include <cstdlib>
 
-#include "frep/worker/allocator_tuning.h"
+#include "frep/farm/allocator_tuning.h"
 #include "frep/worker/brick.h"
 #include "frep/io/geometry_files.h"
 #include "frep/worker/worker.h"

@@ -1,4 +1,4 @@
-#include "frep/worker/allocator_tuning.h"
+#include "frep/farm/allocator_tuning.h"
 
 #include <malloc.h>
 #include <sys/mman.h>
