@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -124,4 +125,63 @@ TEST(VdbLevelSetBuilder, TilesAfterLeavesAndASecondWriteAreRefused) {
   b.write(path, io::VdbMetadata{});
   EXPECT_THROW(b.write(path, io::VdbMetadata{}), std::logic_error);
   std::remove(path.c_str());
+}
+
+// The builder fills tiles and prunes final leaves as the leaves come in x (io/src/vdb_writer.cpp,
+// issue 35); leaves out of x order are built the old way (every tile, then every leaf, then one
+// prune). On lattices whose origin is not on OpenVDB's 8-grid (every tile's faces cut leaves),
+// both give the same bytes, for every store, slab by slab or whole.
+TEST(VdbLevelSetBuilder, FillingAndPruningAsTheLeavesComeChangesNoByte) {
+  Expr X = Expr::x(0), Y = Expr::x(1), Z = Expr::x(2);
+  Expr block = min(min(0.7 - abs(X), 0.6 - abs(Y)), 0.5 - abs(Z));
+  Expr ball = 0.45 - sqrt(square(X - 0.3) + square(Y - 0.2) + square(Z - 0.4));
+  const TapePtr tape = Tape::compile(min(block, -ball), 3);
+  size_t misaligned = 0;
+  for (const std::array<double, 3>& lo : {std::array<double, 3>{-1.03, -0.97, -1.1}, {-0.93, -1.13, -0.99}}) {
+    GridSpec g = io::worldLatticeGrid("test", lo, {1.1, 1.0, 1.05}, 2.0 / 95);
+    for (int a = 0; a < 3; ++a) misaligned += std::llround(g.origin[a] / g.voxel) % 8 != 0;
+    const SampleResult s = sample(tape, g);
+    ASSERT_GT(s.tiles.size(), 10u);
+    SampleResult shuffled = s;  // the same leaves, not in x order: the old way
+    for (size_t i = 0; i + 1 < shuffled.leaves.size(); i += 2) std::swap(shuffled.leaves[i], shuffled.leaves.back());
+    ASSERT_FALSE(std::is_sorted(shuffled.leaves.begin(), shuffled.leaves.end(),
+                                [](const LeafBlock& a, const LeafBlock& b) { return a.origin[0] < b.origin[0]; }));
+    for (io::VdbStore store : {io::VdbStore::Sdf, io::VdbStore::Raw, io::VdbStore::Fog}) {
+      SCOPED_TRACE(io::storeName(store));
+      io::VdbMetadata meta;
+      meta.gridName = "bitten";
+      meta.store = store;
+      const std::string old = emptyFile("old.vdb"), whole = emptyFile("whole.vdb"), slabs = emptyFile("slabs.vdb");
+      io::writeLevelSet(old, shuffled, meta);
+      io::writeLevelSet(whole, s, meta);
+      io::LevelSetBuilder b(s.grid, s.bandVoxels);
+      for (int x0 = 0; x0 < s.grid.dims[0]; x0 += 16) {
+        std::vector<Tile> tiles;
+        std::vector<LeafBlock> leaves;
+        for (const Tile& t : s.tiles)
+          if (t.origin[0] >= x0 && t.origin[0] < x0 + 16) tiles.push_back(t);
+        for (const LeafBlock& l : s.leaves)
+          if (l.origin[0] >= x0 && l.origin[0] < x0 + 16) leaves.push_back(l);
+        b.addTiles(tiles);
+        b.addLeaves(leaves);
+      }
+      b.write(slabs, meta);
+      const std::string want = readAll(old);
+      EXPECT_GT(want.size(), 10000u);
+      EXPECT_TRUE(want == readAll(whole)) << "sorted leaves, filled and pruned as they come, differ";
+      EXPECT_TRUE(want == readAll(slabs)) << "the streamed slabs differ";
+      for (const std::string& p : {old, whole, slabs}) std::remove(p.c_str());
+    }
+  }
+  EXPECT_GE(misaligned, 4u);  // the lattices cut OpenVDB's leaves
+}
+
+TEST(VdbLevelSetBuilder, LeavesBelowLeavesAlreadyPrunedAreRefused) {
+  SampleResult s = bittenBlock();
+  io::LevelSetBuilder b(s.grid, s.bandVoxels);
+  b.addTiles(s.tiles);
+  const size_t half = s.leaves.size() / 2;
+  b.addLeaves(std::vector<LeafBlock>(s.leaves.begin() + long(half), s.leaves.end()));
+  ASSERT_GT(s.leaves.back().origin[0] - s.leaves.front().origin[0], 16);
+  EXPECT_THROW(b.addLeaves(std::vector<LeafBlock>(s.leaves.begin(), s.leaves.begin() + 1)), std::logic_error);
 }
