@@ -2,7 +2,8 @@
 """Minkowski sums of any operands: frepfarm vs OpenSCAD and manifold-3d at equal accuracy (issue 30).
 
 Cases (every operand written the way a user would, HyperFun primitives or STL files):
-  box_ball        hfBlock (+) hfSphere: the baseline of the per-voxel ratio
+  box_ball        hfBlock (+) hfSphere: the per-voxel baseline of operands written in HyperFun
+  box_stl_ball    the same box as an STL file (+) frBall: the baseline of mesh operands
   slab_hf_ball    L-shaped slab hfBlock \\ hfBlock (+) hfSphere r 0.3 (non-convex)
   slab_stl_ball   the same slab as an STL file (+) frBall
   tetra_ball      regular tetrahedron (min of 4 planes) (+) hfSphere
@@ -22,7 +23,8 @@ For each case: frep mesh at several resolutions (2 local workers, the README's m
 OpenSCAD minkowski() (sphere $fn from --fn) and manifold-3d minkowskiSum (node; the whole
 process and the operation alone). Equal accuracy: for each peer run, the coarsest frep run whose
 |volume error| is at most the peer's; the ratio peer / frep of wall times is printed. Also the
-per-voxel time of each case against box_ball at the same resolution, and whether every frep mesh
+per-voxel time of each case against the box (+) ball of the same form (box_ball for HyperFun
+operands, box_stl_ball for meshes) at the same resolution, and whether every frep mesh
 is closed (unpaired edges 0). Never fails on time.
 
 Usage: bench/bench_minkowski_general.py [--quick] [--only case,...] [--frep build/bin/frep]
@@ -236,7 +238,8 @@ def build_cases(work, npm_dir, have_npm):
         path = os.path.join(work, name + ".hf")
         with open(path, "w") as f:
             f.write(model)
-        cases.append(dict(name=name, hf=path, box=box, exact=exact, scad=scad, manifold=manifold, what=what))
+        form = "stl" if 'frMesh(x, "' in model else "hf"  # which baseline is "of the same form"
+        cases.append(dict(name=name, hf=path, box=box, exact=exact, scad=scad, manifold=manifold, what=what, form=form))
 
     # box (+) ball, hfBlock / hfSphere: the baseline.
     bx = [1.0, 1.0, 0.5]
@@ -249,6 +252,16 @@ def build_cases(work, npm_dir, have_npm):
         1.0, steiner_volume(box_v, box_t, 0.25),
         scad="minkowski() { translate([-0.5, -0.5, -0.25]) cube([1, 1, 0.5]); sphere(r = 0.25, $fn = FN); }",
         manifold={"a": {"cube": bx, "corner": [-0.5, -0.5, -0.25]}, "b": {"sphere": 0.25}}, what="convex, r 0.25")
+    # The same box as an STL file (+) frBall: the baseline of the cases whose operand is a mesh.
+    box_stl = os.path.join(work, "box.stl")
+    write_stl(box_stl, box_v, outward(box_v, box_t))
+    add("box_stl_ball",
+        'opa(x[3], a[1]) { opa = frMesh(x, "box.stl"); }\n'
+        "opb(x[3], a[1]) { opb = frBall(x, 0.25); }\n"
+        "my_model(x[3], a[1]) { my_model = frMinkowski(x, opa, opb); }\n",
+        1.0, steiner_volume(box_v, box_t, 0.25),
+        scad="minkowski() { import(\"%s\"); sphere(r = 0.25, $fn = FN); }" % box_stl,
+        manifold={"a": {"stl": box_stl}, "b": {"sphere": 0.25}}, what="convex STL, r 0.25")
     slab_v, slab_t = slab_mesh()
     slab_stl = os.path.join(work, "slab.stl")
     write_stl(slab_stl, slab_v, slab_t)
@@ -324,6 +337,11 @@ def build_cases(work, npm_dir, have_npm):
     return cases
 
 
+# The per-voxel baseline of each operand form: box (+) ball written with hfBlock / hfSphere, and
+# the same box as an STL file (+) frBall.
+BASELINES = {"hf": "box_ball", "stl": "box_stl_ball"}
+
+
 def sphere_radius(case):
     for o in (case["manifold"] or {}).values():
         if "sphere" in o:
@@ -358,7 +376,7 @@ def main():
     cases = build_cases(work, npm_dir, have_npm)
     if args.only:
         keep = set(args.only.split(","))
-        cases = [c for c in cases if c["name"] in keep or c["name"] == "box_ball"]
+        cases = [c for c in cases if c["name"] in keep or c["name"] in BASELINES.values()]
     print("Minkowski sums of any operands: frep mesh (2 local workers) vs OpenSCAD %s and manifold-3d %s" %
           ("(found)" if have_scad else "(not installed)", "(found)" if have_manifold else "(not installed)"))
     print("%d cores, load average %.2f; work in %s" % (os.cpu_count(), os.getloadavg()[0], work))
@@ -422,14 +440,16 @@ def main():
         for fr in frep_runs:
             print("  %-30s %8.2f %9s %10d %+9.4f%% %6d  (%s path)" % ("frep --res %d" % fr["res"], fr["wall"], "", fr["tris"],
                                                                     100 * err_of(fr["vol"]), fr["open"], fr["path"]))
-            if name == "box_ball":
-                base[fr["res"]] = fr["wall"]
+            if name in BASELINES.values():
+                base[(case["form"], fr["res"])] = fr["wall"]
         for pp in peers:
             print("  %-30s %8.2f %9s %10d %+9.4f%%" % (pp["who"], pp["wall"], "%.2f" % pp["op"] if pp["op"] is not None else "",
                                                         pp["tris"], 100 * err_of(pp["vol"])))
         for fr in frep_runs:
-            if fr["res"] in base and name != "box_ball":
-                print("  per-voxel time at --res %d: %.2fx box (+) ball's" % (fr["res"], fr["wall"] / base[fr["res"]]))
+            key = (case["form"], fr["res"])
+            if key in base and name not in BASELINES.values():
+                print("  per-voxel time at --res %d: %.2fx %s's (the box (+) ball of the same form)" %
+                      (fr["res"], fr["wall"] / base[key], BASELINES[case["form"]]))
         for pp in peers:
             if not exact:
                 continue
