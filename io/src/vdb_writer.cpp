@@ -154,28 +154,29 @@ struct GridAssembly {
       pruneFinalLeaves(step);
     }
   }
-  // Leaves in nondecreasing x (the farm's slabs, a sample's sorted leaves; tiles at or past the
-  // leaves added: LevelSetBuilder::addTiles): after each call, the tree's leaves that end at or
-  // below the last leaf's x are final, and those without an active voxel are pruned at once, as
-  // pruneLevelSet will at the end (a tile of the sign of its first value; the levels above see
-  // the same tiles in finish()). Else the leaves that misaligned tiles fill in (the sampler's
-  // 8-grid is offset from OpenVDB's by the lattice's origin) lived until the end: ~0.9 GB at 1024^3.
+  // Each call's leaves at or past (in x) every earlier call's (the farm's slabs, a sample's
+  // sorted leaves; tiles at or past the leaves added: LevelSetBuilder::addTiles), so what lies
+  // before a call's leaves is final: the tiles are filled in and the leaves without an active
+  // voxel pruned there, as pruneLevelSet will at the end (a tile of the sign of its first value;
+  // the levels above see the same tiles in finish()). Else the leaves that misaligned tiles fill
+  // in (the sampler's 8-grid is offset from OpenVDB's by the lattice's origin) lived until the
+  // end: ~0.9 GB at 1024^3.
   void addLeaves(const std::vector<LeafBlock>& leaves) {
-    if (eager && !leaves.empty()) {
-      int64_t lo = INT64_MAX, end = INT64_MIN;
-      for (const LeafBlock& b : leaves) {
-        lo = std::min(lo, int64_t(b.origin[0]) + offset[0]);
-        end = std::max(end, int64_t(b.origin[0]) + offset[0] + kLeafDim);
-      }
-      fillAndPrune(lo & ~int64_t(7));  // what lies before these leaves is final
-      fillTo((end + 7) & ~int64_t(7));  // the tiles under them
+    if (!eager || leaves.empty()) {
+      for (const LeafBlock& b : leaves) addLeaf(acc, b, offset);
+      return;
     }
+    int64_t lo = INT64_MAX, last = INT64_MIN;
     for (const LeafBlock& b : leaves) {
-      if (eager && int64_t(b.origin[0]) + offset[0] < finalBelow)
-        throw std::logic_error("GridAssembly: a leaf at x " + std::to_string(b.origin[0]) + " after leaves past it");
-      addLeaf(acc, b, offset);
+      lo = std::min(lo, int64_t(b.origin[0]) + offset[0]);
+      last = std::max(last, int64_t(b.origin[0]) + offset[0]);
     }
-    if (eager && !leaves.empty()) pruneFinalLeaves(int64_t(leaves.back().origin[0]) + offset[0]);
+    if (lo < finalBelow)
+      throw std::logic_error("GridAssembly: a leaf at x " + std::to_string(lo - offset[0]) + " after leaves past it");
+    fillAndPrune(lo & ~int64_t(7));                       // what lies before these leaves is final
+    fillTo((last + kLeafDim + 7) & ~int64_t(7));          // the tiles under them
+    for (const LeafBlock& b : leaves) addLeaf(acc, b, offset);
+    pruneFinalLeaves(last);  // later calls' leaves lie at or past it
   }
   // Prunes the inactive leaves that end at or below world index x (nothing will be added there).
   void pruneFinalLeaves(int64_t x) {
