@@ -8,6 +8,9 @@ shared, so the ratios are the figures to read, not the seconds, and the CPU time
 and its workers (RUSAGE_CHILDREN) is steadier than wall time under load. Also checks that 0, 1 and 2
 workers write the same bytes.
 
+At the end, the master's peak RSS per size and its ratio to the first size's (issue 35: memory
+flat in the output size).
+
 usage: bench/bench_sample_store.py build/bin/frep [RES,RES,...] [ROUNDS]   (default 256,512 3)"""
 import json
 import os
@@ -46,6 +49,7 @@ def median(runs, key):
     return statistics.median(r[key] for r in runs)
 
 
+rss = {}  # (res, store) -> median master peak RSS (MiB), 2 workers
 with tempfile.TemporaryDirectory() as tmp:
     for res in RESES:
         configs = [("raw", 1), ("raw", 2), ("sdf", 1), ("sdf", 2)]
@@ -58,6 +62,8 @@ with tempfile.TemporaryDirectory() as tmp:
             rs = runs[(store, workers)]
             print("  --store %s, %d worker%s: %.2f s wall, %.2f s CPU (master and workers), master peak RSS %.0f MiB" %
                   (store, workers, "s" if workers > 1 else "", median(rs, "wall"), median(rs, "cpu"), median(rs, "rss")))
+        for store in ("raw", "sdf"):
+            rss[(res, store)] = median(runs[(store, 2)], "rss")
         raw2, sdf2 = median(runs[("raw", 2)], "wall"), median(runs[("sdf", 2)], "wall")
         print("  default (sdf) / raw store, 2 workers: %.2fx wall (goal <= 1.3x), %.2fx CPU; RSS %.2fx" %
               (sdf2 / raw2, median(runs[("sdf", 2)], "cpu") / median(runs[("raw", 2)], "cpu"),
@@ -72,3 +78,10 @@ with tempfile.TemporaryDirectory() as tmp:
         run(res, "sdf", 0, os.path.join(tmp, "sdf0.vdb"))
         same = [open(os.path.join(tmp, "sdf%d.vdb" % w), "rb").read() for w in (0, 1, 2)]
         print("  same bytes for 0, 1 and 2 workers: %s" % ("yes" if same[0] == same[1] == same[2] else "NO"))
+
+# Memory flat in the output size (issue 35): the master's peak RSS per size against the first
+# size's, in the same run. The output (leaves, file) grows about 4x a doubling of the resolution.
+print("master peak RSS, 2 workers (MiB; x the %d^3 figure):" % RESES[0])
+for res in RESES:
+    print("  %5d^3: " % res + ", ".join("--store %s %.0f (%.2fx)" % (store, rss[(res, store)], rss[(res, store)] / rss[(RESES[0], store)])
+                                       for store in ("raw", "sdf")))
