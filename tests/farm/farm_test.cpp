@@ -68,8 +68,9 @@ TEST(Farm, WorkerKilledMidBrickIsReplaced) {
   FarmOptions o = fast(0);
   MasterThread m(j, o);
   WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=30"});
-  WorkerProcess victim(m.endpoint(), {"FREP_TEST_SLOW_MS=400"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(700));  // victim holds a brick now
+  StartedFile victimStarted("victim");
+  WorkerProcess victim(m.endpoint(), {"FREP_TEST_SLOW_MS=400", victimStarted.env()});
+  ASSERT_TRUE(victimStarted.wait()) << "the victim never started a brick";  // it holds one now
   kill(victim.pid, SIGKILL);
   victim.wait();
   m.join();
@@ -83,19 +84,18 @@ TEST(Farm, StoppedWorkerPastLivenessThenContinuedChangesNothing) {
   JobSpec j = job(96);
   FarmOutcome ref = runJob(j, fast(0));
   FarmOptions o = fast(0);
+  LogWatch log;
   MasterThread m(j, o);
   // The sleeper starts alone and is stopped once it holds a brick (a fixed delay missed that on
   // a loaded machine); the steady worker then has to finish the job.
-  const std::string started = "/tmp/frep_farm_test_started." + std::to_string(getpid());
-  std::remove(started.c_str());
-  WorkerProcess sleeper(m.endpoint(), {"FREP_TEST_SLOW_MS=40", "FREP_TEST_STARTED_FILE=" + started});
-  for (int i = 0; i < 3000 && access(started.c_str(), F_OK) != 0; ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  ASSERT_EQ(access(started.c_str(), F_OK), 0) << "the worker never started a brick";
-  std::remove(started.c_str());
+  StartedFile started("sleeper");
+  WorkerProcess sleeper(m.endpoint(), {"FREP_TEST_SLOW_MS=40", started.env()});
+  ASSERT_TRUE(started.wait()) << "the worker never started a brick";
   kill(sleeper.pid, SIGSTOP);
   WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=40"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // > 5 x 100 ms liveness
+  // It stays stopped until the master has counted it dead (5 x 100 ms of silence), unless the
+  // job ended first.
+  waitUntil([&] { return m.finished || log.count("silent past its liveness window") > 0; });
   kill(sleeper.pid, SIGCONT);
   m.join();
   ASSERT_EQ(m.error, "");
@@ -109,8 +109,9 @@ TEST(Farm, SigtermedWorkerHandsItsBrickBack) {
   FarmOptions o = fast(0);
   MasterThread m(j, o);
   WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=30"});
-  WorkerProcess leaver(m.endpoint(), {"FREP_TEST_SLOW_MS=500"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  StartedFile leaverStarted("leaver");
+  WorkerProcess leaver(m.endpoint(), {"FREP_TEST_SLOW_MS=500", leaverStarted.env()});
+  ASSERT_TRUE(leaverStarted.wait()) << "the leaver never started a brick";  // it holds one now
   kill(leaver.pid, SIGTERM);
   EXPECT_EQ(leaver.wait(), 0);
   m.join();
@@ -191,7 +192,7 @@ TEST(Farm, AJournalRecordChangedBeforeTheMergeIsRefused) {
     in.read(reinterpret_cast<char*>(&payloadSize), sizeof payloadSize);
     return in && payloadSize >= 4 && size >= firstPayload + payloadSize;
   };
-  while (!m.finished && !firstRecordWritten()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  waitUntil([&] { return m.finished || firstRecordWritten(); }, std::chrono::seconds(60));
   kill(w.pid, SIGSTOP);  // no more bricks meanwhile, however slow this thread was
   const bool late = m.finished;
   {
@@ -223,8 +224,9 @@ TEST(Farm, StragglerBrickIsIssuedOnceMoreToAnIdleWorker) {
   MasterThread m(j, o);
   // The slow worker joins first and takes the first bricks; the fast one finishes the rest,
   // then gets a copy of the oldest brick still running (after max(1 s, 2 x median)).
-  WorkerProcess slow(m.endpoint(), {"FREP_TEST_SLOW_MS=4000"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  StartedFile slowStarted("slow");
+  WorkerProcess slow(m.endpoint(), {"FREP_TEST_SLOW_MS=4000", slowStarted.env()});
+  ASSERT_TRUE(slowStarted.wait()) << "the slow worker never started a brick";
   WorkerProcess quick(m.endpoint());
   m.join();
   ASSERT_EQ(m.error, "");

@@ -11,13 +11,18 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <future>
+#include <memory>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include <spdlog/sinks/ringbuffer_sink.h>
+#include <spdlog/spdlog.h>
 #include <zmq.hpp>
 
 #include "frep/worker/brick.h"
@@ -92,6 +97,78 @@ inline void tearJournal(const std::string& path, int records, size_t tornBytes) 
   out.write(all.data(), std::streamsize(pos + tornBytes));
 }
 
+// Polls `pred` until it holds or `timeout` has passed; returns whether it held. Tests wait for
+// the condition they need (a worker holds a brick, the master logged what it did) instead of a
+// fixed time, which is slow where the machine is fast and too short where it is loaded.
+template <class Pred>
+bool waitUntil(Pred pred, std::chrono::milliseconds timeout = std::chrono::seconds(30)) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    if (pred()) return true;
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+}
+
+// The file a frep-worker creates when it starts its first brick (env(): the worker's test hook
+// FREP_TEST_STARTED_FILE): once it exists the worker holds a brick, in its FREP_TEST_SLOW_MS
+// pause if it has one.
+struct StartedFile {
+  std::string path;
+  explicit StartedFile(const std::string& name) : path("/tmp/frep_farm_test_" + name + "." + std::to_string(getpid())) {
+    std::remove(path.c_str());
+  }
+  ~StartedFile() { std::remove(path.c_str()); }
+  std::string env() const { return "FREP_TEST_STARTED_FILE=" + path; }
+  bool wait(std::chrono::milliseconds timeout = std::chrono::seconds(30)) const {
+    return waitUntil([&] { return access(path.c_str(), F_OK) == 0; }, timeout);
+  }
+};
+
+// What the master logs from construction to destruction (it logs every peer it drops, every
+// death and departure): a test waits for the line saying the master did what the test needs.
+// Made before the master thread starts and destroyed after it ends (spdlog's sink list is not
+// guarded against concurrent logging).
+struct LogWatch {
+  std::shared_ptr<spdlog::sinks::ringbuffer_sink_mt> sink = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(4096);
+  LogWatch() { spdlog::default_logger()->sinks().push_back(sink); }
+  ~LogWatch() {
+    auto& sinks = spdlog::default_logger()->sinks();
+    sinks.erase(std::remove(sinks.begin(), sinks.end(), sink), sinks.end());
+  }
+  // Lines so far that contain `text`.
+  size_t count(const std::string& text) const {
+    size_t n = 0;
+    for (const std::string& line : sink->last_formatted()) n += line.find(text) != std::string::npos;
+    return n;
+  }
+  bool waitFor(const std::string& text, size_t n = 1,
+               std::chrono::milliseconds timeout = std::chrono::seconds(30)) const {
+    return waitUntil([&] { return count(text) >= n; }, timeout);
+  }
+};
+
+// Connections the master's side (local port of `endpoint`, tcp://127.0.0.1:PORT) still has open
+// (established, or closed by the peer and not yet by the master), from /proc/net/tcp: once a peer
+// closed its socket and this count dropped, the master's ZeroMQ has let go of the connection.
+inline int masterSideConnections(const std::string& endpoint) {
+  const unsigned port = unsigned(std::stoul(endpoint.substr(endpoint.rfind(':') + 1)));
+  int n = 0;
+  for (const char* table : {"/proc/net/tcp", "/proc/net/tcp6"}) {
+    std::ifstream in(table);
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+      std::istringstream f(line);
+      std::string slot, local, remote, state;
+      f >> slot >> local >> remote >> state;
+      const unsigned localPort = unsigned(std::stoul(local.substr(local.rfind(':') + 1), nullptr, 16));
+      if (localPort == port && (state == "01" || state == "08")) ++n;  // ESTABLISHED, CLOSE_WAIT
+    }
+  }
+  return n;
+}
+
 // A frep-worker started by the test (as a cluster's launcher would), so the test can signal it.
 struct WorkerProcess {
   pid_t pid = 0;
@@ -115,15 +192,11 @@ struct WorkerProcess {
   // The exit code (128 + signal if killed); -2 if it had to be killed after timeoutSec.
   int wait(int timeoutSec = 60) {
     int status = 0;
-    auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(timeoutSec);
-    while (waitpid(pid, &status, WNOHANG) == 0) {
-      if (std::chrono::steady_clock::now() > deadline) {
-        kill(pid, SIGKILL);
-        waitpid(pid, &status, 0);
-        pid = 0;
-        return -2;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (!waitUntil([&] { return waitpid(pid, &status, WNOHANG) != 0; }, std::chrono::seconds(timeoutSec))) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      pid = 0;
+      return -2;
     }
     pid = 0;
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

@@ -113,11 +113,13 @@ TEST(Faults, StoppedMasterDoesNotCountItsWorkersDead) {
   JobSpec j = partJob("sample", 96);  // 27 bricks
   int fds[2];
   ASSERT_EQ(pipe(fds), 0);
+  StartedFile started("stopped_master");  // a worker of the child's holds a brick
   pid_t child = fork();
   ASSERT_GE(child, 0);
   if (child == 0) {  // the master, with two local workers that take 60 ms a brick
     close(fds[0]);
     setenv("FREP_TEST_SLOW_MS", "60", 1);
+    setenv("FREP_TEST_STARTED_FILE", started.path.c_str(), 1);
     char line[256];
     try {
       FarmOutcome out = runJob(j, fast(2));
@@ -131,9 +133,11 @@ TEST(Faults, StoppedMasterDoesNotCountItsWorkersDead) {
     _exit(n > 0 ? 0 : 1);
   }
   close(fds[1]);
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // workers joined, bricks running
+  EXPECT_TRUE(started.wait());  // workers joined, bricks running
   kill(child, SIGSTOP);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // liveness window: 0.5 s
+  // The stall itself is under test: the master must stay stopped for longer than the liveness
+  // window (0.5 s), three windows as the test says; nothing to wait for but time.
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   kill(child, SIGCONT);
   std::string got;
   char buf[256];

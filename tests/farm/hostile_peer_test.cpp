@@ -110,6 +110,7 @@ uint64_t vmHwmBytes() {
 TEST(HostilePeer, ForgedResultForAnotherPeersBrickIsNotMerged) {
   JobSpec j = sphereJob();
   SampleResult ref = reference(j);
+  LogWatch log;
   MasterThread master(j, clusterOptions());
   const std::string ep = master.endpoint();
   zmq::context_t ctx(1);
@@ -120,7 +121,8 @@ TEST(HostilePeer, ForgedResultForAnotherPeersBrickIsNotMerged) {
   std::vector<Envelope> bHeld = b.collect(Envelope::kTask, 2);
   ASSERT_EQ(bHeld.size(), 2u);
   for (const Envelope& t : held) b.forgeResult(jobIdOf(j), t.task());  // a's bricks, forged by b
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const std::string foreign = "from b, which does not hold it";
+  EXPECT_TRUE(log.waitFor(foreign, 2)) << "the master never dropped b's forgeries";  // before a leaves
   a.handBackAndLeave(jobIdOf(j), held);
   b.handBackAndLeave(jobIdOf(j), bHeld);
   EXPECT_EQ(runRealWorker(ep), 0);
@@ -135,6 +137,7 @@ TEST(HostilePeer, ForgedResultForAnotherPeersBrickIsNotMerged) {
 TEST(HostilePeer, FailuresAndCorruptResultsFromNonHoldersDoNotPoison) {
   JobSpec j = sphereJob();
   SampleResult ref = reference(j);
+  LogWatch log;
   MasterThread master(j, clusterOptions());
   const std::string ep = master.endpoint();
   zmq::context_t ctx(1);
@@ -144,19 +147,22 @@ TEST(HostilePeer, FailuresAndCorruptResultsFromNonHoldersDoNotPoison) {
   ScriptedPeer b(ctx, ep, "b");
   std::vector<Envelope> bHeld = b.collect(Envelope::kTask, 2);
   ASSERT_EQ(bHeld.size(), 2u);
+  // A step that another peer's message must follow waits until the master has handled it (it
+  // logs every message it drops as foreign, and every departure).
+  const std::string foreign = "from b, which does not hold it";
   // b fails a's first brick again and again and sends corrupt results for its second; then
   // (after a handed them back) for every brick of the job, leased or pending.
   for (int k = 0; k < 5; ++k) {
     b.fail(jobIdOf(j), held[0].task().brick_id(), false);
     b.forgeResult(jobIdOf(j), held[1].task(), /*corruptCrc=*/true);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_TRUE(log.waitFor(foreign, 10));
   a.handBackAndLeave(jobIdOf(j), held);
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_TRUE(log.waitFor("worker a left"));
   for (uint64_t id = 0; id < 8; ++id)
     if (id != bHeld[0].task().brick_id() && id != bHeld[1].task().brick_id())
       for (int k = 0; k < 4; ++k) b.fail(jobIdOf(j), id, false);
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  // b's hand-back follows on the same connection, so the master handles these first.
   b.handBackAndLeave(jobIdOf(j), bHeld);
   EXPECT_EQ(runRealWorker(ep), 0);
   master.join();
@@ -173,16 +179,20 @@ TEST(HostilePeer, FailuresAndCorruptResultsFromNonHoldersDoNotPoison) {
 TEST(HostilePeer, HelloAndVanishPeersDoNotPoison) {
   JobSpec j = sphereJob();
   SampleResult ref = reference(j);
+  LogWatch log;
   MasterThread master(j, clusterOptions());
   const std::string ep = master.endpoint();
   zmq::context_t ctx(1);
   for (int k = 0; k < 6; ++k) {
+    const std::string id = "vanish-" + std::to_string(k);
     {
-      ScriptedPeer v(ctx, ep, "vanish-" + std::to_string(k));
+      ScriptedPeer v(ctx, ep, id);
       ASSERT_EQ(v.collect(Envelope::kTask, 2).size(), 2u);
       v.s.set(zmq::sockopt::linger, 0);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(450));  // past its liveness window
+    // Its death (silence past the liveness window) is what is tested: wait until the master
+    // counted it dead, before the next one says hello.
+    EXPECT_TRUE(log.waitFor("worker " + id + " silent past its liveness window"));
   }
   EXPECT_EQ(runRealWorker(ep), 0);
   master.join();
@@ -200,6 +210,7 @@ TEST(HostilePeer, HelloAndVanishPeersDoNotPoison) {
 TEST(HostilePeer, BigFramesFromUnwelcomedPeersAreDroppedWithBoundedMemory) {
   JobSpec j = sphereJob();
   SampleResult ref = reference(j);
+  LogWatch log;
   MasterThread master(j, clusterOptions());
   const std::string ep = master.endpoint();
   zmq::context_t ctx(1);
@@ -207,7 +218,7 @@ TEST(HostilePeer, BigFramesFromUnwelcomedPeersAreDroppedWithBoundedMemory) {
     ScriptedPeer big(ctx, ep, "big", /*hello=*/false);
     std::string frame(100 << 10, 'x');
     big.s.send(zmq::buffer(frame));
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    EXPECT_TRUE(log.waitFor("message from big"));  // dropped and banned before its hello
     big.sayHello("big");
     EXPECT_EQ(big.collect(Envelope::kWelcome, 1, 800).size(), 0u) << "a banned peer was welcomed";
   }
@@ -427,7 +438,7 @@ TEST(HostilePeer, APeerThatFailsEverythingIsBannedAndTheJobCompletes) {
   const std::string ep = master.endpoint();
   FailingPeer failer(ep, "failer", /*helloAgain=*/true);
   // It fails bricks before the honest worker joins: those wait for another worker.
-  for (int i = 0; i < 250 && failer.failed < 8; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  waitUntil([&] { return failer.failed >= 8; }, std::chrono::seconds(5));
   EXPECT_GE(failer.failed, 8);
   WorkerProcess honest(ep, {"FREP_TEST_SLOW_MS=20"});
   master.join();

@@ -64,8 +64,9 @@ TEST(MeshFarm, WorkerKilledMidJobChangesNothing) {
   // The steady worker keeps the queue busy past the victim's liveness window (27 x 100 ms), so
   // the victim's brick is requeued as a death, not merely copied as a straggler.
   WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=100"});
-  WorkerProcess victim(m.endpoint(), {"FREP_TEST_SLOW_MS=400"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(700));  // the victim holds a brick now
+  StartedFile victimStarted("mesh_victim");
+  WorkerProcess victim(m.endpoint(), {"FREP_TEST_SLOW_MS=400", victimStarted.env()});
+  ASSERT_TRUE(victimStarted.wait()) << "the victim never started a brick";  // it holds one now
   kill(victim.pid, SIGKILL);
   victim.wait();
   m.join();

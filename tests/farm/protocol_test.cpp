@@ -48,6 +48,7 @@ TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
   FarmOptions inProcess;
   inProcess.workers = 0;
   FarmOutcome ref = runJob(j, inProcess);
+  LogWatch log;
   MasterThread master(j, clusterOptions());
   const std::string ep = master.endpoint();
 
@@ -85,7 +86,9 @@ TEST(Protocol, RogueClientIsCountedAndTheJobCompletes) {
   std::vector<zmq::const_buffer> withPayload{zmq::buffer(bytes), zmq::str_buffer("garbage")};
   zmq::send_multipart(rogueSocket(), withPayload);
 
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // The master has handled the garbage once it logged three drops (the oversized frame may be
+  // refused by ZeroMQ itself, unlogged).
+  waitUntil([&] { return log.count("dropped a malformed message") + log.count("dropped an oversized message") >= 3; });
   EXPECT_EQ(runWorker(ep), 0);  // a real worker finishes the job
   master.join();
   const FarmOutcome& out = master.outcome;
@@ -164,7 +167,8 @@ TEST(Protocol, BrickForAPeerThatVanishedGoesBackToTheQueue) {
     zmq::socket_t x = peer("x");
     ASSERT_EQ(collect(x, Envelope::kWelcome, 1).size(), 1u);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(400));  // the master sees the disconnect
+  // The master sees the disconnect once its side of x's connection is closed (only y's is left).
+  EXPECT_TRUE(waitUntil([&] { return masterSideConnections(ep) == 1; }, std::chrono::seconds(10)));
   // "y" hands both bricks back and leaves: the master offers them to "x" first (it is idle).
   for (const Envelope& t : held) {
     Envelope f;

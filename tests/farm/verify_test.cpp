@@ -106,7 +106,7 @@ struct ForgingPeer {
     });
   }
   void waitForged(int n) {
-    for (int i = 0; i < 500 && forged < n; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    waitUntil([&] { return forged >= n; }, std::chrono::seconds(5));
   }
   ~ForgingPeer() {
     stop = true;
