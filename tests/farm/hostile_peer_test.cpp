@@ -227,10 +227,16 @@ TEST(HostilePeer, BigFramesFromUnwelcomedPeersAreDroppedWithBoundedMemory) {
   static std::string huge(64 << 20, 'h');
   const uint64_t before = vmHwmBytes();
   {
-    std::vector<zmq::socket_t> hostile;
+    // ZeroMQ refuses a frame over the limit by closing its connection: each hostile socket's
+    // monitor counts those closings, and the test waits until every frame sent was refused.
+    std::vector<zmq::socket_t> hostile, monitors;
     for (int k = 0; k < 8; ++k) {
       hostile.emplace_back(ctx, zmq::socket_type::dealer);
       hostile.back().set(zmq::sockopt::linger, 0);
+      const std::string monitor = "inproc://hostile-" + std::to_string(k);
+      ASSERT_EQ(zmq_socket_monitor(static_cast<void*>(hostile.back()), monitor.c_str(), ZMQ_EVENT_DISCONNECTED), 0);
+      monitors.emplace_back(ctx, zmq::socket_type::pair);
+      monitors.back().connect(monitor);
       hostile.back().connect(ep);
     }
     for (int round = 0; round < 2; ++round)
@@ -238,7 +244,17 @@ TEST(HostilePeer, BigFramesFromUnwelcomedPeersAreDroppedWithBoundedMemory) {
         zmq::message_t m(huge.data(), huge.size(), [](void*, void*) {}, nullptr);
         h.send(m, zmq::send_flags::dontwait);
       }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+    int refused = 0;
+    const bool allRefused = waitUntil(
+        [&] {
+          zmq::message_t event;
+          for (auto& m : monitors)
+            while (m.recv(event, zmq::recv_flags::dontwait)) refused += event.more();  // an event's first frame
+          return refused >= 2 * int(hostile.size());
+        },
+        std::chrono::seconds(20));
+    EXPECT_TRUE(allRefused) << refused << " of " << 2 * hostile.size() << " frames refused";
+    for (auto& h : hostile) zmq_socket_monitor(static_cast<void*>(h), nullptr, 0);
   }
   const uint64_t grown = vmHwmBytes() - before;
   std::printf("master peak RSS growth with 8 peers x 2 x 64 MiB frames: %.1f MiB\n", double(grown) / (1 << 20));
