@@ -321,19 +321,47 @@ TEST(MeshField, DistanceMatchesBruteForceOnRandomPoints) {
 }
 
 
-// The query prunes by the thread's previous nearest triangle (warm start) and by each triangle's
-// plane: neither may change an answer. Lattice points of a cube (many exact ties between faces,
-// edges and corners) and random points near a torus, queried in order, then shuffled, then
-// interleaved with a second mesh: value, gradient and closest-point choice bit for bit the same.
-TEST(MeshField, AnswersDoNotDependOnTheOrderOfQueries) {
+// A cube of side 2h with every face cut into n x n squares: lattice points around it are
+// equidistant from many triangles (faces, edges, corners), the hard case for tie-breaking.
+Soup finelyCutCube(double h, int n) {
+  Soup s;
+  auto face = [&](int axis, double side) {
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    std::vector<uint32_t> id;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j) {
+        double x[3];
+        x[axis] = side, x[u] = -h + 2 * h * i / n, x[v] = -h + 2 * h * j / n;
+        id.push_back(s.add(x[0], x[1], x[2]));
+      }
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const uint32_t a = id[size_t(i * (n + 1) + j)], b = id[size_t((i + 1) * (n + 1) + j)];
+        const uint32_t c = id[size_t((i + 1) * (n + 1) + j + 1)], d = id[size_t(i * (n + 1) + j + 1)];
+        if (side > 0) s.tri(a, b, c), s.tri(a, c, d);
+        else s.tri(a, c, b), s.tri(a, d, c);
+      }
+  };
+  for (int axis = 0; axis < 3; ++axis) face(axis, h), face(axis, -h);
+  return s;  // equal corners are welded by MeshField
+}
+
+// The query prunes by the thread's previous nearest triangle (warm start), by each triangle's
+// plane and by the candidate cells of a lattice: none may change an answer. Lattice points
+// around a finely cut cube (exact ties between faces, edges and corners) and random points
+// near a torus: value, gradient (so the closest point chosen among ties) bit for bit the same
+// through the cells and through the whole hierarchy, in order, shuffled, and interleaved with
+// a second mesh; and the distance of the brute force.
+TEST(MeshField, AnswersDoNotDependOnTheOrderOfQueriesOrTheCells) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> u(-1.2, 1.2);
-  const Soup cubeSoup = cube(0.5), torusSoup = torus(0.8, 0.3, 40, 24);
+  const Soup cubeSoup = finelyCutCube(0.5, 6), torusSoup = torus(0.8, 0.3, 40, 24);
   MeshField c(cubeSoup.xyz, cubeSoup.tris, "cube"), t(torusSoup.xyz, torusSoup.tris, "torus");
+  ASSERT_TRUE(c.check().closed());
   std::vector<std::array<double, 3>> pts;
-  for (int i = -6; i <= 6; ++i)
-    for (int j = -6; j <= 6; ++j)
-      for (int k = -6; k <= 6; ++k) pts.push_back({0.125 * i, 0.125 * j, 0.125 * k});
+  for (int i = -8; i <= 8; ++i)
+    for (int j = -8; j <= 8; ++j)
+      for (int k = -8; k <= 8; ++k) pts.push_back({0.125 * i, 0.125 * j, 0.125 * k});
   for (int i = 0; i < 3000; ++i) pts.push_back({u(rng), u(rng), 0.4 * u(rng)});
   struct Answer {
     double f, g[3];
@@ -343,22 +371,28 @@ TEST(MeshField, AnswersDoNotDependOnTheOrderOfQueries) {
     a.f = m.gradient(p.data(), a.g);
     return a;
   };
-  auto same = [](const Answer& a, const Answer& b) {
-    return std::memcmp(&a, &b, sizeof a) == 0;
-  };
-  std::vector<Answer> cubeFirst, torusFirst;
-  for (const auto& p : pts) cubeFirst.push_back(ask(c, p));
-  for (const auto& p : pts) torusFirst.push_back(ask(t, p));
+  auto same = [](const Answer& a, const Answer& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  std::vector<Answer> cubeCells, torusCells;
+  for (const auto& p : pts) cubeCells.push_back(ask(c, p));
+  for (const auto& p : pts) torusCells.push_back(ask(t, p));
   std::vector<size_t> order(pts.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::shuffle(order.begin(), order.end(), rng);
-  for (size_t i : order) {
-    ASSERT_TRUE(same(ask(c, pts[i]), cubeFirst[i])) << "cube point " << i;
-    ASSERT_TRUE(same(ask(t, pts[i]), torusFirst[i])) << "torus point " << i;
+  for (bool cells : {true, false}) {
+    MeshField::useCandidateCells(cells);
+    for (size_t i = 0; i < pts.size(); ++i) ASSERT_TRUE(same(ask(c, pts[i]), cubeCells[i])) << "cube point " << i;
+    for (size_t i : order) {
+      ASSERT_TRUE(same(ask(c, pts[i]), cubeCells[i])) << "cube point " << i << (cells ? " (cells)" : " (hierarchy)");
+      ASSERT_TRUE(same(ask(t, pts[i]), torusCells[i])) << "torus point " << i << (cells ? " (cells)" : " (hierarchy)");
+    }
   }
-  for (size_t i = 0; i < pts.size(); i += 97)  // and against the brute force
-    ASSERT_NEAR(std::fabs(torusFirst[i].f), bruteDist3D(torusSoup, pts[i].data()), 1e-12);
+  MeshField::useCandidateCells(true);
+  for (size_t i = 0; i < pts.size(); i += 7) {
+    ASSERT_NEAR(std::fabs(cubeCells[i].f), bruteDist3D(cubeSoup, pts[i].data()), 1e-12);
+    ASSERT_NEAR(std::fabs(torusCells[i].f), bruteDist3D(torusSoup, pts[i].data()), 1e-12);
+  }
 }
+
 TEST(MeshField, SignMatchesWindingNumberOnVertexRaysAndEdgeLines) {
   std::mt19937 rng(13);
   for (const Soup& s : {cube(0.5), torus(0.8, 0.3, 24, 16), starPrism()}) {

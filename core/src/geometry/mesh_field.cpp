@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <unordered_map>
 #include <stdexcept>
 
 #include "frep/geometry/distance_fields.h"
@@ -159,6 +160,14 @@ MeshField::MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::s
     for (int k = 0; k < 3; ++k) pl[k] = faceN_[3 * t + k];  // zero for a degenerate triangle
     pl[3] = dot(pl, &corners_[9 * slot]);
   }
+  // The candidate lattice: 128 cells along the mesh's longest extent, from its box's corner
+  // less a margin of 32 cells (queries come from around the mesh too).
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = 0; i < xyz_.size(); ++i) lo[i % 3] = std::min(lo[i % 3], xyz_[i]), hi[i % 3] = std::max(hi[i % 3], xyz_[i]);
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
+  cellSize_ = extent / 128;
+  scale_ = std::max({std::abs(lo[0]), std::abs(lo[1]), std::abs(lo[2]), std::abs(hi[0]), std::abs(hi[1]), std::abs(hi[2]), extent});
+  for (int k = 0; k < 3; ++k) cellOrigin_[k] = lo[k] - 32 * cellSize_;
   uint64_t h = 0xcbf29ce484222325ULL;
   for (double d : xyz_) {
     uint64_t b;
@@ -206,53 +215,167 @@ void MeshField::orientConsistently() {
   }
 }
 
-// The nearest triangle of this thread's previous query on the same mesh (queries come in
-// nearby runs: a brick's points, a triangle's error samples), keyed by the field's id.
+// Nearest-triangle queries. The answer is canonical: the least squared distance as computed by
+// triangleDist2, and among triangles at exactly that distance the one of the lowest slot. So
+// every way of finding it below (a warm start, the plane test, a cell's candidates, the whole
+// hierarchy) gives the same triangle, whatever the order of queries or the thread.
 namespace {
+// This thread's previous nearest triangle on a mesh (queries come in nearby runs: a brick's
+// points, a triangle's error samples), keyed by the field's id (an address may be reused).
 struct WarmTriangle {
   uint64_t field = 0;
   uint32_t slot = 0;
 };
 thread_local WarmTriangle tWarm;
 std::atomic<uint64_t> gNextMeshFieldId{1};
+
+// Candidate triangles of the cells of a lattice over the mesh, built as queries reach them (per
+// thread: no locks, and the answers do not depend on which cells exist).
+struct CellCache {
+  uint64_t field = 0;
+  std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> cells;  // key -> (first, count)
+  std::vector<uint32_t> slots;                                        // ascending per cell
+};
+constexpr uint32_t kNoCandidates = UINT32_MAX;  // a cell with too many: the hierarchy answers
+constexpr uint32_t kMaxCandidates = 48;
+constexpr size_t kCacheSlots = 1u << 23;  // 32 MB of candidates per thread and mesh, then cleared
+constexpr int kCachedFields = 4;
+thread_local CellCache tCells[kCachedFields];
+std::atomic<bool> gCandidateCells{true};
+thread_local int tCellsNext = 0;
+
+CellCache& cacheOf(uint64_t field) {
+  for (CellCache& c : tCells)
+    if (c.field == field) return c;
+  CellCache& c = tCells[tCellsNext];
+  tCellsNext = (tCellsNext + 1) % kCachedFields;
+  c.field = field;
+  c.cells.clear();
+  c.slots.clear();
+  return c;
+}
+
 }  // namespace
 
+// The best so far, by the canonical order; `found` false: only triangles below best2 count.
+struct MeshField::Nearest {
+  double best2;
+  uint32_t slot = UINT32_MAX;
+  int region = 0;
+  double q[3] = {0, 0, 0};
+  bool found = false;
+};
+
 uint64_t MeshField::newId() { return gNextMeshFieldId++; }
+void MeshField::useCandidateCells(bool on) { gCandidateCells = on; }
+
+// Offers triangle `slot` to n: skipped when its plane is farther than the best (the slack, for
+// the plane's rounding, keeps every triangle that could tie), else measured.
+inline void MeshField::offer(const double* p, uint32_t slot, Nearest& n) const {
+  const double* pl = &slotPlanes_[4 * size_t(slot)];
+  const double slack = 1e-13 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) + std::abs(pl[3]));
+  const double h = std::abs(dot(pl, p) - pl[3]) - slack;
+  if (h > 0 && h * h > n.best2 * (1 + 1e-9)) return;
+  double qq[3];
+  int region;
+  const double* c = &corners_[9 * size_t(slot)];
+  const double d2 = triangleDist2(p, c, c + 3, c + 6, qq, region);
+  const bool better = n.found ? d2 < n.best2 || (d2 == n.best2 && slot < n.slot)
+                              : d2 < n.best2 || n.best2 == std::numeric_limits<double>::infinity();
+  if (!better) return;
+  n.best2 = d2, n.slot = slot, n.region = region, n.found = true;
+  n.q[0] = qq[0], n.q[1] = qq[1], n.q[2] = qq[2];
+}
+
+// The whole hierarchy: every leaf within the best distance so far (inclusive: ties are seen).
+void MeshField::searchAll(const double* p, Nearest& n) const {
+  bvh_.nearAll(p, [&](uint32_t slot, uint32_t) { offer(p, slot, n); }, n.best2);
+}
+
+// The candidates of the lattice cell holding p: every triangle that can be nearest to some
+// point of the cell. With c the cell's centre and T_c its nearest triangle, any point of the
+// cell is within U = |c - T_c| + half the cell's diagonal of T_c, so a triangle farther than U
+// from the whole cell (by its box or its plane) is never nearest there, nor tied. Nothing when
+// p is outside the lattice or the cell has too many candidates.
+const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count) const {
+  int64_t ijk[3];
+  for (int k = 0; k < 3; ++k) {
+    const double u = std::floor((p[k] - cellOrigin_[k]) / cellSize_);
+    if (!(u >= 0 && u < double(1 << 20))) return nullptr;
+    ijk[k] = int64_t(u);
+  }
+  const uint64_t key = uint64_t(ijk[0]) | uint64_t(ijk[1]) << 20 | uint64_t(ijk[2]) << 40;
+  CellCache& cache = cacheOf(id_);
+  auto it = cache.cells.find(key);
+  if (it == cache.cells.end()) {
+    if (cache.slots.size() > kCacheSlots) cache.cells.clear(), cache.slots.clear();
+    Bvh::Box box;
+    double centre[3];
+    for (int k = 0; k < 3; ++k) {
+      box.lo[k] = cellOrigin_[k] + double(ijk[k]) * cellSize_;
+      box.hi[k] = cellOrigin_[k] + double(ijk[k] + 1) * cellSize_;
+      centre[k] = 0.5 * (box.lo[k] + box.hi[k]);
+    }
+    Nearest c{std::numeric_limits<double>::infinity()};
+    searchAll(centre, c);
+    const double halfDiag = 0.5 * std::sqrt(3.0) * cellSize_;
+    const double reach = (std::sqrt(c.best2) + halfDiag) * (1 + 1e-9) + 1e-12 * scale_;
+    const uint32_t first = uint32_t(cache.slots.size());
+    uint32_t count = 0;
+    bvh_.nearBox(box, reach, [&](uint32_t slot, uint32_t) {
+      if (count > kMaxCandidates) return;
+      const double* v = &corners_[9 * size_t(slot)];
+      double gap2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double lo = std::min({v[k], v[3 + k], v[6 + k]}), hi = std::max({v[k], v[3 + k], v[6 + k]});
+        const double d = std::max({0.0, lo - box.hi[k], box.lo[k] - hi});
+        gap2 += d * d;
+      }
+      if (gap2 > reach * reach) return;
+      const double* pl = &slotPlanes_[4 * size_t(slot)];
+      const double spread = 0.5 * cellSize_ * (std::abs(pl[0]) + std::abs(pl[1]) + std::abs(pl[2]));
+      if (std::abs(dot(pl, centre) - pl[3]) - spread > reach) return;
+      cache.slots.push_back(slot);
+      ++count;
+    });
+    if (count > kMaxCandidates) {
+      cache.slots.resize(first);
+      it = cache.cells.emplace(key, std::make_pair(first, kNoCandidates)).first;
+    } else {
+      std::sort(cache.slots.begin() + first, cache.slots.end());
+      it = cache.cells.emplace(key, std::make_pair(first, count)).first;
+    }
+  }
+  if (it->second.second == kNoCandidates) return nullptr;
+  count = it->second.second;
+  return cache.slots.data() + it->second.first;
+}
 
 int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, double& best2, double start2) const {
-  double bq[3] = {0, 0, 0};
-  best2 = start2;
-  bestRegion = 0;
-  // Warm start: the previous nearest triangle's distance (a little above, so that triangle
-  // itself still counts) bounds the search. Only boxes and triangles that could not hold the
-  // nearest one are pruned by it, in the same near-first order, so the triangle found and its
-  // ties are those of a cold search.
-  if (tWarm.field == id_) {
-    double qq[3];
-    int region;
-    const double* c = &corners_[9 * size_t(tWarm.slot)];
-    best2 = std::min(best2, triangleDist2(p, c, c + 3, c + 6, qq, region) * (1 + 2e-9) + 1e-300);
+  Nearest n{start2};
+  const size_t nt = tris_.size() / 3;
+  uint32_t count = 0;
+  const uint32_t* cands = nullptr;
+  if (nt <= 16) {  // a few triangles: all of them, no hierarchy
+    for (uint32_t slot = 0; slot < nt; ++slot) offer(p, slot, n);
+  } else if (gCandidateCells.load(std::memory_order_relaxed) && (cands = cellCandidates(p, count))) {
+    for (uint32_t i = 0; i < count; ++i) offer(p, cands[i], n);
+  } else {
+    // Warm start: the previous nearest triangle's distance, a little above so that it and its
+    // ties still count, bounds the search.
+    if (tWarm.field == id_) {
+      double qq[3];
+      int region;
+      const double* c = &corners_[9 * size_t(tWarm.slot)];
+      n.best2 = std::min(n.best2, triangleDist2(p, c, c + 3, c + 6, qq, region) * (1 + 2e-9) + 1e-300);
+    }
+    searchAll(p, n);
+    if (n.found) tWarm = {id_, n.slot};
   }
-  uint32_t bestSlot = 0;
-  const int64_t t = bvh_.nearest(p, [&](uint32_t slot, uint32_t, double cur) {
-    // The distance to the triangle's plane is a lower bound: a triangle whose plane is
-    // farther than the best so far cannot win. The slack (absolute, for the plane's rounding,
-    // and relative) keeps the nearest triangle and its ties those of the full test.
-    const double* pl = &slotPlanes_[4 * size_t(slot)];
-    const double slack = 1e-13 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) + std::abs(pl[3]));
-    const double h = std::abs(dot(pl, p) - pl[3]) - slack;
-    if (h > 0 && h * h > cur * (1 + 1e-9)) return std::numeric_limits<double>::infinity();
-    double qq[3];
-    int region;
-    const double* c = &corners_[9 * size_t(slot)];
-    const double d2 = triangleDist2(p, c, c + 3, c + 6, qq, region);
-    if (d2 < cur || cur == std::numeric_limits<double>::infinity())
-      bq[0] = qq[0], bq[1] = qq[1], bq[2] = qq[2], bestRegion = region, bestSlot = slot;
-    return d2;
-  }, best2);
-  if (t >= 0) tWarm = {id_, bestSlot};
-  if (q) q[0] = bq[0], q[1] = bq[1], q[2] = bq[2];
-  return t;
+  best2 = n.best2;
+  bestRegion = n.region;
+  if (q) q[0] = n.q[0], q[1] = n.q[1], q[2] = n.q[2];
+  return n.found ? int64_t(bvh_.order()[n.slot]) : -1;
 }
 
 double MeshField::signedDistance(const double* p, double* q) const {

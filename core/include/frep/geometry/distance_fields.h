@@ -13,6 +13,7 @@
 // (DistanceField::bound, geometry/field.h).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -36,6 +37,13 @@ class Bvh {
   // only primitives nearer than it count); returns the nearest primitive (or -1 if none).
   template <typename F>
   int64_t nearest(const double* p, F&& dist2, double& best2) const;
+  // Calls visit(slot, i) for the primitives of every leaf whose box is within sqrt(bound2) of p
+  // (inclusive: equal-distance primitives are all seen), near-first; visit may lower bound2.
+  template <typename F>
+  void nearAll(const double* p, F&& visit, double& bound2) const;
+  // Calls visit(slot, i) for the primitives of every leaf whose box is within `gap` of box q.
+  template <typename F>
+  void nearBox(const Box& q, double gap, F&& visit) const;
   // Calls visit(i) for every primitive whose box contains p.
   template <typename F>
   void containing(const double* p, F&& visit) const;
@@ -128,6 +136,9 @@ class MeshField : public DistanceField {
   Interval bound(const Interval box[3]) const override;
   double windingNumber(const double* p) const;                   // exact sum, O(n)
   double volume() const;                                          // divergence theorem
+  // Tests: answer every query through the whole hierarchy (false) or through the lattice's
+  // candidate cells where they apply (true, the default). The answers are the same.
+  static void useCandidateCells(bool on);
   // A mesh made from a model (a sampled operand): its distance from the model's surface.
   void setSetErrorBound(double e) { setError_ = e; }
   double setErrorBound() const override { return setError_; }
@@ -139,8 +150,13 @@ class MeshField : public DistanceField {
   std::vector<uint32_t> triEdge_;              // 3 edge ids per triangle (edge k: v[k]-v[k+1])
   std::vector<double> corners_;                // 9 coordinates per triangle, in bvh_.order()
   std::vector<double> slotPlanes_;             // unit normal and offset per triangle, same order
-  uint64_t id_ = newId();                      // the warm start's key (an address may be reused)
+  uint64_t id_ = newId();                      // per-thread caches' key (an address may be reused)
+  double cellSize_ = 0, cellOrigin_[3] = {0, 0, 0}, scale_ = 1;  // the candidate lattice
   static uint64_t newId();
+  struct Nearest;  // mesh_field.cpp
+  void offer(const double* p, uint32_t slot, Nearest& n) const;
+  void searchAll(const double* p, Nearest& n) const;
+  const uint32_t* cellCandidates(const double* p, uint32_t& count) const;
   double setError_ = 0;
   Bvh bvh_;
   MeshCheck check_;
@@ -233,6 +249,61 @@ int64_t Bvh::nearest(const double* p, F&& dist2, double& best2) const {
     }
   }
   return best;
+}
+
+template <typename F>
+void Bvh::nearAll(const double* p, F&& visit, double& bound2) const {
+  if (nodes_.empty()) return;
+  struct Entry {
+    uint32_t node;
+    double gap2;
+  };
+  Entry stack[128];
+  int sp = 0;
+  stack[sp++] = {0, boxDist2(nodes_[0].box, p)};
+  while (sp > 0) {
+    const Entry e = stack[--sp];
+    if (e.gap2 > bound2) continue;
+    const NodeB& n = nodes_[e.node];
+    if (n.count > 0) {
+      for (uint32_t k = n.first; k < n.first + n.count; ++k) visit(k, order_[k]);
+      continue;
+    }
+    const double dl = boxDist2(nodes_[n.left].box, p), dr = boxDist2(nodes_[n.right].box, p);
+    if (dl <= dr) {
+      stack[sp++] = {n.right, dr};
+      stack[sp++] = {n.left, dl};
+    } else {
+      stack[sp++] = {n.left, dl};
+      stack[sp++] = {n.right, dr};
+    }
+  }
+}
+
+template <typename F>
+void Bvh::nearBox(const Box& q, double gap, F&& visit) const {
+  if (nodes_.empty()) return;
+  auto within = [&](const Box& b) {
+    double s = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = std::max({0.0, b.lo[k] - q.hi[k], q.lo[k] - b.hi[k]});
+      s += d * d;
+    }
+    return s <= gap * gap;
+  };
+  uint32_t stack[128];
+  int sp = 0;
+  stack[sp++] = 0;
+  while (sp > 0) {
+    const NodeB& n = nodes_[stack[--sp]];
+    if (!within(n.box)) continue;
+    if (n.count > 0) {
+      for (uint32_t k = n.first; k < n.first + n.count; ++k) visit(k, order_[k]);
+      continue;
+    }
+    stack[sp++] = n.left;
+    stack[sp++] = n.right;
+  }
 }
 
 template <typename F>
