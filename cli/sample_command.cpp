@@ -99,12 +99,14 @@ int runSample(const SampleRequest& request) {
   // streamed is dropped with the builder). With --verify, a worker convicted of forging after its
   // bricks were streamed restarts the stream (a new builder; the master merges from the journal).
   std::optional<io::LevelSetBuilder> builder;
-  builder.emplace(farm::gridOf(job), request.band);  // the lattice the master merges on
+  // raw and sdf write the leaves' values as they are: the finished leaves go to a temporary file.
+  const bool spill = request.store == "raw" || request.store == "sdf";
+  builder.emplace(farm::gridOf(job), request.band, spill);  // the lattice the master merges on
   options.sampleSink.tiles = [&](const std::vector<Tile>& tiles) { builder->addTiles(tiles); };
   options.sampleSink.leaves = [&](const std::vector<LeafBlock>& slab) { builder->addLeaves(slab); };
   options.sampleSink.restart = [&] {
     builder.reset();  // its memory first
-    builder.emplace(farm::gridOf(job), request.band);
+    builder.emplace(farm::gridOf(job), request.band, spill);
   };
   jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);

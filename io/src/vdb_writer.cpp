@@ -4,14 +4,22 @@
 #include "frep/sampling/band_distance.h"
 
 #include <openvdb/openvdb.h>
+#include <openvdb/io/Compression.h>
+#include <openvdb/io/DelayedLoadMetadata.h>
 #include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/Prune.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <map>
+#include <sstream>
 #include <stdexcept>
 
 #include "frep/io/error.h"
@@ -66,6 +74,41 @@ struct FileArchive : openvdb::io::Archive {
   void writeTo(std::ostream& os, const openvdb::GridCPtrVec& grids) const {
     write(os, grids, /*seekable=*/true);  // a failed write: writeSealedVdb names its error
   }
+  // What write() writes for one grid, for a grid whose leaves were written out (SpillingGrid):
+  // its metadata as it is (the statistics and file_delayed_load already in it: the archive
+  // would compute them from the leaves' values), then its transform, topology and buffers.
+  void writeWithoutValues(std::ostream& os, const openvdb::GridBase& grid) const {
+    namespace io = openvdb::io;
+    io::StreamMetadata::Ptr file = std::make_shared<io::StreamMetadata>();
+    io::setStreamMetadataPtr(os, file, /*transfer=*/false);
+    io::setDataCompression(os, compression());
+    io::setWriteGridStatsMetadata(os, false);
+    writeHeader(os, /*seekable=*/true);
+    openvdb::MetaMap().writeMeta(os);
+    const int32_t grids = 1;
+    os.write(reinterpret_cast<const char*>(&grids), sizeof grids);
+    const std::string name = grid.getName().empty() ? io::GridDescriptor::addSuffix("", 0) : grid.getName();
+    io::GridDescriptor gd(name, grid.type(), grid.saveFloatAsHalf());
+    io::StreamMetadata::Ptr perGrid = std::make_shared<io::StreamMetadata>(*file);
+    perGrid->setHalfFloat(grid.saveFloatAsHalf());
+    perGrid->gridMetadata() = static_cast<const openvdb::MetaMap&>(grid);
+    io::setStreamMetadataPtr(os, perGrid, /*transfer=*/false);
+    gd.writeHeader(os);
+    const int64_t offsets = int64_t(os.tellp());
+    gd.writeStreamPos(os);
+    gd.setGridPos(os.tellp());
+    setGridCompression(os, grid);
+    grid.writeMeta(os);
+    grid.writeTransform(os);
+    grid.writeTopology(os);
+    gd.setBlockPos(os.tellp());
+    grid.writeBuffers(os);
+    gd.setEndPos(os.tellp());
+    os.seekp(offsets, std::ios_base::beg);
+    gd.writeStreamPos(os);
+    gd.seekToEnd(os);
+    io::setStreamMetadataPtr(os, file, /*transfer=*/false);
+  }
 };
 
 std::string hex(uint64_t v) {
@@ -73,6 +116,83 @@ std::string hex(uint64_t v) {
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
   return buf;
 }
+
+// The leaves of a grid written out as they become final (LevelSetBuilder with spillLeaves): each
+// one's bytes as LeafNode::writeBuffers gives them, in a temporary file (tmpfile(): unlinked,
+// in /tmp) in the order they finish, and in the tree a leaf with its value mask only (no
+// values: ~100 bytes instead of ~2.2 KB). SpillingGrid writes the file's buffers section in the
+// tree's order from it: the same bytes as the leaves held whole.
+struct LeafSpill {
+  std::FILE* file = nullptr;
+  uint64_t size = 0;
+  // A leaf's place in the file, and what the archive's delayed-load metadata says of it.
+  struct Record {
+    uint64_t offset;
+    uint32_t bytes;
+    int8_t mask;
+    int64_t compressed;
+  };
+  std::map<std::array<int32_t, 3>, Record> at;  // by origin
+  uint32_t compression = 0;  // the stream's, as Archive::setGridCompression sets it for a level set
+  openvdb::io::StreamMetadata::Ptr streamMeta = std::make_shared<openvdb::io::StreamMetadata>();
+  float background;
+  explicit LeafSpill(float bg) : file(std::tmpfile()), background(bg) {
+    if (!file) throw ioError(std::string("cannot create a temporary file for the finished leaves: ") + std::strerror(errno));
+    compression = openvdb::io::Archive::hasBloscCompression() ? openvdb::io::COMPRESS_BLOSC : openvdb::io::COMPRESS_NONE;
+  }
+  ~LeafSpill() { std::fclose(file); }
+  LeafSpill(const LeafSpill&) = delete;
+  LeafSpill& operator=(const LeafSpill&) = delete;
+  void put(const openvdb::FloatTree::LeafNodeType& leaf) {
+    std::ostringstream os(std::ios_base::out | std::ios_base::binary);
+    openvdb::io::setStreamMetadataPtr(os, streamMeta, /*transfer=*/false);
+    openvdb::io::setDataCompression(os, compression);
+    leaf.writeBuffers(os, /*toHalf=*/false);
+    const std::string bytes = os.str();
+    if (std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size())
+      throw ioError(std::string("cannot write the finished leaves' temporary file: ") + std::strerror(errno));
+    const openvdb::Coord o = leaf.origin();
+    const auto [mask, compressed] = delayedLoadEntry(leaf, background, compression);
+    at[{o.x(), o.y(), o.z()}] = {size, uint32_t(bytes.size()), mask, compressed};
+    size += bytes.size();
+  }
+  // What OpenVDB 10's archive records of a leaf in the grid's file_delayed_load metadata: the
+  // mask compression's verdict and the size of the values' block (checked against its files).
+  static std::pair<int8_t, int64_t> delayedLoadEntry(const openvdb::FloatTree::LeafNodeType& leaf, float background,
+                                                     uint32_t compression) {
+    using Mask = openvdb::FloatTree::LeafNodeType::NodeMaskType;
+    const float* values = leaf.buffer().data();
+    const openvdb::io::MaskCompress<float, Mask> verdict(leaf.valueMask(), Mask(), values, background);
+    const size_t bytes = openvdb::io::writeCompressedValuesSize(values, leaf.SIZE, leaf.valueMask(),
+                                                                uint8_t(verdict.metadata), false, compression);
+    return {verdict.metadata, int64_t(bytes) + int64_t(sizeof(int64_t))};  // and the block's size field
+  }
+  void copy(const openvdb::Coord& o, std::ostream& os, std::vector<char>& buffer) const {
+    const Record& r = at.at({o.x(), o.y(), o.z()});
+    const uint64_t offset = r.offset;
+    const uint32_t bytes = r.bytes;
+    buffer.resize(bytes);
+    if (std::fflush(file) != 0 || ::pread(::fileno(file), buffer.data(), bytes, off_t(offset)) != ssize_t(bytes))
+      throw openvdb::IoError(std::string("cannot read back a finished leaf: ") + std::strerror(errno ? errno : EIO));
+    os.write(buffer.data(), std::streamsize(bytes));
+  }
+};
+
+struct SpillingGrid final : openvdb::FloatGrid {
+  explicit SpillingGrid(float background) : openvdb::FloatGrid(background) {}
+  std::shared_ptr<LeafSpill> spill;
+  // Tree::writeBuffers' order (the root's table, then each node's children in offset order).
+  void writeBuffers(std::ostream& os) const override {
+    if (!spill || spill->at.empty()) return openvdb::FloatGrid::writeBuffers(os);
+    std::vector<char> buffer;
+    for (auto upper = tree().root().cbeginChildOn(); upper; ++upper)
+      for (auto lower = upper->cbeginChildOn(); lower; ++lower)
+        for (auto leaf = lower->cbeginChildOn(); leaf; ++leaf) {
+          if (leaf->isAllocated()) leaf->writeBuffers(os, /*toHalf=*/false);
+          else spill->copy(leaf->origin(), os, buffer);
+        }
+  }
+};
 
 // The level set grid as the sampler's output comes in: tiles first, then leaves, then finished
 // (pruned to the canonical tree, transform and class set). levelSetGrid and LevelSetBuilder.
@@ -85,6 +205,7 @@ struct GridAssembly {
   openvdb::FloatGrid::Ptr grid;
   openvdb::FloatGrid::Accessor acc;
   bool eager = true;  // prune final leaves as they come (addLeaves)
+  std::shared_ptr<LeafSpill> spill;  // and write the others out (LevelSetBuilder's spillLeaves)
   int64_t finalBelow = INT64_MIN;  // world x below which every leaf was pruned if inactive
   int64_t filledBelow = INT64_MIN;  // world x below which every tile added is filled in
   std::vector<std::pair<openvdb::CoordBBox, float>> pending;  // the rest of the tiles, in order
@@ -94,7 +215,7 @@ struct GridAssembly {
         background(float(band * lattice.voxel)),
         extent{(lattice.dims[0] + 7) & ~7, (lattice.dims[1] + 7) & ~7, (lattice.dims[2] + 7) & ~7},
         offset(latticeOffset(lattice)),
-        grid((openvdb::initialize(), openvdb::FloatGrid::create(background))),
+        grid((openvdb::initialize(), std::make_shared<SpillingGrid>(background))),
         acc(grid->getAccessor()) {}
   // Eager, a tile is filled in only up to the x the leaves have reached (fillTo), the rest as
   // the leaves come: a large tile's misaligned faces would otherwise fill dense leaves along its
@@ -188,14 +309,23 @@ struct GridAssembly {
         const int64_t lo = lower->origin().x();
         if (lo >= x || lo + lower->DIM <= finalBelow) continue;  // none of its leaves newly final
         for (auto leaf = lower->beginChildOn(); leaf; ++leaf) {
-          if (int64_t(leaf->origin().x()) + leaf->DIM > x || !leaf->isInactive()) continue;
-          lower->addTile(leaf.pos(), openvdb::math::isNegative(leaf->getFirstValue()) ? -background : background, false);
+          if (int64_t(leaf->origin().x()) + leaf->DIM > x) continue;
+          if (leaf->isInactive()) {
+            lower->addTile(leaf.pos(), openvdb::math::isNegative(leaf->getFirstValue()) ? -background : background,
+                           false);
+          } else if (spill && leaf->isAllocated()) {
+            spill->put(*leaf);
+            auto* stub = new openvdb::FloatTree::LeafNodeType(openvdb::PartialCreate(), leaf->origin(), 0.0f, false);
+            stub->setValueMask(leaf->getValueMask());
+            lower->addLeaf(stub);  // deletes the leaf
+          }
         }
       }
     }
     finalBelow = x;
   }
   openvdb::FloatGrid::Ptr finish() {
+    static_cast<SpillingGrid&>(*grid).spill = spill;
     if (eager) {
       int64_t end = INT64_MIN;
       for (const auto& p : pending) end = std::max(end, int64_t(p.first.max().x()) + 1);
@@ -276,6 +406,10 @@ namespace {
 // metadata, the checksum, then every byte written and checked.
 void writeGrid(const std::string& path, openvdb::FloatGrid::Ptr grid, const GridSpec& g, int bandVoxels,
                const VdbMetadata& meta) {
+  const auto* spilling = dynamic_cast<const SpillingGrid*>(grid.get());
+  const LeafSpill* spill = spilling && spilling->spill && !spilling->spill->at.empty() ? spilling->spill.get() : nullptr;
+  if (spill && (meta.store == VdbStore::Fog || (meta.store == VdbStore::Sdf && !meta.distanceValues)))
+    throw std::logic_error("writeGrid: the leaves went to a file; the grid can be written only as stored");
   if (meta.store != VdbStore::Raw && !meta.distanceValues) grid = signedDistanceGrid(*grid, bandVoxels);
   if (meta.store == VdbStore::Fog) openvdb::tools::sdfToFogVolume(*grid);  // class fog volume
   const float background = float(bandVoxels * g.voxel);
@@ -319,9 +453,40 @@ void writeGrid(const std::string& path, openvdb::FloatGrid::Ptr grid, const Grid
     if (openvdb::io::Archive::hasBloscCompression()) compression |= openvdb::io::COMPRESS_BLOSC;
     else compression |= openvdb::io::COMPRESS_ZIP;
     archive.setCompression(compression);
+    if (spill) {
+      // The statistics the archive adds, taken here: the leaves written out hold no values, so
+      // memUsage() misses SIZE floats for each (the tree held whole would count them).
+      archive.setGridStatsMetadataEnabled(false);
+      grid->addStatsMetadata();
+      const int64_t values = int64_t(openvdb::FloatTree::LeafNodeType::SIZE * sizeof(float));
+      const int64_t memory = int64_t(grid->memUsage()) + values * int64_t(spill->at.size());
+      grid->removeMeta(openvdb::GridBase::META_FILE_MEM_BYTES);
+      grid->insertMeta(openvdb::GridBase::META_FILE_MEM_BYTES, openvdb::Int64Metadata(memory));
+      grid->insertMeta(openvdb::GridBase::META_FILE_COMPRESSION,
+                       openvdb::StringMetadata(openvdb::io::compressionToString(spill->compression)));
+      // The delayed-load metadata too: the archive would read every leaf's values for it.
+      openvdb::io::DelayedLoadMetadata delayed;
+      const size_t leaves = size_t(grid->tree().leafCount());
+      delayed.resizeMask(leaves);
+      delayed.resizeCompressedSize(leaves);
+      size_t i = 0;
+      for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf, ++i) {
+        const openvdb::Coord o = leaf->origin();
+        const auto [mask, compressed] = leaf->isAllocated()
+                                            ? LeafSpill::delayedLoadEntry(*leaf, background, spill->compression)
+                                            : std::pair<int8_t, int64_t>{spill->at.at({o.x(), o.y(), o.z()}).mask,
+                                                                         spill->at.at({o.x(), o.y(), o.z()}).compressed};
+        delayed.setMask(i, mask);
+        delayed.setCompressedSize(i, compressed);
+      }
+      grid->insertMeta(openvdb::GridBase::META_FILE_DELAYED_LOAD, delayed);
+    }
     // Straight to the file and sealed there: the serialised grid (62 MB at 1024^3) is not held
     // in memory on top of the tree.
-    detail::writeSealedVdb(path, [&](std::ostream& os) { archive.writeTo(os, openvdb::GridCPtrVec{grid}); });
+    detail::writeSealedVdb(path, [&](std::ostream& os) {
+      if (spill) archive.writeWithoutValues(os, *grid);
+      else archive.writeTo(os, openvdb::GridCPtrVec{grid});
+    });
   } catch (const openvdb::Exception& e) {
     throw ioError("cannot write VDB '" + path + "': " + e.what());
   }
@@ -333,10 +498,14 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
   writeGrid(path, levelSetGrid(result), result.grid, result.bandVoxels, meta);
 }
 
-LevelSetBuilder::LevelSetBuilder(const GridSpec& grid, int bandVoxels)
-    : tree_(std::make_unique<Tree>(grid, bandVoxels)) {}
+LevelSetBuilder::LevelSetBuilder(const GridSpec& grid, int bandVoxels, bool spillLeaves)
+    : tree_(std::make_unique<Tree>(grid, bandVoxels)) {
+  if (spillLeaves) tree_->spill = std::make_shared<LeafSpill>(tree_->background);
+}
 
 LevelSetBuilder::~LevelSetBuilder() = default;
+
+uint64_t LevelSetBuilder::leavesWrittenOut() const { return tree_ && tree_->spill ? tree_->spill->at.size() : 0; }
 
 void LevelSetBuilder::addTiles(const std::vector<Tile>& tiles) {
   if (!tree_) throw std::logic_error("LevelSetBuilder: tiles after write");

@@ -185,3 +185,57 @@ TEST(VdbLevelSetBuilder, LeavesBelowLeavesAlreadyPrunedAreRefused) {
   ASSERT_GT(s.leaves.back().origin[0] - s.leaves.front().origin[0], 16);
   EXPECT_THROW(b.addLeaves(std::vector<LeafBlock>(s.leaves.begin(), s.leaves.begin() + 1)), std::logic_error);
 }
+
+// spillLeaves: the finished leaves go to a temporary file as they come and the tree keeps their
+// masks; the same bytes as the tree held whole, raw and sdf (the values as stored).
+TEST(VdbLevelSetBuilder, LeavesWrittenOutAsTheyComeChangeNoByte) {
+  Expr X = Expr::x(0), Y = Expr::x(1), Z = Expr::x(2);
+  Expr block = min(min(0.7 - abs(X), 0.6 - abs(Y)), 0.5 - abs(Z));
+  Expr ball = 0.45 - sqrt(square(X - 0.3) + square(Y - 0.2) + square(Z - 0.4));
+  const TapePtr tape = Tape::compile(min(block, -ball), 3);
+  for (const std::array<double, 3>& lo : {std::array<double, 3>{-1.03, -0.97, -1.1}, {-1, -1, -1}}) {
+    const SampleResult s = sample(tape, io::worldLatticeGrid("test", lo, {1.1, 1.0, 1.05}, 2.0 / 95));
+    for (io::VdbStore store : {io::VdbStore::Sdf, io::VdbStore::Raw}) {
+      SCOPED_TRACE(io::storeName(store));
+      io::VdbMetadata meta;
+      meta.gridName = "bitten";
+      meta.store = store;
+      meta.distanceValues = store == io::VdbStore::Sdf;
+      const std::string whole = emptyFile("whole.vdb"), spilled = emptyFile("spilled.vdb");
+      io::writeLevelSet(whole, s, meta);
+      io::LevelSetBuilder b(s.grid, s.bandVoxels, /*spillLeaves=*/true);
+      for (int x0 = 0; x0 < s.grid.dims[0]; x0 += 16) {
+        std::vector<Tile> tiles;
+        std::vector<LeafBlock> leaves;
+        for (const Tile& t : s.tiles)
+          if (t.origin[0] >= x0 && t.origin[0] < x0 + 16) tiles.push_back(t);
+        for (const LeafBlock& l : s.leaves)
+          if (l.origin[0] >= x0 && l.origin[0] < x0 + 16) leaves.push_back(l);
+        b.addTiles(tiles);
+        b.addLeaves(leaves);
+      }
+      EXPECT_GT(b.leavesWrittenOut(), 100u);  // the tree kept their masks only
+      b.write(spilled, meta);
+      const std::string want = readAll(whole), got = readAll(spilled);
+      EXPECT_GT(want.size(), 10000u);
+      EXPECT_EQ(got.size(), want.size());
+      EXPECT_TRUE(want == got) << "the file with the leaves written out differs";
+      for (const std::string& p : {whole, spilled}) std::remove(p.c_str());
+    }
+  }
+}
+
+TEST(VdbLevelSetBuilder, LeavesWrittenOutAreWrittenOnlyAsStored) {
+  SampleResult s = bittenBlock();
+  for (bool exact : {false, true}) {
+    io::LevelSetBuilder b(s.grid, s.bandVoxels, /*spillLeaves=*/true);
+    b.addTiles(s.tiles);
+    b.addLeaves(s.leaves);
+    io::VdbMetadata meta;
+    meta.store = exact ? io::VdbStore::Sdf : io::VdbStore::Fog;  // sdf-exact or fog: values changed
+    meta.distanceValues = !exact;
+    const std::string path = emptyFile("refused.vdb");
+    EXPECT_THROW(b.write(path, meta), std::logic_error);
+    std::remove(path.c_str());
+  }
+}

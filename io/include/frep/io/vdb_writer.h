@@ -53,7 +53,12 @@ void writeLevelSet(const std::string& path, const SampleResult& result, const Vd
 // file is written in place, not built in memory first.
 class LevelSetBuilder {
  public:
-  LevelSetBuilder(const GridSpec& grid, int bandVoxels);
+  // spillLeaves: the final leaves that stay in the output are written out as they come too, to
+  // an unlinked temporary file (tmpfile(), in /tmp), and the tree keeps their value masks only
+  // (~0.1 KB a leaf instead of ~2.2 KB): the memory no longer grows with the output's leaves.
+  // write() then takes only the stores that write the values as they are (raw, and sdf with
+  // distanceValues), else std::logic_error; the bytes are the same.
+  LevelSetBuilder(const GridSpec& grid, int bandVoxels, bool spillLeaves = false);
   ~LevelSetBuilder();
   LevelSetBuilder(const LevelSetBuilder&) = delete;
   LevelSetBuilder& operator=(const LevelSetBuilder&) = delete;
@@ -63,6 +68,7 @@ class LevelSetBuilder {
   // A leaf below (in x) a leaf of an earlier call is std::logic_error (its place was pruned).
   void addLeaves(const std::vector<LeafBlock>& leaves);
   uint64_t leaves() const { return leaves_; }  // added so far
+  uint64_t leavesWrittenOut() const;           // spillLeaves: the tree's leaves in the temporary file so far
   // Once, at the end; throws Error(kExitIoError) as writeLevelSet does.
   void write(const std::string& path, const VdbMetadata& meta);
 
