@@ -387,6 +387,13 @@ TEST(MeshField, AnswersDoNotDependOnTheOrderOfQueriesOrTheCells) {
     }
   }
   MeshField::useCandidateCells(true);
+  // classValue: the class of its cell where no triangle meets the cell, else the value.
+  for (size_t i = 0; i < pts.size(); ++i)
+    for (const MeshField* m : {&c, &t}) {
+      const double f = m->value(pts[i].data()), k = m->classValue(pts[i].data());
+      ASSERT_EQ(f > 0, k > 0) << m->describe() << " point " << i;
+      ASSERT_EQ(f < 0, k < 0) << m->describe() << " point " << i;
+    }
   for (size_t i = 0; i < pts.size(); i += 7) {
     ASSERT_NEAR(std::fabs(cubeCells[i].f), bruteDist3D(cubeSoup, pts[i].data()), 1e-12);
     ASSERT_NEAR(std::fabs(torusCells[i].f), bruteDist3D(torusSoup, pts[i].data()), 1e-12);

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 #include <map>
-#include <unordered_map>
 #include <stdexcept>
 
 #include "frep/geometry/distance_fields.h"
@@ -160,14 +159,13 @@ MeshField::MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::s
     for (int k = 0; k < 3; ++k) pl[k] = faceN_[3 * t + k];  // zero for a degenerate triangle
     pl[3] = dot(pl, &corners_[9 * slot]);
   }
-  // The candidate lattice: 128 cells along the mesh's longest extent, from its box's corner
-  // less a margin of 32 cells (queries come from around the mesh too).
+  // The candidate lattice: 128 cells along the mesh's longest extent, and a margin of 32 cells
+  // (queries come from around the mesh too).
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (size_t i = 0; i < xyz_.size(); ++i) lo[i % 3] = std::min(lo[i % 3], xyz_[i]), hi[i % 3] = std::max(hi[i % 3], xyz_[i]);
-  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
-  cellSize_ = extent / 128;
-  scale_ = std::max({std::abs(lo[0]), std::abs(lo[1]), std::abs(lo[2]), std::abs(hi[0]), std::abs(hi[1]), std::abs(hi[2]), extent});
-  for (int k = 0; k < 3; ++k) cellOrigin_[k] = lo[k] - 32 * cellSize_;
+  lattice_ = CellLattice::over(lo, hi, 128, 32);
+  scale_ = std::max({std::abs(lo[0]), std::abs(lo[1]), std::abs(lo[2]), std::abs(hi[0]), std::abs(hi[1]), std::abs(hi[2]),
+                     hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
   uint64_t h = 0xcbf29ce484222325ULL;
   for (double d : xyz_) {
     uint64_t b;
@@ -227,34 +225,8 @@ struct WarmTriangle {
   uint32_t slot = 0;
 };
 thread_local WarmTriangle tWarm;
-std::atomic<uint64_t> gNextMeshFieldId{1};
-
-// Candidate triangles of the cells of a lattice over the mesh, built as queries reach them (per
-// thread: no locks, and the answers do not depend on which cells exist).
-struct CellCache {
-  uint64_t field = 0;
-  std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> cells;  // key -> (first, count)
-  std::vector<uint32_t> slots;                                        // ascending per cell
-};
-constexpr uint32_t kNoCandidates = UINT32_MAX;  // a cell with too many: the hierarchy answers
-constexpr uint32_t kMaxCandidates = 48;
-constexpr size_t kCacheSlots = 1u << 23;  // 32 MB of candidates per thread and mesh, then cleared
-constexpr int kCachedFields = 4;
-thread_local CellCache tCells[kCachedFields];
 std::atomic<bool> gCandidateCells{true};
-thread_local int tCellsNext = 0;
-
-CellCache& cacheOf(uint64_t field) {
-  for (CellCache& c : tCells)
-    if (c.field == field) return c;
-  CellCache& c = tCells[tCellsNext];
-  tCellsNext = (tCellsNext + 1) % kCachedFields;
-  c.field = field;
-  c.cells.clear();
-  c.slots.clear();
-  return c;
-}
-
+constexpr uint32_t kMaxCandidates = 48;
 }  // namespace
 
 // The best so far, by the canonical order; `found` false: only triangles below best2 count.
@@ -266,7 +238,6 @@ struct MeshField::Nearest {
   bool found = false;
 };
 
-uint64_t MeshField::newId() { return gNextMeshFieldId++; }
 void MeshField::useCandidateCells(bool on) { gCandidateCells = on; }
 
 // Offers triangle `slot` to n: skipped when its plane is farther than the best (the slack, for
@@ -298,32 +269,25 @@ void MeshField::searchAll(const double* p, Nearest& n) const {
 // from the whole cell (by its box or its plane) is never nearest there, nor tied. Nothing when
 // p is outside the lattice or the cell has too many candidates.
 const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count) const {
+  uint64_t key;
   int64_t ijk[3];
-  for (int k = 0; k < 3; ++k) {
-    const double u = std::floor((p[k] - cellOrigin_[k]) / cellSize_);
-    if (!(u >= 0 && u < double(1 << 20))) return nullptr;
-    ijk[k] = int64_t(u);
-  }
-  const uint64_t key = uint64_t(ijk[0]) | uint64_t(ijk[1]) << 20 | uint64_t(ijk[2]) << 40;
-  CellCache& cache = cacheOf(id_);
-  auto it = cache.cells.find(key);
-  if (it == cache.cells.end()) {
-    if (cache.slots.size() > kCacheSlots) cache.cells.clear(), cache.slots.clear();
+  if (!lattice_.cellOf(p, key, ijk)) return nullptr;
+  return CellLists::get(id_, key, count, [&](std::vector<uint32_t>& out) {
     Bvh::Box box;
+    lattice_.cellBox(ijk, box.lo, box.hi);
+    const double cellSize = lattice_.size;
     double centre[3];
-    for (int k = 0; k < 3; ++k) {
-      box.lo[k] = cellOrigin_[k] + double(ijk[k]) * cellSize_;
-      box.hi[k] = cellOrigin_[k] + double(ijk[k] + 1) * cellSize_;
-      centre[k] = 0.5 * (box.lo[k] + box.hi[k]);
-    }
+    for (int k = 0; k < 3; ++k) centre[k] = 0.5 * (box.lo[k] + box.hi[k]);
     Nearest c{std::numeric_limits<double>::infinity()};
     searchAll(centre, c);
-    const double halfDiag = 0.5 * std::sqrt(3.0) * cellSize_;
+    // A cell far from the mesh (its reach a sphere over many triangles) is left to the
+    // hierarchy: only cells within a few of their sizes of the surface are worth a list.
+    if (c.best2 > 16 * cellSize * cellSize) return false;
+    const double halfDiag = 0.5 * std::sqrt(3.0) * cellSize;
     const double reach = (std::sqrt(c.best2) + halfDiag) * (1 + 1e-9) + 1e-12 * scale_;
-    const uint32_t first = uint32_t(cache.slots.size());
-    uint32_t count = 0;
+    const size_t first = out.size();
+    bool fits = true;
     bvh_.nearBox(box, reach, [&](uint32_t slot, uint32_t) {
-      if (count > kMaxCandidates) return;
       const double* v = &corners_[9 * size_t(slot)];
       double gap2 = 0;
       for (int k = 0; k < 3; ++k) {
@@ -331,24 +295,17 @@ const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count) cons
         const double d = std::max({0.0, lo - box.hi[k], box.lo[k] - hi});
         gap2 += d * d;
       }
-      if (gap2 > reach * reach) return;
+      if (gap2 > reach * reach) return true;
       const double* pl = &slotPlanes_[4 * size_t(slot)];
-      const double spread = 0.5 * cellSize_ * (std::abs(pl[0]) + std::abs(pl[1]) + std::abs(pl[2]));
-      if (std::abs(dot(pl, centre) - pl[3]) - spread > reach) return;
-      cache.slots.push_back(slot);
-      ++count;
+      const double spread = 0.5 * cellSize * (std::abs(pl[0]) + std::abs(pl[1]) + std::abs(pl[2]));
+      if (std::abs(dot(pl, centre) - pl[3]) - spread > reach) return true;
+      out.push_back(slot);
+      fits = out.size() - first <= kMaxCandidates;
+      return fits;  // too many: the hierarchy answers here
     });
-    if (count > kMaxCandidates) {
-      cache.slots.resize(first);
-      it = cache.cells.emplace(key, std::make_pair(first, kNoCandidates)).first;
-    } else {
-      std::sort(cache.slots.begin() + first, cache.slots.end());
-      it = cache.cells.emplace(key, std::make_pair(first, count)).first;
-    }
-  }
-  if (it->second.second == kNoCandidates) return nullptr;
-  count = it->second.second;
-  return cache.slots.data() + it->second.first;
+    std::sort(out.begin() + long(first), out.end());
+    return fits;
+  });
 }
 
 int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, double& best2, double start2) const {
@@ -401,6 +358,24 @@ double MeshField::signedDistance(const double* p, double* q) const {
 }
 
 double MeshField::value(const double* p) const { return signedDistance(p, nullptr); }
+
+double MeshField::classValue(const double* p) const {
+  uint64_t key;
+  int64_t ijk[3];
+  if (!check_.closed() || !lattice_.cellOf(p, key, ijk)) return value(p);
+  uint32_t count = 0;
+  const uint32_t* cls = CellLists::get(classId_, key, count, [&](std::vector<uint32_t>& out) {
+    Bvh::Box box;
+    lattice_.cellBox(ijk, box.lo, box.hi);
+    if (!(bvh_.boxGap(box) > 0.0)) return false;  // a triangle may cross the cell
+    // No triangle meets the (closed) cell: f has one sign in it, that of its centre.
+    const double c[3] = {0.5 * (box.lo[0] + box.hi[0]), 0.5 * (box.lo[1] + box.hi[1]), 0.5 * (box.lo[2] + box.hi[2])};
+    out.push_back(value(c) > 0 ? 1u : 0u);
+    return true;
+  });
+  if (!cls) return value(p);
+  return cls[0] ? lattice_.size : -lattice_.size;
+}
 
 Interval MeshField::bound(const Interval box[3]) const {
   const Interval lip = DistanceField::bound(box);

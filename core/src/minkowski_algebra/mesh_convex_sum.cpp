@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "frep/geometry/cell_lists.h"
 #include "frep/geometry/distance_fields.h"
 #include "frep/minkowski_algebra/convex_polytope.h"
 #include "frep/minkowski_algebra/registry.h"
@@ -261,6 +262,13 @@ class MeshConvexSumField : public DistanceField {
       boxes.push_back(box);
     }
     cellBvh_.build(boxes);
+    // Lists for a lattice of 128 cells along the boxes' longest side: a point's query then
+    // tests one short list instead of walking the many overlapping boxes of the hierarchy.
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (const Bvh::Box& x : boxes)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], x.lo[k]), hi[k] = std::max(hi[k], x.hi[k]);
+    lattice_ = CellLattice::over(lo, hi, 128, 0);
+    cellBoxes_ = std::move(boxes);
     convolutionPieces(a, b, bDirs, tol, tri);
     pruneInterior(soup, soupTris, tol);
     pieces_ = soupTris.size() / 3;
@@ -309,7 +317,7 @@ class MeshConvexSumField : public DistanceField {
   std::string name_;
   V3 b0_{};
   double memoRadius_ = 0;
-  uint64_t id_ = nextFieldId();  // the memo's key: an address may be reused by another field
+  uint64_t id_ = CellLists::newOwner();  // the memo's and lists' key (an address may be reused)
   struct SignMemo {
     uint64_t owner;
     double x[3];
@@ -318,16 +326,14 @@ class MeshConvexSumField : public DistanceField {
   static constexpr int kSignMemos = 4;
   static thread_local SignMemo tSignMemo[kSignMemos];
   static thread_local int tSignMemoNext;
-  static uint64_t nextFieldId() {
-    static std::atomic<uint64_t> next{1};
-    return next++;
-  }
   std::vector<std::array<double, 4>> planes_;  // u . x <= h
   struct Cell {
     uint32_t first, count;
   };
   std::vector<Cell> cells_;
+  std::vector<Bvh::Box> cellBoxes_;
   Bvh cellBvh_;
+  CellLattice lattice_;  // of the lists of cells whose boxes meet a lattice cell
   std::shared_ptr<const MeshField> soup_;
   size_t pieces_ = 0;
   uint64_t hash_ = 0;
@@ -469,7 +475,7 @@ class MeshConvexSumField : public DistanceField {
   // which reads as outside except on a piece (-0, inside), where either class is right. A point
   // in no cell within memoRadius_ of one classified before has its class (see the constructor).
   double sumClass(const double* p) const {
-    const double g = cellsValue(p);
+    const double g = cellsValue(p, true);
     if (g >= 0) return g;
     if (memoRadius_ > 0)
       for (SignMemo& m : tSignMemo) {
@@ -477,7 +483,7 @@ class MeshConvexSumField : public DistanceField {
         const double dx = p[0] - m.x[0], dy = p[1] - m.x[1], dz = p[2] - m.x[2];
         if (dx * dx + dy * dy + dz * dz < memoRadius_ * memoRadius_) return m.inside ? memoRadius_ : -INFINITY;
       }
-    const double inA = translateValue(p);
+    const double inA = translateValue(p, true);
     if (std::isnan(inA)) return sumField(p, nullptr);
     if (memoRadius_ > 0) {
       tSignMemo[tSignMemoNext] = {id_, {p[0], p[1], p[2]}, inA >= 0};
@@ -492,23 +498,65 @@ class MeshConvexSumField : public DistanceField {
     return g >= 0 ? g : translateValue(p);
   }
   // f_A(p - b0), negated for the complement: the translate A + b0's field.
-  double translateValue(const double* p) const {
+  // classOnly: a value of the same sign (MeshField::classValue) will do.
+  double translateValue(const double* p, bool classOnly = false) const {
     const double shifted[3] = {p[0] - b0_[0], p[1] - b0_[1], p[2] - b0_[2]};
-    return complement_ ? -a_->value(shifted) : a_->value(shifted);
+    const double f = classOnly ? a_->classValue(shifted) : a_->value(shifted);
+    return complement_ ? -f : f;
   }
-  // max_T c_T(p) over the cells whose box holds p (-inf: none).
-  double cellsValue(const double* p) const {
+  // max_T c_T(p) over the cells whose box holds p (-inf: none). firstInside: any c_T >= 0 will
+  // do (the class is all that is asked), so the first cell holding p ends the search.
+  double cellsValue(const double* p, bool firstInside = false) const {
     double g = -INFINITY;
-    cellBvh_.containing(p, [&](uint32_t i) {
+    // A cell's planes stop as soon as its c_T cannot raise g (or, for the class, is negative).
+    const double floor = firstInside ? 0.0 : -INFINITY;
+    auto visit = [&](uint32_t i) {
       const Cell& c = cells_[i];
       double m = INFINITY;
-      for (uint32_t k = c.first; k < c.first + c.count && m > g; ++k) {
+      const double stop = std::max(g, floor);
+      for (uint32_t k = c.first; k < c.first + c.count && m >= stop && (m > g || firstInside); ++k) {
         const auto& u = planes_[k];
         m = std::min(m, u[3] - (u[0] * p[0] + u[1] * p[1] + u[2] * p[2]));
       }
-      g = std::max(g, m);
-    });
+      if (m >= floor) g = std::max(g, m);
+      return !(firstInside && g >= 0);
+    };
+    uint32_t count = 0;
+    const uint32_t* list = cellsNear(p, count);
+    if (!list) {
+      cellBvh_.containing(p, visit);
+      return g;
+    }
+    // The list holds every cell whose box meets p's lattice cell; the same boxes as the
+    // hierarchy's test (closed) pick those that hold p, so g is the same max.
+    for (uint32_t j = 0; j < count; ++j) {
+      const Bvh::Box& b = cellBoxes_[list[j]];
+      if (p[0] < b.lo[0] || p[0] > b.hi[0] || p[1] < b.lo[1] || p[1] > b.hi[1] || p[2] < b.lo[2] || p[2] > b.hi[2])
+        continue;
+      if (!visit(list[j])) break;
+    }
     return g;
+  }
+  // The cells whose boxes meet the lattice cell holding p (at most 512), or nothing.
+  const uint32_t* cellsNear(const double* p, uint32_t& count) const {
+    uint64_t key;
+    int64_t ijk[3];
+    if (!lattice_.cellOf(p, key, ijk)) return nullptr;
+    return CellLists::get(id_, key, count, [&](std::vector<uint32_t>& out) {
+      Bvh::Box q;
+      lattice_.cellBox(ijk, q.lo, q.hi);
+      const size_t first = out.size();
+      bool fits = true;
+      cellBvh_.nearBox(q, 0.0, [&](uint32_t, uint32_t i) {
+        const Bvh::Box& b = cellBoxes_[i];
+        for (int k = 0; k < 3; ++k)
+          if (b.lo[k] > q.hi[k] || b.hi[k] < q.lo[k]) return true;
+        out.push_back(i);
+        fits = out.size() - first <= 512;
+        return fits;
+      });
+      return fits;
+    });
   }
   bool sameGeometry(const DistanceField& o) const override {
     const auto& m = static_cast<const MeshConvexSumField&>(o);

@@ -21,6 +21,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "frep/geometry/cell_lists.h"
 #include "frep/geometry/field.h"
 
 namespace frep {
@@ -41,10 +42,11 @@ class Bvh {
   // (inclusive: equal-distance primitives are all seen), near-first; visit may lower bound2.
   template <typename F>
   void nearAll(const double* p, F&& visit, double& bound2) const;
-  // Calls visit(slot, i) for the primitives of every leaf whose box is within `gap` of box q.
+  // Calls visit(slot, i) for the primitives of every leaf whose box is within `gap` of box q
+  // (a visit returning false stops).
   template <typename F>
   void nearBox(const Box& q, double gap, F&& visit) const;
-  // Calls visit(i) for every primitive whose box contains p.
+  // Calls visit(i) for every primitive whose box contains p (a visit returning false stops).
   template <typename F>
   void containing(const double* p, F&& visit) const;
   size_t numNodes() const { return nodes_.size(); }
@@ -114,6 +116,10 @@ class MeshField : public DistanceField {
   // mesh or an index out of range.
   MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::string name);
   double value(const double p[3]) const override;
+  // A value with value(p)'s sign (0 only where value is 0): on a closed mesh, in a lattice cell
+  // that no triangle meets, the class of the cell's centre (one query a cell and thread), else
+  // value(p). For callers that ask only inside or outside.
+  double classValue(const double p[3]) const;
   double gradient(const double p[3], double g[3]) const override;
   uint64_t contentHash() const override { return hash_; }
   std::string describe() const override { return name_; }
@@ -150,9 +156,10 @@ class MeshField : public DistanceField {
   std::vector<uint32_t> triEdge_;              // 3 edge ids per triangle (edge k: v[k]-v[k+1])
   std::vector<double> corners_;                // 9 coordinates per triangle, in bvh_.order()
   std::vector<double> slotPlanes_;             // unit normal and offset per triangle, same order
-  uint64_t id_ = newId();                      // per-thread caches' key (an address may be reused)
-  double cellSize_ = 0, cellOrigin_[3] = {0, 0, 0}, scale_ = 1;  // the candidate lattice
-  static uint64_t newId();
+  uint64_t id_ = CellLists::newOwner();        // per-thread caches' key (an address may be reused)
+  uint64_t classId_ = CellLists::newOwner();   // the lists of classValue's cells
+  CellLattice lattice_;                        // of the candidate cells
+  double scale_ = 1;                           // the largest coordinate or extent
   struct Nearest;  // mesh_field.cpp
   void offer(const double* p, uint32_t slot, Nearest& n) const;
   void searchAll(const double* p, Nearest& n) const;
@@ -298,7 +305,13 @@ void Bvh::nearBox(const Box& q, double gap, F&& visit) const {
     const NodeB& n = nodes_[stack[--sp]];
     if (!within(n.box)) continue;
     if (n.count > 0) {
-      for (uint32_t k = n.first; k < n.first + n.count; ++k) visit(k, order_[k]);
+      for (uint32_t k = n.first; k < n.first + n.count; ++k) {
+        if constexpr (std::is_same_v<std::invoke_result_t<F, uint32_t, uint32_t>, bool>) {
+          if (!visit(k, order_[k])) return;
+        } else {
+          visit(k, order_[k]);
+        }
+      }
       continue;
     }
     stack[sp++] = n.left;
@@ -316,7 +329,13 @@ void Bvh::containing(const double* p, F&& visit) const {
     const NodeB& n = nodes_[stack[--sp]];
     if (boxDist2(n.box, p) > 0.0) continue;
     if (n.count > 0) {
-      for (uint32_t k = n.first; k < n.first + n.count; ++k) visit(order_[k]);
+      for (uint32_t k = n.first; k < n.first + n.count; ++k) {
+        if constexpr (std::is_same_v<std::invoke_result_t<F, uint32_t>, bool>) {
+          if (!visit(order_[k])) return;  // the visitor has its answer
+        } else {
+          visit(order_[k]);
+        }
+      }
       continue;
     }
     stack[sp++] = n.left;

@@ -1,0 +1,55 @@
+// Per-thread candidate lists of lattice cells (cell_lists.h).
+#include "frep/geometry/cell_lists.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+namespace frep {
+
+CellLattice CellLattice::over(const double lo[3], const double hi[3], int cells, int margin) {
+  CellLattice l;
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
+  l.size = extent / cells;
+  for (int k = 0; k < 3; ++k) l.origin[k] = lo[k] - margin * l.size;
+  return l;
+}
+
+bool CellLattice::cellOf(const double* p, uint64_t& key, int64_t ijk[3]) const {
+  for (int k = 0; k < 3; ++k) {
+    const double u = std::floor((p[k] - origin[k]) / size);
+    if (!(u >= 0 && u < double(1 << 20))) return false;
+    ijk[k] = int64_t(u);
+  }
+  key = uint64_t(ijk[0]) | uint64_t(ijk[1]) << 20 | uint64_t(ijk[2]) << 40;
+  return true;
+}
+
+void CellLattice::cellBox(const int64_t ijk[3], double lo[3], double hi[3]) const {
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = origin[k] + double(ijk[k]) * size;
+    hi[k] = origin[k] + double(ijk[k] + 1) * size;
+  }
+}
+
+uint64_t CellLists::newOwner() {
+  static std::atomic<uint64_t> next{1};
+  return next++;
+}
+
+// A few owners a thread (a model may hold several meshes), replaced round robin.
+CellLists::Lists& CellLists::listsOf(uint64_t owner) {
+  constexpr int kOwners = 4;
+  thread_local Lists lists[kOwners];
+  thread_local int next = 0;
+  for (Lists& l : lists)
+    if (l.owner == owner) return l;
+  Lists& l = lists[next];
+  next = (next + 1) % kOwners;
+  l.owner = owner;
+  l.cells.clear();
+  l.items.clear();
+  return l;
+}
+
+}  // namespace frep
