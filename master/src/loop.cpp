@@ -280,8 +280,10 @@ bool Master::adoptReconnected(const std::string& workerId, const std::string& ri
 }
 
 // A peer that sent garbage: a welcomed one is told bye and its bricks go back to the queue,
-// not charged; its routing id is ignored from now on (bounded list, oldest forgotten).
-void Master::ban(zmq::socket_t& router, const std::string& rid, const std::string& why) {
+// not charged; its routing id is ignored from now on (bounded list, oldest forgotten). `rid` is
+// a copy: banWorker passes the key of the peer entry that leases_.drop erases (a use after free
+// that TSan found, HostilePeer.APeerThatFailsEverythingIsBannedAndTheJobCompletes).
+void Master::ban(zmq::socket_t& router, std::string rid, const std::string& why) {
   if (peers().count(rid)) {
     Envelope bye;
     bye.set_job_id(jobId_);

@@ -198,7 +198,8 @@ class Master {
 
   bool adoptReconnected(const std::string& workerId, const std::string& rid, const Hello& hello);
 
-  void ban(zmq::socket_t& router, const std::string& rid, const std::string& why);
+  // `rid` by value: it may be the key of the peer entry that ban erases (banWorker).
+  void ban(zmq::socket_t& router, std::string rid, const std::string& why);
 
   size_t payloadLimit() const { return payloadLimit_; }
   Clock::duration liveWindow() const { return std::chrono::milliseconds(opt_.heartbeatMs * opt_.liveness); }
