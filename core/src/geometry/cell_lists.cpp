@@ -11,13 +11,14 @@ CellLattice CellLattice::over(const double lo[3], const double hi[3], int cells,
   CellLattice l;
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-300});
   l.size = extent / cells;
+  l.inverse = 1 / l.size;
   for (int k = 0; k < 3; ++k) l.origin[k] = lo[k] - margin * l.size;
   return l;
 }
 
 bool CellLattice::cellOf(const double* p, uint64_t& key, int64_t ijk[3]) const {
   for (int k = 0; k < 3; ++k) {
-    const double u = std::floor((p[k] - origin[k]) / size);
+    const double u = std::floor((p[k] - origin[k]) * inverse);
     if (!(u >= 0 && u < double(1 << 20))) return false;
     ijk[k] = int64_t(u);
   }
@@ -49,6 +50,7 @@ CellLists::Lists& CellLists::listsOf(uint64_t owner) {
   l.owner = owner;
   l.cells.clear();
   l.items.clear();
+  l.hasLast = false;
   return l;
 }
 

@@ -367,7 +367,8 @@ double MeshField::classValue(const double* p) const {
   const uint32_t* cls = CellLists::get(classId_, key, count, [&](std::vector<uint32_t>& out) {
     Bvh::Box box;
     lattice_.cellBox(ijk, box.lo, box.hi);
-    if (!(bvh_.boxGap(box) > 0.0)) return false;  // a triangle may cross the cell
+    // (a margin: a point may be placed in the cell from a few ulps outside)
+    if (!(bvh_.boxGap(box) > 1e-9 * lattice_.size)) return false;  // a triangle may cross the cell
     // No triangle meets the (closed) cell: f has one sign in it, that of its centre.
     const double c[3] = {0.5 * (box.lo[0] + box.hi[0]), 0.5 * (box.lo[1] + box.hi[1]), 0.5 * (box.lo[2] + box.hi[2])};
     out.push_back(value(c) > 0 ? 1u : 0u);

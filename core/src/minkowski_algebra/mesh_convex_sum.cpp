@@ -547,10 +547,12 @@ class MeshConvexSumField : public DistanceField {
       lattice_.cellBox(ijk, q.lo, q.hi);
       const size_t first = out.size();
       bool fits = true;
-      cellBvh_.nearBox(q, 0.0, [&](uint32_t, uint32_t i) {
+      // A little beyond the cell: a point may be placed in it from a few ulps outside.
+      const double eps = 1e-9 * lattice_.size;
+      cellBvh_.nearBox(q, eps, [&](uint32_t, uint32_t i) {
         const Bvh::Box& b = cellBoxes_[i];
         for (int k = 0; k < 3; ++k)
-          if (b.lo[k] > q.hi[k] || b.hi[k] < q.lo[k]) return true;
+          if (b.lo[k] > q.hi[k] + eps || b.hi[k] < q.lo[k] - eps) return true;
         out.push_back(i);
         fits = out.size() - first <= 512;
         return fits;

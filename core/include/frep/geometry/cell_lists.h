@@ -13,10 +13,12 @@
 
 namespace frep {
 
-// A cubic lattice: cell (i, j, k) is [origin + (i, j, k) size, origin + (i + 1, j + 1, k + 1) size).
+// A cubic lattice: cell (i, j, k) is [origin + (i, j, k) size, origin + (i + 1, j + 1, k + 1) size)
+// up to rounding (a point may be placed in a neighbour within a few ulps: users give their
+// lists that much slack).
 struct CellLattice {
   double origin[3] = {0, 0, 0};
-  double size = 1;
+  double size = 1, inverse = 1;  // inverse = 1 / size
   // The lattice over a box [lo, hi]: `cells` along its longest side, `margin` cells around it.
   static CellLattice over(const double lo[3], const double hi[3], int cells, int margin);
   // The key of the cell holding p and its indices; false outside 2^20 cells a side.
@@ -34,17 +36,20 @@ class CellLists {
   template <typename Build>
   static const uint32_t* get(uint64_t owner, uint64_t key, uint32_t& count, Build&& build) {
     Lists& l = listsOf(owner);
-    auto it = l.cells.find(key);
-    if (it == l.cells.end()) {
-      if (l.items.size() > kMaxItems) l.cells.clear(), l.items.clear();
-      const uint32_t first = uint32_t(l.items.size());
-      const bool has = build(l.items);
-      if (!has) l.items.resize(first);
-      it = l.cells.emplace(key, std::make_pair(first, has ? uint32_t(l.items.size() - first) : kNone)).first;
+    if (!(l.hasLast && l.lastKey == key)) {  // runs of queries stay in one cell
+      auto it = l.cells.find(key);
+      if (it == l.cells.end()) {
+        if (l.items.size() > kMaxItems) l.cells.clear(), l.items.clear();
+        const uint32_t first = uint32_t(l.items.size());
+        const bool has = build(l.items);
+        if (!has) l.items.resize(first);
+        it = l.cells.emplace(key, std::make_pair(first, has ? uint32_t(l.items.size() - first) : kNone)).first;
+      }
+      l.hasLast = true, l.lastKey = key, l.last = it->second;
     }
-    if (it->second.second == kNone) return nullptr;
-    count = it->second.second;
-    return l.items.data() + it->second.first;
+    if (l.last.second == kNone) return nullptr;
+    count = l.last.second;
+    return l.items.data() + l.last.first;
   }
 
  private:
@@ -53,6 +58,9 @@ class CellLists {
     uint64_t owner = 0;
     std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> cells;  // key -> (first, count)
     std::vector<uint32_t> items;
+    bool hasLast = false;  // the last cell asked for
+    uint64_t lastKey = 0;
+    std::pair<uint32_t, uint32_t> last;
   };
   static Lists& listsOf(uint64_t owner);
 };
