@@ -214,47 +214,23 @@ inline double Bvh::boxDist2(const Box& b, const double* p) {
   return s;
 }
 
+// The first primitive in near-first order that reaches the least distance: a later one
+// replaces it only when strictly nearer, so visiting the tied boxes nearAll includes changes
+// nothing.
 template <typename F>
 int64_t Bvh::nearest(const double* p, F&& dist2, double& best2) const {
   int64_t best = -1;
-  if (nodes_.empty()) return best;
-  // Each entry keeps its box's squared gap, computed once when its parent was opened (the
-  // same value and the same near-first order as computing it again when popped).
-  struct Entry {
-    uint32_t node;
-    double gap2;
-  };
-  Entry stack[128];
-  int sp = 0;
-  stack[sp++] = {0, boxDist2(nodes_[0].box, p)};
-  while (sp > 0) {
-    const Entry e = stack[--sp];
-    if (e.gap2 > best2 || (e.gap2 == best2 && best >= 0)) continue;  // a tie cannot be nearer
-    const NodeB& n = nodes_[e.node];
-    if (n.count > 0) {
-      for (uint32_t k = n.first; k < n.first + n.count; ++k) {
-        // The callback may take the leaf slot too (primitives stored in slot order).
-        double d;
-        if constexpr (std::is_invocable_v<F, uint32_t, uint32_t, double>)
-          d = dist2(k, order_[k], best2);
-        else
-          d = dist2(order_[k], best2);
-        if (d < best2 || (best < 0 && best2 == INFINITY)) {
-          best2 = d;
-          best = order_[k];
-        }
-      }
-      continue;
+  nearAll(p, [&](uint32_t slot, uint32_t id) {
+    double d;
+    if constexpr (std::is_invocable_v<F, uint32_t, uint32_t, double>)
+      d = dist2(slot, id, best2);
+    else
+      d = dist2(id, best2);
+    if (d < best2 || (best < 0 && best2 == INFINITY)) {
+      best2 = d;
+      best = id;
     }
-    const double dl = boxDist2(nodes_[n.left].box, p), dr = boxDist2(nodes_[n.right].box, p);
-    if (dl <= dr) {
-      stack[sp++] = {n.right, dr};
-      stack[sp++] = {n.left, dl};
-    } else {
-      stack[sp++] = {n.left, dl};
-      stack[sp++] = {n.right, dr};
-    }
-  }
+  }, best2);
   return best;
 }
 
