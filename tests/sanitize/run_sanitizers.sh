@@ -49,14 +49,14 @@ run() {
     exit 1
   fi
   if [ "$status" != 0 ]; then
-    grep -E "^\[  FAILED  \]" "$log" | sort -u | head -20 || true
+    grep -aE "^\[  FAILED  \]" "$log" | sort -u | head -20 || true
     tail -40 "$log"
     echo "run_sanitizers: $what FAILED, exit $status (log: $log)"
     exit 1
   fi
-  skipped=$(grep -c '^\[  SKIPPED \]' "$log" || true)
-  echo "run_sanitizers: $what: $(grep -c '^\[       OK \]' "$log") passed, $skipped skipped, $(( $(date +%s) - start )) s"
-  if [ "$skipped" != 0 ]; then grep '^\[  SKIPPED \]' "$log" | sed 's/^/run_sanitizers:   /'; fi
+  skipped=$(grep -ac '^\[  SKIPPED \] .* ms)$' "$log" || true)
+  echo "run_sanitizers: $what: $(grep -ac '^\[       OK \]' "$log") passed, $skipped skipped, $(( $(date +%s) - start )) s"
+  if [ "$skipped" != 0 ]; then grep -a '^\[  SKIPPED \] .* ms)$' "$log" | sed 's/^/run_sanitizers:   /'; fi
 }
 
 # The core tests that take minutes even in Release (measured by ctest's cost data, seconds of
