@@ -7,6 +7,6 @@ cd "$(dirname "$0")/.."
 export FREP_REQUIRE_CORPUS=1
 cd build && ctest --output-on-failure -j"$(nproc)"
 cd .. && ./tests/fuzz/run_fuzz.sh build-fuzz  # bounded ASan+UBSan fuzz run of 4 targets (tests/fuzz, docs/cli.md "Fuzzing")
-# ASan+UBSan of the core tests, TSan of the farm tests, each in a build of its own (docs/cli.md
-# "Sanitizers": the runs measured so far, and why the others wait).
-TSAN_CORE_FILTER= ASAN_FARM_FILTER= ./tests/sanitize/run_sanitizers.sh all
+# ASan+UBSan of the core tests in a build of its own (docs/cli.md "Sanitizers": the TSan run of
+# the farm tests is run by hand until its timing-bound tests are shown steady on a free machine).
+ASAN_FARM_FILTER= ./tests/sanitize/run_sanitizers.sh asan
