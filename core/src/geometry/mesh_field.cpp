@@ -269,12 +269,9 @@ void MeshField::searchAll(const double* p, Nearest& n) const {
 // from the whole cell (by its box or its plane) is never nearest there, nor tied. Nothing when
 // p is outside the lattice or the cell has too many candidates.
 const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count) const {
-  uint64_t key;
-  int64_t ijk[3];
-  if (!lattice_.cellOf(p, key, ijk)) return nullptr;
-  return CellLists::get(id_, key, count, [&](std::vector<uint32_t>& out) {
+  return CellLists::at(id_, lattice_, p, count, [&](const double* lo, const double* hi, std::vector<uint32_t>& out) {
     Bvh::Box box;
-    lattice_.cellBox(ijk, box.lo, box.hi);
+    for (int k = 0; k < 3; ++k) box.lo[k] = lo[k], box.hi[k] = hi[k];
     const double cellSize = lattice_.size;
     double centre[3];
     for (int k = 0; k < 3; ++k) centre[k] = 0.5 * (box.lo[k] + box.hi[k]);
@@ -360,13 +357,11 @@ double MeshField::signedDistance(const double* p, double* q) const {
 double MeshField::value(const double* p) const { return signedDistance(p, nullptr); }
 
 double MeshField::classValue(const double* p) const {
-  uint64_t key;
-  int64_t ijk[3];
-  if (!check_.closed() || !lattice_.cellOf(p, key, ijk)) return value(p);
+  if (!check_.closed()) return value(p);
   uint32_t count = 0;
-  const uint32_t* cls = CellLists::get(classId_, key, count, [&](std::vector<uint32_t>& out) {
+  const uint32_t* cls = CellLists::at(classId_, lattice_, p, count, [&](const double* lo, const double* hi, std::vector<uint32_t>& out) {
     Bvh::Box box;
-    lattice_.cellBox(ijk, box.lo, box.hi);
+    for (int k = 0; k < 3; ++k) box.lo[k] = lo[k], box.hi[k] = hi[k];
     // (a margin: a point may be placed in the cell from a few ulps outside)
     if (!(bvh_.boxGap(box) > 1e-9 * lattice_.size)) return false;  // a triangle may cross the cell
     // No triangle meets the (closed) cell: f has one sign in it, that of its centre.

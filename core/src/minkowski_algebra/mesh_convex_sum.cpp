@@ -539,12 +539,9 @@ class MeshConvexSumField : public DistanceField {
   }
   // The cells whose boxes meet the lattice cell holding p (at most 512), or nothing.
   const uint32_t* cellsNear(const double* p, uint32_t& count) const {
-    uint64_t key;
-    int64_t ijk[3];
-    if (!lattice_.cellOf(p, key, ijk)) return nullptr;
-    return CellLists::get(id_, key, count, [&](std::vector<uint32_t>& out) {
+    return CellLists::at(id_, lattice_, p, count, [&](const double* lo, const double* hi, std::vector<uint32_t>& out) {
       Bvh::Box q;
-      lattice_.cellBox(ijk, q.lo, q.hi);
+      for (int k = 0; k < 3; ++k) q.lo[k] = lo[k], q.hi[k] = hi[k];
       const size_t first = out.size();
       bool fits = true;
       // A little beyond the cell: a point may be placed in it from a few ulps outside.

@@ -31,6 +31,20 @@ class CellLists {
   static constexpr uint32_t kNone = UINT32_MAX;  // a cell given no list
   // A key for a new owner (a field): the lists of different owners never mix.
   static uint64_t newOwner();
+  // The list of the cell of `lattice` holding p, built by build(lo, hi, out) from the cell's
+  // box; nullptr also when p is outside the lattice.
+  template <typename Build>
+  static const uint32_t* at(uint64_t owner, const CellLattice& lattice, const double* p, uint32_t& count,
+                            Build&& build) {
+    uint64_t key;
+    int64_t ijk[3];
+    if (!lattice.cellOf(p, key, ijk)) return nullptr;
+    return get(owner, key, count, [&](std::vector<uint32_t>& out) {
+      double lo[3], hi[3];
+      lattice.cellBox(ijk, lo, hi);
+      return build(lo, hi, out);
+    });
+  }
   // The list of `key` for `owner` on this thread, built by build(out) (appending to out and
   // returning false for "no list") the first time; nullptr when the cell has no list.
   template <typename Build>
