@@ -51,6 +51,8 @@ bool supported(Op op, double imm) {
   }
 }
 
+inline bool binary(Op op) { return op == Op::Add || op == Op::Sub || op == Op::Mul || op == Op::Min || op == Op::Max; }
+
 }  // namespace
 
 bool FloatErrorBound::supports(const Tape& tape) {
@@ -60,23 +62,47 @@ bool FloatErrorBound::supports(const Tape& tape) {
   return true;
 }
 
-double FloatErrorBound::bound(const Tape& tape, const Interval* box) {
-  regs_.resize(tape.numRegs());
-  const auto& uni = tape.uniforms();
+void FloatErrorBound::enterConstants(const std::vector<double>& uni) {
+  if (regs_.size() < uni.size()) regs_.resize(uni.size());
   for (size_t r = 0; r < uni.size(); ++r) {
     const double c = uni[r];
     // float(c) - c is exact in double (both on c's binade grid, |difference| < 2^-24 |c|)
     regs_[r] = {c, c, std::fabs(double(float(c)) - c), 0.0};
   }
+}
+
+double FloatErrorBound::bound(const Tape& tape, const Interval* box) {
+  regs_.resize(tape.numRegs());
+  enterConstants(tape.uniforms());
   for (uint32_t v = 0; v < tape.numVars(); ++v) {
     const Interval& x = box[v];
     if (!(mag(x.lo, x.hi) < kMaxMagnitude)) return kInf;
     regs_[tape.varReg(v)] = {x.lo, x.hi, upErr(kUf * mag(x.lo, x.hi) + kTinyF), 0.0};
   }
-  for (const Instr& ins : tape.code()) {
+  for (const Instr& ins : tape.code())
     if (!supported(ins.op, ins.imm)) return kInf;
+  return propagate(tape.code().data(), tape.size(), tape.resultReg());
+}
+
+void FloatErrorBound::bind(const Tape& root) { enterConstants(root.uniforms()); }
+
+double FloatErrorBound::bound(const DenseTape& tape, const Interval* box) {
+  if (regs_.size() < tape.numRegs) regs_.resize(tape.numRegs);
+  for (uint32_t v = 0; v < tape.numVars; ++v) {
+    const Interval& x = box[v];
+    if (!(mag(x.lo, x.hi) < kMaxMagnitude)) return kInf;
+    regs_[tape.numUniforms + v] = {x.lo, x.hi, upErr(kUf * mag(x.lo, x.hi) + kTinyF), 0.0};
+  }
+  return propagate(tape.code.data(), tape.size(), tape.result);
+}
+
+// One pass in tape order over instructions of the covered ops (PowI: squares).
+template <typename I>
+double FloatErrorBound::propagate(const I* code, size_t size, uint32_t result) {
+  for (size_t k = 0; k < size; ++k) {
+    const I& ins = code[k];
     const Reg a = regs_[ins.a];
-    const Reg b = opArity(ins.op) > 1 ? regs_[ins.b] : a;
+    const Reg b = binary(ins.op) ? regs_[ins.b] : a;
     const double ma = mag(a.lo, a.hi), mb = mag(b.lo, b.hi);
     Reg o = a;
     // Rounded result: propagated error pf / pd, then the op's own rounding of a value whose
@@ -142,7 +168,7 @@ double FloatErrorBound::bound(const Tape& tape, const Interval* box) {
     if (!(mag(o.lo, o.hi) + o.ef < kMaxMagnitude)) return kInf;
     regs_[ins.out] = o;
   }
-  const Reg& r = regs_[tape.resultReg()];
+  const Reg& r = regs_[result];
   return upErr(r.ef + r.ed);
 }
 

@@ -22,7 +22,9 @@
 
 #include "frep/evaluators/eval.h"
 #include "frep/evaluators/float_error.h"
+#include "frep/expressions/dense_tape.h"
 #include "sampling/parallel_chunks.h"
+#include "sampling/plane_dense.h"
 
 namespace frep {
 namespace {
@@ -213,6 +215,12 @@ std::vector<double> evaluatePlane(const TapePtr& tape, const PlaneLattice& l, co
   if (!(l.step > 0) || !std::isfinite(l.step)) throw std::invalid_argument("evaluatePlane: pixel step must be positive");
   if (l.u == l.v) throw std::invalid_argument("evaluatePlane: the image axes must differ");
   std::vector<double> out(size_t(l.width) * size_t(l.height));
+  if (DenseTape::supports(*tape)) {
+    PlaneStats st;
+    evaluatePlaneDense(tape, l, opt, out, st);
+    if (stats) *stats = st;
+    return out;
+  }
   PlaneEvaluator pe(tape, l, opt, out);
   const int tilesX = (l.width + kTopTile - 1) / kTopTile, tilesY = (l.height + kTopTile - 1) / kTopTile;
   tbb::enumerable_thread_specific<PlaneWorker> workers;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "frep/evaluators/interval.h"
+#include "frep/expressions/dense_tape.h"
 #include "frep/expressions/tape.h"
 
 namespace frep {
@@ -20,12 +21,20 @@ class FloatErrorBound {
   // the caller passes them in double; the float lanes get them rounded to float). +inf when the
   // tape is not supported or a value may leave float's range.
   double bound(const Tape& tape, const Interval* box);
+  // The same for a DenseTape (every op of which is covered), after bind(root) with the root
+  // tape it derives from: the constants are entered once per root, not per call (a call of
+  // the Tape overload in between enters its own: bind again).
+  void bind(const Tape& root);
+  double bound(const DenseTape& tape, const Interval* box);
 
  private:
   struct Reg {
     double lo, hi;  // encloses the exact (real) value over the box
     double ef, ed;  // bounds on |float value - exact| and |double value - exact|
   };
+  template <typename I>
+  double propagate(const I* code, size_t size, uint32_t result);
+  void enterConstants(const std::vector<double>& uniforms);
   std::vector<Reg> regs_;
 };
 

@@ -1,0 +1,52 @@
+// Evaluators of a DenseTape (frep/expressions/dense_tape.h): intervals over a box, recording the
+// choices DenseSimplifier prunes by, and batches of points in float or double. Both agree with
+// the Tape evaluators (eval.h) on every op, bit for bit: the interval pass takes the same
+// decisions and bounds as IntervalEvaluator, a double batch gives BatchEvaluator<double>'s
+// values, a float batch the rounding FloatErrorBound models. One evaluator per thread; each
+// binds the constants of one root tape at a time (bind).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "frep/evaluators/interval.h"
+#include "frep/expressions/dense_tape.h"
+
+namespace frep {
+
+class DenseIntervalEvaluator {
+ public:
+  // The constants of the root tape every later tape is derived from.
+  void bind(const Tape& root);
+  // Interval of the tape's result over the box (box[i]: var i). choices (tape.size() entries)
+  // gets, at each min/max, 0 (both sides possible), 1 or 2 (the box decides for a or b, as
+  // IntervalEvaluator decides); returns how many were decided in *decided.
+  Interval eval(const DenseTape& tape, const Interval* box, uint8_t* choices, uint32_t* decided);
+
+ private:
+  std::vector<Interval> regs_;
+  uint32_t numUniforms_ = 0;
+};
+
+template <typename T>
+class DenseBatchEvaluator {
+ public:
+  static constexpr size_t kBatch = 256;
+  void bind(const Tape& root);
+  // Lanes of var i for the next eval (after bind; valid until the next bind or reserve).
+  T* in(uint32_t var) { return regs_.data() + size_t(numUniforms_ + var) * kBatch; }
+  // Makes room for the tape's registers; call before filling in() for a tape with more
+  // registers than any before.
+  void reserve(const DenseTape& tape);
+  // The tape's value at lanes [0, count), count <= kBatch.
+  const T* eval(const DenseTape& tape, size_t count);
+
+ private:
+  std::vector<T> regs_;  // register-major, kBatch lanes each; a constant's lane 0 holds it
+  uint32_t numUniforms_ = 0;
+};
+extern template class DenseBatchEvaluator<float>;
+extern template class DenseBatchEvaluator<double>;
+
+}  // namespace frep

@@ -1,0 +1,53 @@
+// A tape of the arithmetic subset (+ - * neg abs sqrt square min max copy) in a compact form for
+// quadtree subdivision (frep/sampling/plane.h): 16-byte instructions, and a simplifier that
+// prunes it in one backward pass over an interval pass's choices, dropping dead code and
+// renumbering the temporaries (Fidget's "tape simplification"), into a tape the caller reuses.
+// A pruned tape then reads a few dozen registers, not the root's thousands, and its batches
+// stay in L1.
+//
+// Register layout, as in Tape: [0, numUniforms) constants (the root's uniforms), then the vars,
+// then temporaries; constants and vars are never written.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "frep/expressions/tape.h"
+
+namespace frep {
+
+struct DenseInstr {
+  Op op;  // Add Sub Mul Neg Abs Sqrt PowI (squares only) Min Max Copy
+  uint32_t out = 0, a = 0, b = 0;
+};
+
+struct DenseTape {
+  std::vector<DenseInstr> code;
+  uint32_t numRegs = 0, result = 0;
+  uint32_t numUniforms = 0, numVars = 0;
+  uint32_t numChoices = 0;  // min/max instructions
+
+  // Whether every instruction of t is in the subset (no extremum, field, select, ...).
+  static bool supports(const Tape& t);
+  // The whole of t (supports(t) must hold), with t's own registers.
+  void assign(const Tape& t);
+  uint32_t firstTemp() const { return numUniforms + numVars; }
+  size_t size() const { return code.size(); }
+};
+
+// Choice per instruction of the tape an interval pass walked: 0 both, 1 keep a, 2 keep b (only
+// min/max entries are read).
+class DenseSimplifier {
+ public:
+  // out = parent restricted to where the choices hold: a decided min/max becomes its kept
+  // operand (renamed, or a copy when that value already has a register), unread instructions
+  // are dropped, temporaries are reallocated last use first (so a tape needs few registers).
+  // The values are the parent's bit for bit: the same operations on the same operands.
+  void simplify(const DenseTape& parent, const uint8_t* choices, DenseTape& out);
+
+ private:
+  std::vector<uint32_t> bind_;  // parent register -> out register of its live value
+  std::vector<uint32_t> free_;
+};
+
+}  // namespace frep

@@ -1,0 +1,117 @@
+// DenseTape and its one-pass simplifier (dense_tape.h).
+//
+// The backward pass follows each value from its last reader to its definition, so a register is
+// allocated when a value's last reader is met and freed at its definition (linear scan in
+// reverse); an instruction's output register may then serve one of its inputs, which the
+// evaluators' lane loops allow (each lane reads before it writes).
+#include "frep/expressions/dense_tape.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace frep {
+namespace {
+
+constexpr uint32_t kNone = UINT32_MAX;
+
+bool inSubset(const Instr& ins) {
+  switch (ins.op) {
+    case Op::Add:
+    case Op::Sub:
+    case Op::Mul:
+    case Op::Neg:
+    case Op::Abs:
+    case Op::Sqrt:
+    case Op::Min:
+    case Op::Max:
+    case Op::Copy:
+      return true;
+    case Op::PowI:
+      return ins.imm == 2.0;
+    default:
+      return false;
+  }
+}
+
+inline bool binary(Op op) { return op == Op::Add || op == Op::Sub || op == Op::Mul || op == Op::Min || op == Op::Max; }
+
+}  // namespace
+
+bool DenseTape::supports(const Tape& t) {
+  if (t.hasExtrema()) return false;
+  for (const Instr& ins : t.code())
+    if (!inSubset(ins)) return false;
+  return true;
+}
+
+void DenseTape::assign(const Tape& t) {
+  if (!supports(t)) throw std::invalid_argument("DenseTape: the tape has ops outside the arithmetic subset");
+  code.clear();
+  numChoices = 0;
+  for (const Instr& ins : t.code()) {
+    code.push_back(DenseInstr{ins.op, ins.out, ins.a, binary(ins.op) ? ins.b : ins.a});
+    numChoices += ins.op == Op::Min || ins.op == Op::Max;
+  }
+  numRegs = t.numRegs();
+  result = t.resultReg();
+  numUniforms = t.numUniforms();
+  numVars = t.numVars();
+}
+
+void DenseSimplifier::simplify(const DenseTape& parent, const uint8_t* choices, DenseTape& out) {
+  const uint32_t fixed = parent.firstTemp();
+  if (bind_.size() < parent.numRegs) bind_.resize(parent.numRegs);
+  for (uint32_t r = 0; r < fixed; ++r) bind_[r] = r;
+  std::fill(bind_.begin() + fixed, bind_.begin() + parent.numRegs, kNone);
+  free_.clear();
+  uint32_t next = fixed;
+  auto alloc = [&]() -> uint32_t {
+    if (free_.empty()) return next++;
+    const uint32_t r = free_.back();
+    free_.pop_back();
+    return r;
+  };
+  auto use = [&](uint32_t p) -> uint32_t {  // register of the value parent register p holds here
+    uint32_t& b = bind_[p];
+    if (b == kNone) b = alloc();
+    return b;
+  };
+  out.code.clear();
+  out.numChoices = 0;
+  // The result always lives in a temporary (a copy if the parent's is a constant or a var).
+  const uint32_t res = alloc();
+  if (parent.result < fixed) {
+    out.code.push_back(DenseInstr{Op::Copy, res, parent.result, parent.result});
+  } else {
+    bind_[parent.result] = res;
+  }
+  for (size_t i = parent.code.size(); i-- > 0;) {
+    const DenseInstr& ins = parent.code[i];
+    const uint32_t r = bind_[ins.out];
+    if (r == kNone) continue;  // not read again
+    bind_[ins.out] = kNone;    // earlier readers of this register read an older value
+    const bool choice = ins.op == Op::Min || ins.op == Op::Max;
+    if (choice && choices[i] != 0) {
+      const uint32_t kept = choices[i] == 1 ? ins.a : ins.b;
+      if (bind_[kept] == kNone) {
+        bind_[kept] = r;  // the kept value is computed straight into r
+      } else {
+        out.code.push_back(DenseInstr{Op::Copy, r, bind_[kept], bind_[kept]});
+        free_.push_back(r);
+      }
+      continue;
+    }
+    free_.push_back(r);
+    const uint32_t a = use(ins.a);
+    const uint32_t b = binary(ins.op) ? use(ins.b) : a;
+    out.code.push_back(DenseInstr{ins.op, r, a, b});
+    out.numChoices += choice;
+  }
+  std::reverse(out.code.begin(), out.code.end());
+  out.numRegs = next;
+  out.result = res;
+  out.numUniforms = parent.numUniforms;
+  out.numVars = parent.numVars;
+}
+
+}  // namespace frep

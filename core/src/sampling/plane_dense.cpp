@@ -1,0 +1,221 @@
+// evaluatePlane on a DenseTape (plane_dense.h), in Fidget's shape: fixed top tiles (the
+// parallel grain) classified by intervals over the whole tape, each tile's tape simplified in
+// one backward pass (DenseSimplifier) into a per-depth buffer of its thread (no allocation once
+// warm), split in four down to leaf tiles of one batch, whose pixels are evaluated with the
+// leaf's short, densely numbered tape. Float leaves (signOnly + floatSigns) keep a pixel's float
+// value where it exceeds the certified bound over the leaf's box (FloatErrorBound) and recompute
+// the others in double on the same tape, so every sign is the double path's.
+#include "sampling/plane_dense.h"
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "frep/evaluators/dense_eval.h"
+#include "frep/evaluators/float_error.h"
+#include "frep/expressions/dense_tape.h"
+#include "sampling/parallel_chunks.h"
+
+namespace frep {
+namespace {
+
+// Top tiles: the first interval pass over the whole tape is per 64 x 64 pixels.
+constexpr int kTopTile = 256;
+// Leaves of at most kLeafTile^2 pixels.
+constexpr int kLeafTile = 16;
+constexpr int kMaxDepth = 16;
+
+struct Worker {
+  DenseIntervalEvaluator interval;
+  DenseSimplifier simplifier;
+  DenseBatchEvaluator<float> fbatch;
+  DenseBatchEvaluator<double> dbatch;
+  FloatErrorBound error;
+  std::vector<DenseTape> tapes = std::vector<DenseTape>(kMaxDepth);  // the tape of each depth
+  std::vector<uint8_t> choices;
+  std::vector<uint32_t> redo;
+  std::vector<Interval> box;
+  PlaneStats stats;
+  bool ready = false;
+};
+
+class DensePlane {
+ public:
+  DensePlane(const TapePtr& tape, const PlaneLattice& l, const PlaneOptions& opt, std::vector<double>& out)
+      : tape_(tape), l_(l), opt_(opt), out_(out), float_(opt.signOnly && opt.floatSigns) {
+    root_.assign(*tape);
+  }
+
+  double colCoord(int c) const { return l_.origin[0] + double(c) * l_.step; }
+  double rowCoord(int r) const { return l_.origin[1] + double(l_.height - 1 - r) * l_.step; }
+  double held(uint32_t var) const {
+    if (int(var) == l_.normal) return l_.at;
+    if (var >= 3 && var - 3 < l_.fixed.size()) return l_.fixed[var - 3];
+    return 0.0;
+  }
+  size_t index(int c, int r) const { return size_t(r) * size_t(l_.width) + size_t(c); }
+
+  // Per thread, once: the root's constants, and the lanes of the held coordinates (the tapes
+  // never write a var's register, so they stay).
+  void prepare(Worker& w) const {
+    if (w.ready) return;
+    w.interval.bind(*tape_);
+    w.fbatch.bind(*tape_);
+    w.dbatch.bind(*tape_);
+    w.error.bind(*tape_);
+    w.choices.resize(root_.size());
+    w.box.resize(std::max<uint32_t>(root_.numVars, 1));
+    for (uint32_t var = 0; var < root_.numVars; ++var) {
+      w.box[var] = Interval(held(var));
+      if (var == l_.u || var == l_.v) continue;
+      std::fill(w.fbatch.in(var), w.fbatch.in(var) + DenseBatchEvaluator<float>::kBatch, float(held(var)));
+      std::fill(w.dbatch.in(var), w.dbatch.in(var) + DenseBatchEvaluator<double>::kBatch, held(var));
+    }
+    w.ready = true;
+  }
+
+  void top(Worker& w, int c0, int c1, int r0, int r1) { tile(w, c0, c1, r0, r1, root_, 0); }
+
+ private:
+  // Pixels [c0, c1) x [r0, r1) with the tape of the enclosing tile.
+  void tile(Worker& w, int c0, int c1, int r0, int r1, const DenseTape& tape, int depth) {
+    if (l_.u < root_.numVars) w.box[l_.u] = Interval(colCoord(c0), colCoord(c1 - 1));
+    if (l_.v < root_.numVars) w.box[l_.v] = Interval(rowCoord(r1 - 1), rowCoord(r0));
+    ++w.stats.intervalEvals;
+    w.stats.intervalInstrs += tape.size();
+    uint32_t decided = 0;
+    const Interval iv = w.interval.eval(tape, w.box.data(), w.choices.data(), &decided);
+    const int side = iv.lo > 0 ? 1 : iv.hi < 0 ? -1 : 0;
+    const uint64_t pixels = uint64_t(c1 - c0) * uint64_t(r1 - r0);
+    if (side != 0) w.stats.decidedPixels += pixels;
+    if (side != 0 && opt_.signOnly) {
+      const double fill = side > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+      for (int r = r0; r < r1; ++r)
+        std::fill(out_.begin() + long(index(c0, r)), out_.begin() + long(index(c1, r)), fill);
+      return;
+    }
+    const DenseTape* t = &tape;
+    if (decided && depth + 1 < kMaxDepth) {
+      w.simplifier.simplify(tape, w.choices.data(), w.tapes[size_t(depth + 1)]);
+      t = &w.tapes[size_t(depth + 1)];
+    }
+    if (c1 - c0 <= kLeafTile && r1 - r0 <= kLeafTile) {
+      leaf(w, c0, c1, r0, r1, *t);
+      return;
+    }
+    const int cm = c1 - c0 > kLeafTile ? c0 + (c1 - c0 + 1) / 2 : c1;
+    const int rm = r1 - r0 > kLeafTile ? r0 + (r1 - r0 + 1) / 2 : r1;
+    tile(w, c0, cm, r0, rm, *t, depth + 1);
+    if (cm < c1) tile(w, cm, c1, r0, rm, *t, depth + 1);
+    if (rm < r1) tile(w, c0, cm, rm, r1, *t, depth + 1);
+    if (cm < c1 && rm < r1) tile(w, cm, c1, rm, r1, *t, depth + 1);
+  }
+
+  // Fills the u and v lanes of a batch with the pixels of the tile, row by row.
+  template <typename T>
+  void coordinates(DenseBatchEvaluator<T>& b, int c0, int c1, int r0, int r1) const {
+    T* us = l_.u < root_.numVars ? b.in(l_.u) : nullptr;
+    T* vs = l_.v < root_.numVars ? b.in(l_.v) : nullptr;
+    size_t k = 0;
+    for (int r = r0; r < r1; ++r) {
+      const T v = T(rowCoord(r));
+      for (int c = c0; c < c1; ++c, ++k) {
+        if (us) us[k] = T(colCoord(c));
+        if (vs) vs[k] = v;
+      }
+    }
+  }
+
+  // A leaf tile, by batches of whole rows; w.box still holds its box.
+  void leaf(Worker& w, int c0, int c1, int r0, int r1, const DenseTape& tape) {
+    const double bound = float_ ? w.error.bound(tape, w.box.data()) : std::numeric_limits<double>::infinity();
+    const int rows = std::max(1, int(DenseBatchEvaluator<float>::kBatch) / (c1 - c0));
+    for (int ra = r0; ra < r1; ra += rows) batch(w, c0, c1, ra, std::min(r1, ra + rows), tape, bound);
+  }
+
+  void batch(Worker& w, int c0, int c1, int r0, int r1, const DenseTape& tape, double bound) {
+    const int cols = c1 - c0;
+    const size_t n = size_t(cols) * size_t(r1 - r0);
+    w.stats.pointEvals += n;
+    w.stats.tapeInstrs += tape.size();
+    ++w.stats.tapeBatches;
+    if (!std::isfinite(bound)) {
+      w.dbatch.reserve(tape);
+      coordinates(w.dbatch, c0, c1, r0, r1);
+      const double* f = w.dbatch.eval(tape, n);
+      size_t k = 0;
+      for (int r = r0; r < r1; ++r, k += size_t(cols)) std::copy(f + k, f + k + size_t(cols), &out_[index(c0, r)]);
+      if (float_) w.stats.doublePixels += n;  // not certified in float
+      return;
+    }
+    w.fbatch.reserve(tape);
+    coordinates(w.fbatch, c0, c1, r0, r1);
+    const float* f = w.fbatch.eval(tape, n);
+    w.redo.clear();
+    size_t k = 0;
+    for (int r = r0; r < r1; ++r) {
+      double* row = &out_[index(c0, r)];
+      for (int c = 0; c < cols; ++c, ++k) {
+        if (std::fabs(double(f[k])) > bound) row[c] = double(f[k]);
+        else w.redo.push_back(uint32_t(k));
+      }
+    }
+    w.stats.floatPixels += n - w.redo.size();
+    if (w.redo.empty()) return;
+    // The uncertain pixels, packed into one double batch on the same tape.
+    const size_t m = w.redo.size();
+    w.dbatch.reserve(tape);
+    double* us = l_.u < root_.numVars ? w.dbatch.in(l_.u) : nullptr;
+    double* vs = l_.v < root_.numVars ? w.dbatch.in(l_.v) : nullptr;
+    for (size_t j = 0; j < m; ++j) {
+      const int c = c0 + int(w.redo[j] % uint32_t(cols)), r = r0 + int(w.redo[j] / uint32_t(cols));
+      if (us) us[j] = colCoord(c);
+      if (vs) vs[j] = rowCoord(r);
+    }
+    const double* g = w.dbatch.eval(tape, m);
+    for (size_t j = 0; j < m; ++j) {
+      const int c = c0 + int(w.redo[j] % uint32_t(cols)), r = r0 + int(w.redo[j] / uint32_t(cols));
+      out_[index(c, r)] = g[j];
+    }
+    w.stats.doublePixels += m;
+  }
+
+  const TapePtr& tape_;
+  const PlaneLattice& l_;
+  const PlaneOptions& opt_;
+  std::vector<double>& out_;
+  bool float_;
+  DenseTape root_;
+};
+
+}  // namespace
+
+void evaluatePlaneDense(const TapePtr& tape, const PlaneLattice& l, const PlaneOptions& opt, std::vector<double>& out,
+                        PlaneStats& stats) {
+  DensePlane plane(tape, l, opt, out);
+  const int tilesX = (l.width + kTopTile - 1) / kTopTile, tilesY = (l.height + kTopTile - 1) / kTopTile;
+  tbb::enumerable_thread_specific<Worker> workers;
+  parallelChunks(size_t(tilesX) * size_t(tilesY), 1, opt.threads, [&](size_t b, size_t e) {
+    Worker& w = workers.local();
+    plane.prepare(w);
+    for (size_t t = b; t < e; ++t) {
+      const int tx = int(t % size_t(tilesX)), ty = int(t / size_t(tilesX));
+      const int c0 = tx * kTopTile, r0 = ty * kTopTile;
+      plane.top(w, c0, std::min(c0 + kTopTile, l.width), r0, std::min(r0 + kTopTile, l.height));
+    }
+  });
+  for (const Worker& w : workers) {
+    stats.pointEvals += w.stats.pointEvals;
+    stats.intervalEvals += w.stats.intervalEvals;
+    stats.intervalInstrs += w.stats.intervalInstrs;
+    stats.tapeInstrs += w.stats.tapeInstrs;
+    stats.tapeBatches += w.stats.tapeBatches;
+    stats.decidedPixels += w.stats.decidedPixels;
+    stats.floatPixels += w.stats.floatPixels;
+    stats.doublePixels += w.stats.doublePixels;
+  }
+}
+
+}  // namespace frep

@@ -1,0 +1,175 @@
+// DenseTape (frep/expressions/dense_tape.h) and its evaluators (frep/evaluators/dense_eval.h):
+// the interval pass gives IntervalEvaluator's bounds bit for bit, a tape simplified by a box's
+// choices gives the full tape's double values bit for bit at every point of the box, in few
+// registers, and slices of arithmetic-only models (the dense path of evaluatePlane) are the
+// every-pixel values, with the double signs in float.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "frep/evaluators/dense_eval.h"
+#include "frep/evaluators/eval.h"
+#include "frep/expressions/dense_tape.h"
+#include "frep/sampling/plane.h"
+
+using namespace frep;
+
+namespace {
+
+// CSG of spheres, boxes and planes with only the dense subset's ops (+ - * neg abs sqrt square
+// min max): unions, intersections, differences, shells and offsets.
+Expr arithmeticCsg(std::mt19937_64& rng, int depth) {
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  const Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  if (depth == 0 || rng() % 6 == 0) {
+    const double cx = u(rng), cy = u(rng), cz = u(rng), r = 0.2 + 0.3 * std::fabs(u(rng));
+    switch (rng() % 3) {
+      case 0:
+        return sqrt(square(x - cx) + square(y - cy) + square(z - cz)) - r;
+      case 1:
+        return max(max(abs(x - cx), abs(y - cy)), abs(z - cz)) - r;
+      default:
+        return 0.3 * u(rng) - u(rng) * x - u(rng) * y - u(rng) * z;
+    }
+  }
+  const Expr a = arithmeticCsg(rng, depth - 1), b = arithmeticCsg(rng, depth - 1);
+  switch (rng() % 5) {
+    case 0:
+      return max(a, b);
+    case 1:
+      return min(a, b);
+    case 2:
+      return min(a, -b);
+    case 3:
+      return abs(a) - 0.05;
+    default:
+      return (a * b) - 0.01;
+  }
+}
+
+uint64_t bits(double v) {
+  uint64_t b;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+
+}  // namespace
+
+TEST(DenseTape, SimplifiedTapesGiveTheFullTapesBitsInTheirBox) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-2.0, 2.0), w(0.01, 0.8), t(0.0, 1.0);
+  size_t decidedBoxes = 0;
+  for (int m = 0; m < 40; ++m) {
+    TapePtr tape = Tape::compile(arithmeticCsg(rng, 6), 3);
+    ASSERT_TRUE(DenseTape::supports(*tape));
+    DenseTape root;
+    root.assign(*tape);
+    DenseIntervalEvaluator di;
+    di.bind(*tape);
+    IntervalEvaluator ref;
+    DenseSimplifier simp;
+    DenseBatchEvaluator<double> db;
+    db.bind(*tape);
+    BatchEvaluator<double> full;
+    std::vector<uint8_t> choices(root.size());
+    for (int k = 0; k < 20; ++k) {
+      Interval box[3];
+      for (auto& b : box) {
+        const double c = u(rng), h = w(rng);
+        b = Interval(c - h, c + h);
+      }
+      uint32_t decided = 0;
+      const Interval got = di.eval(root, box, choices.data(), &decided);
+      const Interval want = ref.eval(*tape, box);
+      EXPECT_EQ(bits(got.lo), bits(want.lo));
+      EXPECT_EQ(bits(got.hi), bits(want.hi));
+      DenseTape pruned;
+      simp.simplify(root, choices.data(), pruned);
+      if (decided) {
+        ++decidedBoxes;
+        EXPECT_LT(pruned.size(), root.size());
+      }
+      EXPECT_LE(pruned.numRegs, root.numRegs);
+      // A twice-simplified tape (a sub-box) stays exact too.
+      Interval sub[3];
+      for (int i = 0; i < 3; ++i) sub[i] = Interval(box[i].lo, box[i].mid());
+      std::vector<uint8_t> subChoices(pruned.size());
+      di.eval(pruned, sub, subChoices.data(), &decided);
+      DenseTape twice;
+      simp.simplify(pruned, subChoices.data(), twice);
+      for (const DenseTape* dt : {&pruned, &twice}) {
+        const Interval* b = dt == &pruned ? box : sub;
+        const size_t n = 64;
+        db.reserve(*dt);
+        full.reserve(*tape);
+        for (uint32_t v = 0; v < 3; ++v)
+          for (size_t i = 0; i < n; ++i) {
+            const double p = b[v].lo + t(rng) * b[v].width();
+            db.in(v)[i] = p;
+            full.in(v)[i] = p;
+          }
+        const double* f = full.eval(*tape, n);
+        const double* g = db.eval(*dt, n);
+        for (size_t i = 0; i < n; ++i) ASSERT_EQ(bits(f[i]), bits(g[i])) << "model " << m << " box " << k;
+      }
+    }
+  }
+  EXPECT_GT(decidedBoxes, 100u);
+}
+
+TEST(DenseTape, SimplifiedTapeUsesFewRegisters) {
+  // 64 spheres: near one of them the tape is that sphere, whatever register the root gave it.
+  Expr e = Expr(1e9);
+  for (int i = 0; i < 64; ++i) {
+    const double a = 2 * M_PI * i / 64;
+    e = min(e, sqrt(square(Expr::x(0) - 1.5 * std::cos(a)) + square(Expr::x(1) - 1.5 * std::sin(a))) - 0.1);
+  }
+  TapePtr tape = Tape::compile(e, 2);
+  DenseTape root;
+  root.assign(*tape);
+  DenseIntervalEvaluator di;
+  di.bind(*tape);
+  std::vector<uint8_t> choices(root.size());
+  const Interval box[2] = {Interval(1.45, 1.55), Interval(-0.05, 0.05)};
+  uint32_t decided = 0;
+  di.eval(root, box, choices.data(), &decided);
+  DenseTape pruned;
+  DenseSimplifier().simplify(root, choices.data(), pruned);
+  EXPECT_LE(pruned.size(), 8u);  // (x - c)^2 + (y - s)^2, sqrt, - r: a copy at most
+  EXPECT_LE(pruned.numRegs, pruned.firstTemp() + 3);
+}
+
+TEST(DenseTape, SlicesOfArithmeticModelsAreEveryPixelsValues) {
+  std::mt19937_64 rng(5);
+  for (int m = 0; m < 6; ++m) {
+    TapePtr tape = Tape::compile(arithmeticCsg(rng, 6), 3);
+    PlaneLattice l;
+    l.normal = 2, l.at = 0.1;
+    l.origin[0] = -2.0, l.origin[1] = -1.9;
+    l.width = 300, l.height = 211;
+    l.step = 3.9 / 299.0;
+    std::vector<double> ref(size_t(l.width) * size_t(l.height));
+    PointEvaluator pe;
+    for (int r = 0; r < l.height; ++r)
+      for (int c = 0; c < l.width; ++c) {
+        const double x[3] = {l.origin[0] + c * l.step, l.origin[1] + (l.height - 1 - r) * l.step, l.at};
+        ref[size_t(r) * size_t(l.width) + size_t(c)] = pe.eval(*tape, x);
+      }
+    for (int mode = 0; mode < 3; ++mode) {
+      PlaneOptions o;
+      o.signOnly = mode > 0;
+      o.floatSigns = mode == 2;
+      o.threads = 1 + m % 2;
+      const std::vector<double> got = evaluatePlane(tape, l, o);
+      size_t wrong = 0;
+      for (size_t i = 0; i < ref.size(); ++i) {
+        if (mode == 0) wrong += bits(ref[i]) != bits(got[i]);
+        else wrong += (ref[i] >= 0) != (got[i] >= 0) || std::isnan(ref[i]) != std::isnan(got[i]);
+      }
+      EXPECT_EQ(wrong, 0u) << "model " << m << " mode " << mode;
+    }
+  }
+}
