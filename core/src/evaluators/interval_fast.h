@@ -17,14 +17,17 @@ namespace detail {
 
 // One step to the next double above x: std::nextafter(x, inf) without the libm call (this runs
 // for every bound of every op). +inf and NaN stay as they are.
+// Without branches on the sign: -0 + 0 is +0, then the bits step by +1 (positive) or -1
+// (negative: the sign bit, shifted arithmetically, gives -1), which is the same result.
 inline double nextUp(double x) {
   if (!(x < std::numeric_limits<double>::infinity())) return x;
-  if (x == 0.0) return std::numeric_limits<double>::denorm_min();
-  uint64_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  bits = x > 0.0 ? bits + 1 : bits - 1;
-  std::memcpy(&x, &bits, sizeof bits);
-  return x;
+  const double y = x + 0.0;
+  int64_t bits;
+  std::memcpy(&bits, &y, sizeof bits);
+  bits += (bits >> 63) | 1;
+  double r;
+  std::memcpy(&r, &bits, sizeof r);
+  return r;
 }
 inline double up1(double x) { return nextUp(x); }
 inline double down1(double x) { return -nextUp(-x); }
@@ -81,8 +84,10 @@ inline bool finiteIv2(const Interval& a, const Interval& b) {
       return true;
     case Op::Mul: {
       if (!finiteIv2(a, b)) return false;
-      const double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
-      r = Interval(down1(*std::min_element(p, p + 4)), up1(*std::max_element(p, p + 4)));
+      // pairwise: the first of the smallest (largest) product, as min_element (max_element)
+      const double p0 = a.lo * b.lo, p1 = a.lo * b.hi, p2 = a.hi * b.lo, p3 = a.hi * b.hi;
+      r = Interval(down1(std::min(std::min(p0, p1), std::min(p2, p3))),
+                   up1(std::max(std::max(p0, p1), std::max(p2, p3))));
       return true;
     }
     case Op::Min:

@@ -61,53 +61,57 @@ void DenseTape::assign(const Tape& t) {
 void DenseSimplifier::simplify(const DenseTape& parent, const uint8_t* choices, DenseTape& out) {
   const uint32_t fixed = parent.firstTemp();
   if (bind_.size() < parent.numRegs) bind_.resize(parent.numRegs);
-  for (uint32_t r = 0; r < fixed; ++r) bind_[r] = r;
-  std::fill(bind_.begin() + fixed, bind_.begin() + parent.numRegs, kNone);
-  free_.clear();
+  if (free_.size() < size_t(parent.numRegs) + 1) free_.resize(size_t(parent.numRegs) + 1);
+  uint32_t* bind = bind_.data();
+  uint32_t* freeRegs = free_.data();
+  for (uint32_t r = 0; r < fixed; ++r) bind[r] = r;
+  std::fill(bind + fixed, bind + parent.numRegs, kNone);
+  size_t numFree = 0;
   uint32_t next = fixed;
-  auto alloc = [&]() -> uint32_t {
-    if (free_.empty()) return next++;
-    const uint32_t r = free_.back();
-    free_.pop_back();
-    return r;
-  };
+  auto alloc = [&]() -> uint32_t { return numFree ? freeRegs[--numFree] : next++; };
   auto use = [&](uint32_t p) -> uint32_t {  // register of the value parent register p holds here
-    uint32_t& b = bind_[p];
+    uint32_t& b = bind[p];
     if (b == kNone) b = alloc();
     return b;
   };
-  out.code.clear();
-  out.numChoices = 0;
+  // Written back to front: at most one instruction per parent instruction, plus the result's copy.
+  const size_t cap = parent.code.size() + 1;
+  if (scratch_.size() < cap) scratch_.resize(cap);
+  DenseInstr* const end = scratch_.data() + cap;
+  DenseInstr* dst = end;
+  uint32_t choicesLeft = 0;
   // The result always lives in a temporary (a copy if the parent's is a constant or a var).
   const uint32_t res = alloc();
   if (parent.result < fixed) {
-    out.code.push_back(DenseInstr{Op::Copy, res, parent.result, parent.result});
+    *--dst = DenseInstr{Op::Copy, res, parent.result, parent.result};
   } else {
-    bind_[parent.result] = res;
+    bind[parent.result] = res;
   }
+  const DenseInstr* code = parent.code.data();
   for (size_t i = parent.code.size(); i-- > 0;) {
-    const DenseInstr& ins = parent.code[i];
-    const uint32_t r = bind_[ins.out];
+    const DenseInstr ins = code[i];
+    const uint32_t r = bind[ins.out];
     if (r == kNone) continue;  // not read again
-    bind_[ins.out] = kNone;    // earlier readers of this register read an older value
+    bind[ins.out] = kNone;     // earlier readers of this register read an older value
     const bool choice = ins.op == Op::Min || ins.op == Op::Max;
     if (choice && choices[i] != 0) {
       const uint32_t kept = choices[i] == 1 ? ins.a : ins.b;
-      if (bind_[kept] == kNone) {
-        bind_[kept] = r;  // the kept value is computed straight into r
+      if (bind[kept] == kNone) {
+        bind[kept] = r;  // the kept value is computed straight into r
       } else {
-        out.code.push_back(DenseInstr{Op::Copy, r, bind_[kept], bind_[kept]});
-        free_.push_back(r);
+        *--dst = DenseInstr{Op::Copy, r, bind[kept], bind[kept]};
+        freeRegs[numFree++] = r;
       }
       continue;
     }
-    free_.push_back(r);
+    freeRegs[numFree++] = r;
     const uint32_t a = use(ins.a);
     const uint32_t b = binary(ins.op) ? use(ins.b) : a;
-    out.code.push_back(DenseInstr{ins.op, r, a, b});
-    out.numChoices += choice;
+    *--dst = DenseInstr{ins.op, r, a, b};
+    choicesLeft += choice;
   }
-  std::reverse(out.code.begin(), out.code.end());
+  out.code.assign(dst, end);  // within its capacity once warm
+  out.numChoices = choicesLeft;
   out.numRegs = next;
   out.result = res;
   out.numUniforms = parent.numUniforms;

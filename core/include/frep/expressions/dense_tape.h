@@ -48,6 +48,7 @@ class DenseSimplifier {
  private:
   std::vector<uint32_t> bind_;  // parent register -> out register of its live value
   std::vector<uint32_t> free_;
+  std::vector<DenseInstr> scratch_;  // the simplified code, written back to front
 };
 
 }  // namespace frep
