@@ -7,118 +7,10 @@
 #include <stdexcept>
 #include <vector>
 
-#include "frep/evaluators/eval.h"
+#include "sampling/halo_field.h"
 #include "sampling/parallel_chunks.h"
 
 namespace frep {
-namespace {
-
-// The region and a voxel around it on a dense array: the sampled values, NaN where the sampler
-// decided the sign without evaluating. Kept between calls on a thread and all NaN between them,
-// so a call cleans only what it set.
-struct Scratch {
-  std::vector<float> value;
-};
-
-struct Field {
-  int64_t lo[3], hi[3], n[3], s0, s1;
-  Scratch& s;
-  explicit Field(Scratch& scratch) : s(scratch) {}
-  void reserve() {
-    if (s.value.size() >= size()) return;
-    s.value.resize(size(), std::numeric_limits<float>::quiet_NaN());
-  }
-  size_t size() const { return size_t(n[0] * n[1] * n[2]); }
-  int64_t at(int64_t i, int64_t j, int64_t k) const { return (i - lo[0]) * s0 + (j - lo[1]) * s1 + (k - lo[2]); }
-};
-
-// Evaluates the points of a box of the halo that the sampler evaluates when it samples the
-// brick they belong to: a point's value is computed when the interval of f over its 2^3 block
-// (on the lattice's 2-grid, clipped to the grid) and the band around it may hold a zero. Blocks
-// of 8^3 around them, and the box, are classified first (a larger box's interval holds the
-// smaller's: interval arithmetic is inclusion-monotone), so the same points are evaluated.
-class HaloSampler {
- public:
-  HaloSampler(const GridSpec& g, const SampleOptions& opt, uint32_t nvars, BandDistanceStats& st)
-      : g_(g), opt_(opt), nvars_(nvars), st_(st) {
-    interval_.setExtremumBudgetOnly(opt.pointwiseSearches && opt.extremumSignsOnly);
-  }
-
-  // [lo, hi) per axis, inside the field's box.
-  void box(const TapePtr& tape, const int64_t* lo, const int64_t* hi, Field& f, std::vector<int64_t>& evaluated) {
-    for (int a = 0; a < 3; ++a)
-      if (lo[a] >= hi[a]) return;
-    auto down = [](int64_t v, int64_t m) { return v - ((v % m) + m) % m; };
-    auto up = [&](int64_t v, int64_t m, int a) { return std::min<int64_t>(down(v + m - 1, m), g_.dims[a]) - 1; };
-    if (decided(*tape, {down(lo[0], 8), down(lo[1], 8), down(lo[2], 8)},
-                {up(hi[0], 8, 0), up(hi[1], 8, 1), up(hi[2], 8, 2)}))
-      return;
-    const TapePtr boxTape = interval_.pruned(tape);
-    for (int64_t bx = down(lo[0], 8); bx < hi[0]; bx += 8)
-      for (int64_t by = down(lo[1], 8); by < hi[1]; by += 8)
-        for (int64_t bz = down(lo[2], 8); bz < hi[2]; bz += 8) {
-          if (decided(*boxTape, {bx, by, bz}, {up(bx + 8, 8, 0), up(by + 8, 8, 1), up(bz + 8, 8, 2)})) continue;
-          const TapePtr blockTape = interval_.pruned(boxTape);
-          todo_.clear();
-          for (int64_t ex = std::max(bx, down(lo[0], 2)); ex < std::min(bx + 8, hi[0]); ex += 2)
-            for (int64_t ey = std::max(by, down(lo[1], 2)); ey < std::min(by + 8, hi[1]); ey += 2)
-              for (int64_t ez = std::max(bz, down(lo[2], 2)); ez < std::min(bz + 8, hi[2]); ez += 2) {
-                if (decided(*blockTape, {ex, ey, ez}, {up(ex + 2, 2, 0), up(ey + 2, 2, 1), up(ez + 2, 2, 2)})) continue;
-                for (int64_t x = std::max(ex, lo[0]); x < std::min(ex + 2, hi[0]); ++x)
-                  for (int64_t y = std::max(ey, lo[1]); y < std::min(ey + 2, hi[1]); ++y)
-                    for (int64_t z = std::max(ez, lo[2]); z < std::min(ez + 2, hi[2]); ++z) todo_.push_back({x, y, z});
-              }
-          evaluate(*blockTape, f, evaluated);
-        }
-  }
-
- private:
-  // True when f has one sign over the box's points [lo, hi] and the band around them.
-  bool decided(const Tape& tape, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) {
-    const int64_t d = opt_.bandVoxels;
-    box_.resize(std::max<size_t>(nvars_, 1));
-    for (uint32_t v = 0; v < nvars_; ++v)
-      box_[v] = v < 3
-                    ? Interval(g_.origin[v] + double(lo[v] - d) * g_.voxel, g_.origin[v] + double(hi[v] + d) * g_.voxel)
-                    : Interval(opt_.fixedCoords[v - 3]);
-    ++st_.haloIntervalEvals;
-    const Interval iv = interval_.eval(tape, box_.data());
-    return iv.lo > 0 || iv.hi < 0;
-  }
-
-  void evaluate(const Tape& tape, Field& f, std::vector<int64_t>& evaluated) {
-    constexpr size_t B = BatchEvaluator<double>::kBatch;
-    batch_.reserve(tape);
-    batch_.setExtremumWarmStarts(!opt_.pointwiseSearches);
-    batch_.setExtremumSignsOnly(opt_.pointwiseSearches && opt_.extremumSignsOnly);
-    for (size_t start = 0; start < todo_.size(); start += B) {
-      const size_t count = std::min(B, todo_.size() - start);
-      for (size_t k = 0; k < count; ++k)
-        for (uint32_t v = 0; v < nvars_; ++v)
-          batch_.in(v)[k] = v < 3 ? g_.origin[v] + double(todo_[start + k][v]) * g_.voxel : opt_.fixedCoords[v - 3];
-      const double* out = batch_.eval(tape, count);
-      for (size_t k = 0; k < count; ++k) {
-        if (std::isnan(out[k])) continue;  // not evaluated, as the sampler stores it
-        const auto& p = todo_[start + k];
-        const int64_t l = f.at(p[0], p[1], p[2]);
-        f.s.value[size_t(l)] = storedValue(out[k]);
-        evaluated.push_back(l);
-      }
-      st_.haloPointEvals += count;
-    }
-  }
-
-  const GridSpec& g_;
-  const SampleOptions& opt_;
-  uint32_t nvars_;
-  BandDistanceStats& st_;
-  IntervalEvaluator interval_;
-  BatchEvaluator<double> batch_;
-  std::vector<Interval> box_;
-  std::vector<std::array<int64_t, 3>> todo_;
-};
-
-}  // namespace
 
 std::string bandDistanceBound() {
   return "second-order estimate from the sampled lattice: f's Taylor expansion to second order (central "
@@ -133,50 +25,9 @@ void bandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOptions
   BandDistanceStats local;
   BandDistanceStats& st = stats ? *stats : local;
   if (r.leaves.empty()) return;  // tiles only: every point further than the band from a zero
-  int64_t core[2][3];
-  thread_local Scratch scratch;
-  Field f(scratch);
-  for (int a = 0; a < 3; ++a) {
-    core[0][a] = opt.regionLo[a];
-    core[1][a] = opt.regionHi[a] < 0 ? grid.dims[a] : std::min(opt.regionHi[a], grid.dims[a]);
-    f.lo[a] = std::max<int64_t>(0, core[0][a] - 1);  // a voxel of halo: the stencil's reach
-    f.hi[a] = std::min<int64_t>(grid.dims[a], core[1][a] + 1);
-    f.n[a] = f.hi[a] - f.lo[a];
-  }
-  f.s1 = f.n[2];
-  f.s0 = f.n[1] * f.n[2];
-  f.reserve();
-
-  // The region's evaluated points, then the halo's six faces (the x faces take the edges).
-  std::vector<int64_t> evaluated;
-  struct Clean {  // the thread's array clean again, also when a halo evaluation throws
-    Field& f;
-    const std::vector<int64_t>& evaluated;
-    ~Clean() {
-      for (int64_t l : evaluated) f.s.value[size_t(l)] = std::numeric_limits<float>::quiet_NaN();
-    }
-  } clean{f, evaluated};
-  for (const LeafBlock& l : r.leaves)
-    for (int n = 0; n < kLeafVoxels; ++n) {
-      if (!l.isActive(n)) continue;
-      const int64_t i = l.origin[0] + (n >> 6), j = l.origin[1] + ((n >> 3) & 7), k = l.origin[2] + (n & 7);
-      if (i >= core[1][0] || j >= core[1][1] || k >= core[1][2]) continue;
-      const int64_t at = f.at(i, j, k);
-      f.s.value[size_t(at)] = l.values[size_t(n)];
-      evaluated.push_back(at);
-    }
-  HaloSampler halos(grid, opt, tape->numVars(), st);
-  for (int a = 0; a < 3; ++a)
-    for (int side = 0; side < 2; ++side) {
-      int64_t lo[3], hi[3];
-      for (int b = 0; b < 3; ++b) {
-        lo[b] = b < a ? core[0][b] : f.lo[b];  // earlier axes' faces hold those edges already
-        hi[b] = b < a ? core[1][b] : f.hi[b];
-      }
-      if (side == 0) hi[a] = core[0][a];
-      else lo[a] = core[1][a];
-      halos.box(tape, lo, hi, f, evaluated);
-    }
+  // The region and a voxel around it (the stencil's reach), NaN where not evaluated.
+  const detail::HaloField f(tape, grid, opt, r, 1, st);
+  const int64_t core[2][3] = {{f.coreLo[0], f.coreLo[1], f.coreLo[2]}, {f.coreHi[0], f.coreHi[1], f.coreHi[2]}};
 
   // Each evaluated voxel of the region: f's gradient g and Hessian H by central differences of
   // its neighbours (one-sided, first order, where one was not evaluated), then the nearest zero
@@ -184,7 +35,7 @@ void bandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOptions
   // exactly its distance), in the stable form 2 f / (|g| + sqrt(|g|^2 - 2 f n.H.n)).
   const float background = float(opt.bandVoxels * grid.voxel);
   const double h = grid.voxel;
-  const std::vector<float>& value = f.s.value;
+  const float* value = f.values();
   const float nan = std::numeric_limits<float>::quiet_NaN();
   auto estimateLeaf = [&](LeafBlock& l) {
     for (int n = 0; n < kLeafVoxels; ++n) {
@@ -199,7 +50,7 @@ void bandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOptions
                             c[2] > f.lo[2] && c[2] + 1 < f.hi[2];
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) {
-          const float* row = value.data() + at + (i - 1) * f.s0 + (j - 1) * f.s1;
+          const float* row = value + at + (i - 1) * f.s0 + (j - 1) * f.s1;
           for (int k = 0; k < 3; ++k)
             q[i][j][k] = interior || (c[0] + i - 1 >= f.lo[0] && c[0] + i - 1 < f.hi[0] && c[1] + j - 1 >= f.lo[1] &&
                                       c[1] + j - 1 < f.hi[1] && c[2] + k - 1 >= f.lo[2] && c[2] + k - 1 < f.hi[2])
