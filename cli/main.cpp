@@ -164,7 +164,7 @@ int main(int argc, char** argv) {
   sampleCmd->add_option("--band", sample.band, "Band half-width in voxels (default 3)");
   sampleCmd->add_option("--store", sample.store,
                         "What the grid holds: sdf (signed distance, estimated per brick; default), sdf-exact (the exact "
-                        "distance to the sampled surface, redistanced on the master), raw (-f) or fog (density grid)")
+                        "distance to the samples' piecewise-linear surface, per brick), raw (-f) or fog (density grid)")
       ->check(CLI::IsMember({"sdf", "sdf-exact", "raw", "fog"}));
   sampleCmd->add_option("--threads", sample.threads, "Threads of the in-process run, --workers 0 (default 0: all cores)");
   addFarmOptions(sampleCmd, sample.farm);

@@ -22,6 +22,7 @@
 #include "sampling_grid.h"
 #include "frep/io/vdb_writer.h"
 #include "frep/sampling/band_distance.h"
+#include "frep/sampling/exact_band_distance.h"
 
 namespace frep::cli {
 namespace {
@@ -88,9 +89,10 @@ int runSample(const SampleRequest& request) {
   }
   farm::JobSpec job = makeJob(m, request.model.path, grid, "sample");
   job.set_band(request.band);
-  // The workers store the band's distance estimate (--store sdf, fog); sdf-exact redistances the
-  // merged samples on the master instead (the exact distance to their meshed zero set).
-  job.set_distance(request.store == "sdf" || request.store == "fog");
+  // The workers store the band's distance: the estimate (--store sdf, fog) or the exact distance
+  // to the samples' piecewise-linear zero set (sdf-exact); the master merges either as it is.
+  job.set_distance(request.store != "raw");
+  job.set_distance_exact(request.store == "sdf-exact");
   if (cut.faces) setCutBox(job, cutLo, cutHi);
   spdlog::info("sampling '{}' on {}x{}x{} voxels of {}", m.model.objectName, grid.dims[0], grid.dims[1],
                grid.dims[2], grid.voxel);
@@ -100,7 +102,7 @@ int runSample(const SampleRequest& request) {
   // bricks were streamed restarts the stream (a new builder; the master merges from the journal).
   std::optional<io::LevelSetBuilder> builder;
   // raw and sdf write the leaves' values as they are: the finished leaves go to a temporary file.
-  const bool spill = request.store == "raw" || request.store == "sdf";
+  const bool spill = request.store != "fog";
   builder.emplace(farm::gridOf(job), request.band, spill);  // the lattice the master merges on
   options.sampleSink.tiles = [&](const std::vector<Tile>& tiles) { builder->addTiles(tiles); };
   options.sampleSink.leaves = [&](const std::vector<LeafBlock>& slab) { builder->addLeaves(slab); };
@@ -113,7 +115,9 @@ int runSample(const SampleRequest& request) {
   farm::FarmReport& report = outcome.report;
   requireComplete(reportOut, report, request.farm.strict);
   report.cutFaces = cut.names();
-  if (job.distance()) report.errorBounds.push_back("stored value (signed distance): " + bandDistanceBound());
+  if (job.distance())
+    report.errorBounds.push_back("stored value (signed distance): " +
+                                 (job.distance_exact() ? exactBandDistanceBound() : bandDistanceBound()));
 
   io::VdbMetadata meta;
   meta.gridName = m.model.objectName;
@@ -126,6 +130,7 @@ int runSample(const SampleRequest& request) {
   meta.sourceHash = m.model.sourceHash;
   meta.iso = request.model.iso;
   meta.distanceValues = job.distance();
+  meta.exactDistance = job.distance_exact();
   jsonPhase("write");
   builder->write(out.tempPath(), meta);
   writeReportWith(reportOut, report, [&] {

@@ -2,6 +2,7 @@
 
 #include "frep/io/vdb_grid.h"
 #include "frep/sampling/band_distance.h"
+#include "frep/sampling/exact_band_distance.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/io/Compression.h>
@@ -436,7 +437,8 @@ void writeGrid(const std::string& path, openvdb::FloatGrid::Ptr grid, const Grid
   grid->insertMeta("frep_params", openvdb::StringMetadata(meta.params));
   grid->insertMeta("frep_version", openvdb::StringMetadata(FREP_VERSION));
   if (meta.store != VdbStore::Raw && meta.distanceValues)
-    grid->insertMeta("frep_distance", openvdb::StringMetadata(bandDistanceBound()));
+    grid->insertMeta("frep_distance", openvdb::StringMetadata(meta.exactDistance ? exactBandDistanceBound()
+                                                                                 : bandDistanceBound()));
 
   try {
     grid->insertMeta(kGridChecksumKey, openvdb::StringMetadata(std::string(kChecksumDigits, '0')));  // sealed below

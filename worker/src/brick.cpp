@@ -6,6 +6,7 @@
 #include "frep/extremum/extremum.h"
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/sampling/band_distance.h"
+#include "frep/sampling/exact_band_distance.h"
 
 namespace frep::farm {
 
@@ -76,7 +77,8 @@ BrickOutput computeBrickOnce(const TapePtr& tape, const JobSpec& job, const std:
   SampleResult r = sample(tape, grid, opt);
   if (job.distance()) {
     BandDistanceStats halo;
-    bandDistance(tape, grid, opt, r, &halo);
+    if (job.distance_exact()) exactBandDistance(tape, grid, opt, r, &halo);
+    else bandDistance(tape, grid, opt, r, &halo);
     r.stats.pointEvals += halo.haloPointEvals;
     r.stats.intervalEvals += halo.haloIntervalEvals;
   }

@@ -27,6 +27,9 @@ struct VdbMetadata {
   // core sampling/band_distance.h), stored as it is, with its bound in frep_distance; false:
   // the distance is computed here from -f by the mesh round trip below.
   bool distanceValues = false;
+  // With distanceValues: the workers' exact distance to the samples' piecewise-linear zero set
+  // (core sampling/exact_band_distance.h, --store sdf-exact), not the estimate: frep_distance.
+  bool exactDistance = false;
 };
 
 // Writes one FloatGrid on the world lattice (index (i, j, k) at world (i, j, k) * voxel: a pure

@@ -13,8 +13,9 @@ namespace frep::farm {
 
 // Major 2: the job once per connection (Welcome.job), tasks carry its id only. Minors of major 1
 // (all kept): 1 "render" jobs (RenderSpec), 2 ModelFile.hash (checked), 3 Hello.holding.
+// Minors of major 2: 1 JobSpec.distance_exact (--store sdf-exact computed by the workers).
 constexpr uint32_t kProtoMajor = 2;
-constexpr uint32_t kProtoMinor = 0;
+constexpr uint32_t kProtoMinor = 1;
 
 struct Incoming {
   std::string routingId;  // empty on the DEALER side
