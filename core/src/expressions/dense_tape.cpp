@@ -58,7 +58,7 @@ void DenseTape::assign(const Tape& t) {
   numVars = t.numVars();
 }
 
-void DenseSimplifier::simplify(const DenseTape& parent, const uint8_t* choices, DenseTape& out) {
+void DenseSimplifier::simplify(const DenseTape& parent, const uint8_t* choices, DenseTape& out, size_t stride) {
   const uint32_t fixed = parent.firstTemp();
   if (bind_.size() < parent.numRegs) bind_.resize(parent.numRegs);
   if (free_.size() < size_t(parent.numRegs) + 1) free_.resize(size_t(parent.numRegs) + 1);
@@ -94,8 +94,8 @@ void DenseSimplifier::simplify(const DenseTape& parent, const uint8_t* choices, 
     if (r == kNone) continue;  // not read again
     bind[ins.out] = kNone;     // earlier readers of this register read an older value
     const bool choice = ins.op == Op::Min || ins.op == Op::Max;
-    if (choice && choices[i] != 0) {
-      const uint32_t kept = choices[i] == 1 ? ins.a : ins.b;
+    if (choice && choices[i * stride] != 0) {
+      const uint32_t kept = choices[i * stride] == 1 ? ins.a : ins.b;
       if (bind[kept] == kNone) {
         bind[kept] = r;  // the kept value is computed straight into r
       } else {

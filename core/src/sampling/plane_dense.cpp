@@ -23,10 +23,9 @@ namespace {
 
 // Top tiles (the parallel grain): the passes over the whole tape are per 256 x 256 pixels.
 constexpr int kTopTile = 256;
-// Leaves of at most kLeafTile^2 pixels; float leaves of kFloatLeafTile^2 (Prospero 1024^2: 32
-// measured ~10 % faster than 16, 64 1.6x slower: the float lanes are cheap, intervals are not).
+// Leaves of at most 16 x 16 pixels, one batch (Prospero 1024^2, float signs: 8 x 8 and 32 x 32
+// measured slower, by more interval passes and simplifications or by longer batch tapes).
 constexpr int kLeafTile = 16;
-constexpr int kFloatLeafTile = 32;
 constexpr int kMaxDepth = 16;
 
 struct Worker {
@@ -35,10 +34,11 @@ struct Worker {
   DenseBatchEvaluator<float> fbatch;
   DenseBatchEvaluator<double> dbatch;
   FloatErrorBound error;
-  std::vector<DenseTape> tapes = std::vector<DenseTape>(kMaxDepth);  // the tape of each depth
-  std::vector<uint8_t> choices;
+  // Per depth: the tape of the tile being split, the choices and boxes of its quadrants.
+  std::vector<DenseTape> tapes = std::vector<DenseTape>(kMaxDepth);
+  std::vector<std::vector<uint8_t>> choices = std::vector<std::vector<uint8_t>>(kMaxDepth);
+  std::vector<std::vector<Interval>> boxes = std::vector<std::vector<Interval>>(kMaxDepth);
   std::vector<uint32_t> redo;
-  std::vector<Interval> box;
   PlaneStats stats;
   bool ready = false;
 };
@@ -48,6 +48,7 @@ class DensePlane {
   DensePlane(const TapePtr& tape, const PlaneLattice& l, const PlaneOptions& opt, std::vector<double>& out)
       : tape_(tape), l_(l), opt_(opt), out_(out), float_(opt.signOnly && opt.floatSigns) {
     root_.assign(*tape);
+    nvb_ = std::max<uint32_t>(root_.numVars, 1);
   }
 
   double colCoord(int c) const { return l_.origin[0] + double(c) * l_.step; }
@@ -67,10 +68,12 @@ class DensePlane {
     w.fbatch.bind(*tape_);
     w.dbatch.bind(*tape_);
     w.error.bind(*tape_);
-    w.choices.resize(root_.size());
-    w.box.resize(std::max<uint32_t>(root_.numVars, 1));
+    for (auto& boxes : w.boxes) {
+      boxes.resize(4 * nvb_);
+      for (size_t j = 0; j < 4; ++j)
+        for (uint32_t var = 0; var < root_.numVars; ++var) boxes[j * nvb_ + var] = Interval(held(var));
+    }
     for (uint32_t var = 0; var < root_.numVars; ++var) {
-      w.box[var] = Interval(held(var));
       if (var == l_.u || var == l_.v) continue;
       std::fill(w.fbatch.in(var), w.fbatch.in(var) + DenseBatchEvaluator<float>::kBatch, float(held(var)));
       std::fill(w.dbatch.in(var), w.dbatch.in(var) + DenseBatchEvaluator<double>::kBatch, held(var));
@@ -78,41 +81,64 @@ class DensePlane {
     w.ready = true;
   }
 
-  void top(Worker& w, int c0, int c1, int r0, int r1) { tile(w, c0, c1, r0, r1, root_, 0); }
+  void top(Worker& w, int c0, int c1, int r0, int r1) { group(w, Rect{c0, c1, r0, r1}, root_, 0); }
 
  private:
-  // Pixels [c0, c1) x [r0, r1) with the tape of the enclosing tile.
-  void tile(Worker& w, int c0, int c1, int r0, int r1, const DenseTape& tape, int depth) {
-    if (l_.u < root_.numVars) w.box[l_.u] = Interval(colCoord(c0), colCoord(c1 - 1));
-    if (l_.v < root_.numVars) w.box[l_.v] = Interval(rowCoord(r1 - 1), rowCoord(r0));
-    ++w.stats.intervalEvals;
-    w.stats.intervalInstrs += tape.size();
-    uint32_t decided = 0;
-    const Interval iv = w.interval.eval(tape, w.box.data(), w.choices.data(), &decided);
-    const int side = iv.lo > 0 ? 1 : iv.hi < 0 ? -1 : 0;
-    const uint64_t pixels = uint64_t(c1 - c0) * uint64_t(r1 - r0);
-    if (side != 0) w.stats.decidedPixels += pixels;
-    if (side != 0 && opt_.signOnly) {
-      const double fill = side > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
-      for (int r = r0; r < r1; ++r)
-        std::fill(out_.begin() + long(index(c0, r)), out_.begin() + long(index(c1, r)), fill);
-      return;
+  struct Rect {
+    int c0, c1, r0, r1;  // pixels [c0, c1) x [r0, r1)
+  };
+  bool isLeaf(const Rect& t) const { return t.c1 - t.c0 <= leafSide_ && t.r1 - t.r0 <= leafSide_; }
+
+  // The quadrants of tile p (p itself when it is a leaf already), classified in one four-lane
+  // pass of p's tape over their boxes; each is then filled (signOnly, decided), evaluated as a
+  // leaf, or split in turn, with the tape simplified by its own choices.
+  void group(Worker& w, const Rect& p, const DenseTape& tape, int depth) {
+    Rect kids[4];
+    int n = 0;
+    if (isLeaf(p)) {
+      kids[n++] = p;
+    } else {
+      const int cm = p.c1 - p.c0 > leafSide_ ? p.c0 + (p.c1 - p.c0 + 1) / 2 : p.c1;
+      const int rm = p.r1 - p.r0 > leafSide_ ? p.r0 + (p.r1 - p.r0 + 1) / 2 : p.r1;
+      kids[n++] = Rect{p.c0, cm, p.r0, rm};
+      if (cm < p.c1) kids[n++] = Rect{cm, p.c1, p.r0, rm};
+      if (rm < p.r1) kids[n++] = Rect{p.c0, cm, rm, p.r1};
+      if (cm < p.c1 && rm < p.r1) kids[n++] = Rect{cm, p.c1, rm, p.r1};
     }
-    const DenseTape* t = &tape;
-    if (decided && depth + 1 < kMaxDepth) {
-      w.simplifier.simplify(tape, w.choices.data(), w.tapes[size_t(depth + 1)]);
-      t = &w.tapes[size_t(depth + 1)];
+    // Lanes past n repeat the last tile (computed and ignored).
+    Interval* boxes = w.boxes[size_t(depth)].data();
+    for (int j = 0; j < 4; ++j) {
+      const Rect& t = kids[std::min(j, n - 1)];
+      Interval* b = boxes + size_t(j) * nvb_;
+      if (l_.u < root_.numVars) b[l_.u] = Interval(colCoord(t.c0), colCoord(t.c1 - 1));
+      if (l_.v < root_.numVars) b[l_.v] = Interval(rowCoord(t.r1 - 1), rowCoord(t.r0));
     }
-    if (c1 - c0 <= leafSide_ && r1 - r0 <= leafSide_) {
-      leaf(w, c0, c1, r0, r1, *t);
-      return;
+    std::vector<uint8_t>& choices = w.choices[size_t(depth)];
+    if (choices.size() < 4 * tape.size()) choices.resize(4 * tape.size());
+    uint32_t decided[4];
+    Interval iv[4];
+    w.interval.eval4(tape, boxes, choices.data(), decided, iv);
+    for (int j = 0; j < n; ++j) {
+      const Rect& t = kids[j];
+      ++w.stats.intervalEvals;
+      w.stats.intervalInstrs += tape.size();
+      const int side = iv[j].lo > 0 ? 1 : iv[j].hi < 0 ? -1 : 0;
+      if (side != 0) w.stats.decidedPixels += uint64_t(t.c1 - t.c0) * uint64_t(t.r1 - t.r0);
+      if (side != 0 && opt_.signOnly) {
+        const double fill =
+            side > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+        for (int r = t.r0; r < t.r1; ++r)
+          std::fill(out_.begin() + long(index(t.c0, r)), out_.begin() + long(index(t.c1, r)), fill);
+        continue;
+      }
+      const DenseTape* own = &tape;
+      if (decided[j] && depth + 1 < kMaxDepth) {
+        w.simplifier.simplify(tape, choices.data() + j, w.tapes[size_t(depth + 1)], 4);
+        own = &w.tapes[size_t(depth + 1)];
+      }
+      if (isLeaf(t)) leaf(w, t.c0, t.c1, t.r0, t.r1, *own, boxes + size_t(j) * nvb_);
+      else group(w, t, *own, depth + 1);
     }
-    const int cm = c1 - c0 > leafSide_ ? c0 + (c1 - c0 + 1) / 2 : c1;
-    const int rm = r1 - r0 > leafSide_ ? r0 + (r1 - r0 + 1) / 2 : r1;
-    tile(w, c0, cm, r0, rm, *t, depth + 1);
-    if (cm < c1) tile(w, cm, c1, r0, rm, *t, depth + 1);
-    if (rm < r1) tile(w, c0, cm, rm, r1, *t, depth + 1);
-    if (cm < c1 && rm < r1) tile(w, cm, c1, rm, r1, *t, depth + 1);
   }
 
   // Fills the u and v lanes of a batch with the pixels of the tile, row by row.
@@ -130,9 +156,9 @@ class DensePlane {
     }
   }
 
-  // A leaf tile, by batches of whole rows; w.box still holds its box.
-  void leaf(Worker& w, int c0, int c1, int r0, int r1, const DenseTape& tape) {
-    const double bound = float_ ? w.error.bound(tape, w.box.data()) : std::numeric_limits<double>::infinity();
+  // A leaf tile over the given box, by batches of whole rows.
+  void leaf(Worker& w, int c0, int c1, int r0, int r1, const DenseTape& tape, const Interval* box) {
+    const double bound = float_ ? w.error.bound(tape, box) : std::numeric_limits<double>::infinity();
     const int rows = std::max(1, int(DenseBatchEvaluator<float>::kBatch) / (c1 - c0));
     for (int ra = r0; ra < r1; ra += rows) batch(w, c0, c1, ra, std::min(r1, ra + rows), tape, bound);
   }
@@ -191,7 +217,8 @@ class DensePlane {
   const PlaneOptions& opt_;
   std::vector<double>& out_;
   bool float_;
-  int leafSide_ = float_ ? kFloatLeafTile : kLeafTile;
+  int leafSide_ = kLeafTile;
+  size_t nvb_ = 1;  // Intervals per box: max(numVars, 1)
   DenseTape root_;
 };
 

@@ -23,9 +23,18 @@ class DenseIntervalEvaluator {
   // gets, at each min/max, 0 (both sides possible), 1 or 2 (the box decides for a or b, as
   // IntervalEvaluator decides); returns how many were decided in *decided.
   Interval eval(const DenseTape& tape, const Interval* box, uint8_t* choices, uint32_t* decided);
+  // The same for four boxes in one pass (boxes[j * numVars + i]: var i of box j), each box's
+  // results those eval gives it, bit for bit: choices[4 k + j] is box j's choice at
+  // instruction k (4 * tape.size() entries), decided[j] and out[j] its count and interval.
+  void eval4(const DenseTape& tape, const Interval* boxes, uint8_t* choices, uint32_t* decided, Interval* out);
+
+  struct alignas(64) Iv4 {
+    double lo[4], hi[4];
+  };
 
  private:
   std::vector<Interval> regs_;
+  std::vector<Iv4> regs4_;
   uint32_t numUniforms_ = 0;
 };
 

@@ -43,7 +43,8 @@ class DenseSimplifier {
   // operand (renamed, or a copy when that value already has a register), unread instructions
   // are dropped, temporaries are reallocated last use first (so a tape needs few registers).
   // The values are the parent's bit for bit: the same operations on the same operands.
-  void simplify(const DenseTape& parent, const uint8_t* choices, DenseTape& out);
+  // choices[k * stride]: instruction k's (a stride of 4 reads one box of eval4's).
+  void simplify(const DenseTape& parent, const uint8_t* choices, DenseTape& out, size_t stride = 1);
 
  private:
   std::vector<uint32_t> bind_;  // parent register -> out register of its live value
