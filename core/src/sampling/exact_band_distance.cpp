@@ -20,13 +20,19 @@ namespace {
 struct Triangle {
   double v[3][3];
   double lo[3], hi[3];
+  double n[3], nn, na;  // its plane's normal (not unit), |n|^2 and n.v[0]: a cheaper lower bound
 };
 
 // The triangles of the cells that have some, and where each cell's are, by the cell's low
 // corner's index in the halo field (-1: none). Thread's arrays, kept -1 between calls.
 struct CellTriangles {
   std::vector<int32_t> first;  // index into range
-  std::vector<std::array<uint32_t, 2>> range;
+  std::vector<uint64_t> rows;  // per row of cells along z (x, y), a bit per cell that has some
+  struct Range {
+    uint32_t first, count;
+    double lo[3], hi[3];  // the box of its triangles
+  };
+  std::vector<Range> range;
   std::vector<Triangle> triangles;
 };
 
@@ -53,6 +59,12 @@ void addTriangle(const double* a, const double* b, const double* c, std::vector<
     t.lo[ax] = std::min(std::min(a[ax], b[ax]), c[ax]);
     t.hi[ax] = std::max(std::max(a[ax], b[ax]), c[ax]);
   }
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  t.n[0] = u[1] * w[2] - u[2] * w[1];
+  t.n[1] = u[2] * w[0] - u[0] * w[2];
+  t.n[2] = u[0] * w[1] - u[1] * w[0];
+  t.nn = t.n[0] * t.n[0] + t.n[1] * t.n[1] + t.n[2] * t.n[2];
+  t.na = t.n[0] * a[0] + t.n[1] * a[1] + t.n[2] * a[2];
   out.push_back(t);
 }
 
@@ -119,24 +131,23 @@ double triangle2(const double* a, const double* b, const double* c) {
   return dot(p, p);
 }
 
-// A cell at integer offset o from a voxel (its low corner minus the voxel), and the squared
-// distance from the voxel to the cell's box: a lower bound of its triangles' distances.
-struct CellOffset {
-  int o[3];
-  int gap2;
+// A row of cells along z at offset (x, y) from a voxel, and the squared distance from the voxel
+// to the row's slab in x and y: a lower bound of its cells' triangles' distances.
+struct RowOffset {
+  int x, y, gap2;
 };
 
-// The cells whose box lies within `band` voxels of a voxel, nearest first.
-std::vector<CellOffset> cellOffsets(int band) {
-  std::vector<CellOffset> out;
+int gap(int o) { return o > 0 ? o : (o + 1 < 0 ? -(o + 1) : 0); }  // to a cell at offset o
+
+// The rows of the cells whose box lies within `band` voxels of a voxel, nearest first.
+std::vector<RowOffset> rowOffsets(int band) {
+  std::vector<RowOffset> out;
   for (int x = -band; x < band; ++x)
-    for (int y = -band; y < band; ++y)
-      for (int z = -band; z < band; ++z) {
-        auto gap = [](int o) { return o > 0 ? o : (o + 1 < 0 ? -(o + 1) : 0); };
-        const int g2 = gap(x) * gap(x) + gap(y) * gap(y) + gap(z) * gap(z);
-        if (g2 < band * band) out.push_back({{x, y, z}, g2});
-      }
-  std::stable_sort(out.begin(), out.end(), [](const CellOffset& a, const CellOffset& b) { return a.gap2 < b.gap2; });
+    for (int y = -band; y < band; ++y) {
+      const int g2 = gap(x) * gap(x) + gap(y) * gap(y);
+      if (g2 < band * band) out.push_back({x, y, g2});
+    }
+  std::stable_sort(out.begin(), out.end(), [](const RowOffset& a, const RowOffset& b) { return a.gap2 < b.gap2; });
   return out;
 }
 
@@ -170,17 +181,23 @@ void exactBandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOp
   thread_local CellTriangles threadCells;
   CellTriangles& cells = threadCells;  // this thread's, also in the loop below on TBB's threads
   const size_t size = size_t(f.n[0] * f.n[1] * f.n[2]);
+  const int64_t words = (f.n[2] + 63) / 64;  // per row of cells along z: a bit per cell with triangles
   if (cells.first.size() < size) cells.first.resize(size, -1);
+  if (cells.rows.size() < size_t(f.n[0] * f.n[1] * words)) cells.rows.resize(size_t(f.n[0] * f.n[1] * words), 0);
   cells.range.clear();
   cells.triangles.clear();
   std::vector<int64_t> built;  // cells.first's entries to clear
   struct Clean {
     CellTriangles& c;
     std::vector<int64_t>& built;
+    int64_t s1, words;
     ~Clean() {
-      for (int64_t p : built) c.first[size_t(p)] = -1;
+      for (int64_t p : built) {
+        c.first[size_t(p)] = -1;
+        c.rows[size_t(p / s1 * words + p % s1 / 64)] = 0;
+      }
     }
-  } clean{cells, built};
+  } clean{cells, built, f.s1, words};
   const int64_t corner[8] = {0, 1, f.s1, f.s1 + 1, f.s0, f.s0 + 1, f.s0 + f.s1, f.s0 + f.s1 + 1};
   for (int64_t p : f.evaluated()) {
     const int64_t i = f.lo[0] + p / f.s0, j = f.lo[1] + (p % f.s0) / f.s1, k = f.lo[2] + p % f.s1;
@@ -197,7 +214,14 @@ void exactBandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOp
     const size_t before = cells.triangles.size();
     triangulateCell(q, cells.triangles);
     cells.first[size_t(p)] = int32_t(cells.range.size());
-    cells.range.push_back({uint32_t(before), uint32_t(cells.triangles.size() - before)});
+    CellTriangles::Range range{uint32_t(before), uint32_t(cells.triangles.size() - before), {1, 1, 1}, {0, 0, 0}};
+    for (size_t t = before; t < cells.triangles.size(); ++t)
+      for (int a = 0; a < 3; ++a) {
+        range.lo[a] = std::min(range.lo[a], cells.triangles[t].lo[a]);
+        range.hi[a] = std::max(range.hi[a], cells.triangles[t].hi[a]);
+      }
+    cells.range.push_back(range);
+    cells.rows[size_t(p / f.s1 * words + (p % f.s1) / 64)] |= uint64_t(1) << (p % f.s1 % 64);
     built.push_back(p);
   }
 
@@ -205,37 +229,69 @@ void exactBandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOp
   // band, nearest cells first, stopping at the first cell whose box is no nearer than the best
   // triangle so far (a fixed order from the voxel's neighbourhood alone: the same bytes in any
   // brick; the minimum is exact in any order).
-  const std::vector<CellOffset> offsets = cellOffsets(W);
+  const std::vector<RowOffset> offsets = rowOffsets(W);
+  std::vector<int> zOrder;  // the offsets along z of the cells within the band, nearest first
+  for (int k = 0; k < W; ++k) zOrder.insert(zOrder.end(), {k, -k - 1});
   const float background = float(W * grid.voxel);
   const double h = grid.voxel;
   const Triangle* triangles = cells.triangles.data();
+  // The triangles of the cell at offset o from the voxel, against the best so far.
+  auto cell = [&](int64_t p, const int* o, double& best) {
+    const CellTriangles::Range& range = cells.range[size_t(cells.first[size_t(p)])];
+    double cell2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = o[a] + range.lo[a], hi = o[a] + range.hi[a];
+      const double g = lo > 0 ? lo : (hi < 0 ? -hi : 0.0);
+      cell2 += g * g;
+    }
+    if (cell2 >= best) return;
+    for (uint32_t t = range.first; t < range.first + range.count; ++t) {
+      const Triangle& tri = triangles[t];
+      double box2 = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double lo = o[a] + tri.lo[a], hi = o[a] + tri.hi[a];
+        const double g = lo > 0 ? lo : (hi < 0 ? -hi : 0.0);
+        box2 += g * g;
+      }
+      if (box2 >= best) continue;
+      // The distance to its plane, no more than to it (a degenerate triangle has none).
+      const double plane = tri.n[0] * o[0] + tri.n[1] * o[1] + tri.n[2] * o[2] + tri.na;
+      if (tri.nn > 0 && plane * plane >= best * tri.nn) continue;
+      double v[3][3];
+      for (int k = 0; k < 3; ++k)
+        for (int a = 0; a < 3; ++a) v[k][a] = o[a] + tri.v[k][a];
+      best = std::min(best, triangle2(v[0], v[1], v[2]));
+    }
+  };
   auto leafDistance = [&](LeafBlock& l) {
     for (int n = 0; n < kLeafVoxels; ++n) {
       if (!l.isActive(n)) continue;
       const int64_t c[3] = {l.origin[0] + (n >> 6), l.origin[1] + ((n >> 3) & 7), l.origin[2] + (n & 7)};
       if (c[0] >= f.coreHi[0] || c[1] >= f.coreHi[1] || c[2] >= f.coreHi[2]) continue;
       double best = double(W) * double(W);
-      for (const CellOffset& o : offsets) {
-        if (double(o.gap2) >= best) break;
-        const int64_t x = c[0] + o.o[0], y = c[1] + o.o[1], z = c[2] + o.o[2];
-        if (x < f.lo[0] || y < f.lo[1] || z < f.lo[2] || x + 1 >= f.hi[0] || y + 1 >= f.hi[1] || z + 1 >= f.hi[2])
-          continue;
-        const int32_t id = cells.first[size_t(f.at(x, y, z))];
-        if (id < 0) continue;
-        const auto [first, count] = cells.range[size_t(id)];
-        for (uint32_t t = first; t < first + count; ++t) {
-          const Triangle& tri = triangles[t];
-          double box2 = 0;
-          for (int a = 0; a < 3; ++a) {
-            const double lo = o.o[a] + tri.lo[a], hi = o.o[a] + tri.hi[a];
-            const double g = lo > 0 ? lo : (hi < 0 ? -hi : 0.0);
-            box2 += g * g;
-          }
-          if (box2 >= best) continue;
-          double v[3][3];
-          for (int k = 0; k < 3; ++k)
-            for (int a = 0; a < 3; ++a) v[k][a] = o.o[a] + tri.v[k][a];
-          best = std::min(best, triangle2(v[0], v[1], v[2]));
+      // Rows nearest first; in a row, its cells with triangles nearest first.
+      const int64_t zlo = std::max(c[2] - W, f.lo[2]) - f.lo[2], zhi = std::min(c[2] + W - 1, f.hi[2] - 2) - f.lo[2];
+      const int64_t cz = c[2] - f.lo[2];
+      for (const RowOffset& r : offsets) {
+        if (double(r.gap2) >= best) break;
+        const int64_t x = c[0] + r.x, y = c[1] + r.y;
+        if (x < f.lo[0] || y < f.lo[1] || x + 1 >= f.hi[0] || y + 1 >= f.hi[1]) continue;
+        const int64_t row = (x - f.lo[0]) * f.s0 + (y - f.lo[1]) * f.s1;
+        const uint64_t* bits = cells.rows.data() + size_t(row / f.s1 * words);
+        bool any = false;
+        for (int64_t wz = zlo / 64; wz <= zhi / 64 && !any; ++wz) {
+          uint64_t b = bits[wz];
+          if (wz == zlo / 64) b &= ~uint64_t(0) << (zlo % 64);
+          if (wz == zhi / 64 && zhi % 64 != 63) b &= (uint64_t(1) << (zhi % 64 + 1)) - 1;
+          any = b != 0;
+        }
+        if (!any) continue;
+        for (const int oz : zOrder) {  // gaps 0, 0, 1, 1, 2, 2, ...
+          if (double(r.gap2 + gap(oz) * gap(oz)) >= best) break;
+          const int64_t z = cz + oz;
+          if (z < zlo || z > zhi || !((bits[z / 64] >> (z % 64)) & 1)) continue;
+          const int o[3] = {r.x, r.y, oz};
+          cell(row + z, o, best);
         }
       }
       const uint64_t bit = uint64_t(1) << (n & 63);
