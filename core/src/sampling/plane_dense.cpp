@@ -26,7 +26,9 @@ constexpr int kTopTile = 256;
 // Leaves of at most 16 x 16 pixels, one batch (Prospero 1024^2, float signs: 8 x 8 and 32 x 32
 // measured slower, by more interval passes and simplifications or by longer batch tapes).
 constexpr int kLeafTile = 16;
+// Buffers per depth: the top tile's, then one per halving down to the leaves.
 constexpr int kMaxDepth = 16;
+static_assert((kTopTile >> (kMaxDepth - 2)) <= kLeafTile, "a depth's buffers for every halving");
 
 struct Worker {
   DenseIntervalEvaluator interval;
@@ -81,13 +83,48 @@ class DensePlane {
     w.ready = true;
   }
 
-  void top(Worker& w, int c0, int c1, int r0, int r1) { group(w, Rect{c0, c1, r0, r1}, root_, 0); }
+  // A top tile: one single-box pass over the whole tape first (its simplified tape, some 10x
+  // shorter on Prospero, is what the quadrants' four-lane pass and simplifications then walk).
+  void top(Worker& w, int c0, int c1, int r0, int r1) {
+    const Rect t{c0, c1, r0, r1};
+    Interval* box = w.boxes[0].data();
+    setBox(box, t);
+    if (w.choices[0].size() < root_.size()) w.choices[0].resize(root_.size());
+    uint32_t decided = 0;
+    const Interval iv = w.interval.eval(root_, box, w.choices[0].data(), &decided);
+    if (decide(w, t, iv, root_.size())) return;
+    const DenseTape* own = &root_;
+    if (decided) {
+      w.simplifier.simplify(root_, w.choices[0].data(), w.tapes[0]);
+      own = &w.tapes[0];
+    }
+    if (isLeaf(t)) leaf(w, c0, c1, r0, r1, *own, box);
+    else group(w, t, *own, 0);
+  }
 
  private:
   struct Rect {
     int c0, c1, r0, r1;  // pixels [c0, c1) x [r0, r1)
   };
   bool isLeaf(const Rect& t) const { return t.c1 - t.c0 <= leafSide_ && t.r1 - t.r0 <= leafSide_; }
+  void setBox(Interval* b, const Rect& t) const {
+    if (l_.u < root_.numVars) b[l_.u] = Interval(colCoord(t.c0), colCoord(t.c1 - 1));
+    if (l_.v < root_.numVars) b[l_.v] = Interval(rowCoord(t.r1 - 1), rowCoord(t.r0));
+  }
+
+  // Counts tile t's interval pass (over a tape of `size` instructions); with signOnly, fills it
+  // when the interval decides its sign and says so.
+  bool decide(Worker& w, const Rect& t, const Interval& iv, size_t size) {
+    ++w.stats.intervalEvals;
+    w.stats.intervalInstrs += size;
+    const int side = iv.lo > 0 ? 1 : iv.hi < 0 ? -1 : 0;
+    if (side != 0) w.stats.decidedPixels += uint64_t(t.c1 - t.c0) * uint64_t(t.r1 - t.r0);
+    if (side == 0 || !opt_.signOnly) return false;
+    const double fill = side > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+    for (int r = t.r0; r < t.r1; ++r)
+      std::fill(out_.begin() + long(index(t.c0, r)), out_.begin() + long(index(t.c1, r)), fill);
+    return true;
+  }
 
   // The quadrants of tile p (p itself when it is a leaf already), classified in one four-lane
   // pass of p's tape over their boxes; each is then filled (signOnly, decided), evaluated as a
@@ -105,34 +142,20 @@ class DensePlane {
       if (rm < p.r1) kids[n++] = Rect{p.c0, cm, rm, p.r1};
       if (cm < p.c1 && rm < p.r1) kids[n++] = Rect{cm, p.c1, rm, p.r1};
     }
-    // Lanes past n repeat the last tile (computed and ignored).
-    Interval* boxes = w.boxes[size_t(depth)].data();
-    for (int j = 0; j < 4; ++j) {
-      const Rect& t = kids[std::min(j, n - 1)];
-      Interval* b = boxes + size_t(j) * nvb_;
-      if (l_.u < root_.numVars) b[l_.u] = Interval(colCoord(t.c0), colCoord(t.c1 - 1));
-      if (l_.v < root_.numVars) b[l_.v] = Interval(rowCoord(t.r1 - 1), rowCoord(t.r0));
-    }
-    std::vector<uint8_t>& choices = w.choices[size_t(depth)];
+    // Lanes past n repeat the last tile (computed and ignored); depth + 1's box buffers, as
+    // depth 0's holds the top tile's.
+    Interval* boxes = w.boxes[size_t(depth + 1)].data();
+    for (int j = 0; j < 4; ++j) setBox(boxes + size_t(j) * nvb_, kids[std::min(j, n - 1)]);
+    std::vector<uint8_t>& choices = w.choices[size_t(depth + 1)];
     if (choices.size() < 4 * tape.size()) choices.resize(4 * tape.size());
     uint32_t decided[4];
     Interval iv[4];
     w.interval.eval4(tape, boxes, choices.data(), decided, iv);
     for (int j = 0; j < n; ++j) {
       const Rect& t = kids[j];
-      ++w.stats.intervalEvals;
-      w.stats.intervalInstrs += tape.size();
-      const int side = iv[j].lo > 0 ? 1 : iv[j].hi < 0 ? -1 : 0;
-      if (side != 0) w.stats.decidedPixels += uint64_t(t.c1 - t.c0) * uint64_t(t.r1 - t.r0);
-      if (side != 0 && opt_.signOnly) {
-        const double fill =
-            side > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
-        for (int r = t.r0; r < t.r1; ++r)
-          std::fill(out_.begin() + long(index(t.c0, r)), out_.begin() + long(index(t.c1, r)), fill);
-        continue;
-      }
+      if (decide(w, t, iv[j], tape.size())) continue;
       const DenseTape* own = &tape;
-      if (decided[j] && depth + 1 < kMaxDepth) {
+      if (decided[j]) {
         w.simplifier.simplify(tape, choices.data() + j, w.tapes[size_t(depth + 1)], 4);
         own = &w.tapes[size_t(depth + 1)];
       }
