@@ -244,15 +244,16 @@ inline __attribute__((always_inline)) void unaryLoop(const T* a, bool ac, T* o, 
 }
 
 // No __restrict on o: an output may be one of its inputs' registers (lane i reads, then writes i).
+// Register r >= nu is regs[(r - nu) * B ...], a constant r < nu is consts[r].
 template <typename T>
-FREP_CLONES void runDense(const DenseInstr* code, size_t size, T* regs, size_t n, uint32_t nu) {
+FREP_CLONES void runDense(const DenseInstr* code, size_t size, const T* consts, T* regs, size_t n, uint32_t nu) {
   constexpr size_t B = DenseBatchEvaluator<T>::kBatch;
   for (size_t k = 0; k < size; ++k) {
     const DenseInstr& ins = code[k];
-    const T* a = regs + size_t(ins.a) * B;
-    const T* b = regs + size_t(ins.b) * B;
-    T* o = regs + size_t(ins.out) * B;
     const bool ac = ins.a < nu, bc = ins.b < nu;
+    const T* a = ac ? consts + ins.a : regs + size_t(ins.a - nu) * B;
+    const T* b = bc ? consts + ins.b : regs + size_t(ins.b - nu) * B;
+    T* o = regs + size_t(ins.out - nu) * B;
     switch (ins.op) {
       case Op::Add:
         binaryLoop(a, ac, b, bc, o, n, [](T x, T y) { return x + y; });
@@ -294,15 +295,16 @@ template <typename T>
 void DenseBatchEvaluator<T>::bind(const Tape& root) {
   const auto& u = root.uniforms();
   numUniforms_ = uint32_t(u.size());
-  // The constants and vars; temporaries as tapes need them (reserve): pruned ones need few.
-  const size_t fixed = size_t(numUniforms_ + root.numVars()) * kBatch;
-  if (regs_.size() < fixed) regs_.resize(fixed);
-  for (size_t i = 0; i < u.size(); ++i) regs_[i * kBatch] = T(u[i]);
+  consts_.resize(u.size());
+  for (size_t i = 0; i < u.size(); ++i) consts_[i] = T(u[i]);
+  // The vars; temporaries as tapes need them (reserve): pruned ones need few.
+  if (regs_.size() < size_t(root.numVars()) * kBatch) regs_.resize(size_t(root.numVars()) * kBatch);
 }
 
 template <typename T>
 void DenseBatchEvaluator<T>::reserve(const DenseTape& tape) {
-  if (regs_.size() < size_t(tape.numRegs) * kBatch) regs_.resize(size_t(tape.numRegs) * kBatch);
+  const size_t need = size_t(tape.numRegs - numUniforms_) * kBatch;
+  if (regs_.size() < need) regs_.resize(need);
 }
 
 template <typename T>
@@ -310,8 +312,11 @@ const T* DenseBatchEvaluator<T>::eval(const DenseTape& tape, size_t count) {
   reserve(tape);
   // Whole vectors: the lanes past count are computed and ignored.
   const size_t n = std::min(kBatch, (count + 7) & ~size_t(7));
-  runDense<T>(tape.code.data(), tape.code.size(), regs_.data(), n, numUniforms_);
-  return regs_.data() + size_t(tape.result) * kBatch;
+  runDense<T>(tape.code.data(), tape.code.size(), consts_.data(), regs_.data(), n, numUniforms_);
+  if (tape.result >= numUniforms_) return regs_.data() + size_t(tape.result - numUniforms_) * kBatch;
+  // A constant model (a tape with no instruction)
+  result_.assign(kBatch, consts_[tape.result]);
+  return result_.data();
 }
 
 template class DenseBatchEvaluator<float>;

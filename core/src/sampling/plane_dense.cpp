@@ -51,6 +51,7 @@ class DensePlane {
       : tape_(tape), l_(l), opt_(opt), out_(out), float_(opt.signOnly && opt.floatSigns) {
     root_.assign(*tape);
     nvb_ = std::max<uint32_t>(root_.numVars, 1);
+    for (int c = 0; c < l.width; ++c) colD_.push_back(colCoord(c)), colF_.push_back(float(colCoord(c)));
   }
 
   double colCoord(int c) const { return l_.origin[0] + double(c) * l_.step; }
@@ -167,16 +168,19 @@ class DensePlane {
   // Fills the u and v lanes of a batch with the pixels of the tile, row by row.
   template <typename T>
   void coordinates(DenseBatchEvaluator<T>& b, int c0, int c1, int r0, int r1) const {
-    T* us = l_.u < root_.numVars ? b.in(l_.u) : nullptr;
-    T* vs = l_.v < root_.numVars ? b.in(l_.v) : nullptr;
-    size_t k = 0;
-    for (int r = r0; r < r1; ++r) {
-      const T v = T(rowCoord(r));
-      for (int c = c0; c < c1; ++c, ++k) {
-        if (us) us[k] = T(colCoord(c));
-        if (vs) vs[k] = v;
-      }
-    }
+    const size_t cols = size_t(c1 - c0);
+    const T* cs = columns<T>() + c0;
+    if (l_.u < root_.numVars)
+      for (size_t k = 0, r = size_t(r0); r < size_t(r1); ++r, k += cols) std::copy(cs, cs + cols, b.in(l_.u) + k);
+    if (l_.v < root_.numVars)
+      for (size_t k = 0, r = size_t(r0); r < size_t(r1); ++r, k += cols)
+        std::fill(b.in(l_.v) + k, b.in(l_.v) + k + cols, T(rowCoord(int(r))));
+  }
+  // Every column's u, in double and rounded to float (the leaves' coordinates, computed once).
+  template <typename T>
+  const T* columns() const {
+    if constexpr (sizeof(T) == sizeof(float)) return colF_.data();
+    else return colD_.data();
   }
 
   // A leaf tile over the given box, by batches of whole rows.
@@ -241,6 +245,8 @@ class DensePlane {
   std::vector<double>& out_;
   bool float_;
   int leafSide_ = kLeafTile;
+  std::vector<double> colD_;
+  std::vector<float> colF_;
   size_t nvb_ = 1;  // Intervals per box: max(numVars, 1)
   DenseTape root_;
 };

@@ -44,7 +44,7 @@ class DenseBatchEvaluator {
   static constexpr size_t kBatch = 256;
   void bind(const Tape& root);
   // Lanes of var i for the next eval (after bind; valid until the next bind or reserve).
-  T* in(uint32_t var) { return regs_.data() + size_t(numUniforms_ + var) * kBatch; }
+  T* in(uint32_t var) { return regs_.data() + size_t(var) * kBatch; }
   // Makes room for the tape's registers; call before filling in() for a tape with more
   // registers than any before.
   void reserve(const DenseTape& tape);
@@ -52,7 +52,9 @@ class DenseBatchEvaluator {
   const T* eval(const DenseTape& tape, size_t count);
 
  private:
-  std::vector<T> regs_;  // register-major, kBatch lanes each; a constant's lane 0 holds it
+  std::vector<T> consts_;  // register r < numUniforms_: one value
+  std::vector<T> regs_;    // register r >= numUniforms_: kBatch lanes from (r - numUniforms_) * kBatch
+  std::vector<T> result_;  // a constant result's lanes
   uint32_t numUniforms_ = 0;
 };
 extern template class DenseBatchEvaluator<float>;
