@@ -3,7 +3,8 @@
 // on the Prospero challenge text (Fidget's 7,866-op model, ../shared/corpus/fidget/prospero.hf)
 // at 1024^2: wall and CPU milliseconds (best of 5), the ratios, and that the values agree bit
 // for bit; then sign images in double and in float with the certified double fallback
-// (PlaneOptions::floatSigns), whose signs must all be the baseline's. Usage: bench_slice [model.hf] [side]
+// (PlaneOptions::floatSigns), whose signs must all be the baseline's; each by the general path and
+// by dense tapes (PlaneOptions::denseTapes). Usage: bench_slice [model.hf] [side]
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -41,7 +42,8 @@ Timing best(int repeats, const std::function<void()>& fn) {
     const double c0 = cpuSeconds();
     const auto w0 = std::chrono::steady_clock::now();
     fn();
-    t.wallMs = std::min(t.wallMs, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count());
+    t.wallMs =
+        std::min(t.wallMs, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count());
     t.cpuMs = std::min(t.cpuMs, 1e3 * (cpuSeconds() - c0));
   }
   return t;
@@ -96,39 +98,50 @@ int main(int argc, char** argv) {
   std::vector<double> ref, fast, mask, fmask;
   const Timing tb = best(3, [&] { ref = bruteForce(tape, l); });
   std::printf("%s at %dx%d: %zu instructions, %u registers\n", path.c_str(), side, side, tape->size(), tape->numRegs());
-  std::printf("%-52s %10s %10s %9s %9s\n", "", "wall ms", "CPU ms", "vs base", "vs same");
+  std::printf("%-52s %10s %10s %9s %9s\n", "", "wall ms", "CPU ms", "vs base", "vs general");
   std::printf("%-52s %10.1f %10.1f %9s\n", "every pixel, full tape, 1 thread (baseline)", tb.wallMs, tb.cpuMs, "1.0x");
-  // Rows: values in double, signs in double, signs in float with the double fallback; "vs same"
-  // compares with the double values row of the same thread count.
-  Timing values[3] = {};
-  PlaneStats floatStats, work[3];
+  // Rows: values in double, signs in double, signs in float with the double fallback, each by
+  // the general path (pruned Tapes, one tile per interval pass: "before") and by dense tapes
+  // (PlaneOptions::denseTapes, the default); "vs general" compares with the general path's row
+  // of the same mode and thread count.
+  PlaneStats floatStats, work[3][2];
+  const char* name[3] = {"values", "signs (--mask), double", "signs, float + fallback"};
   for (int mode = 0; mode < 3; ++mode) {
-    for (int threads : {1, 2}) {
-      PlaneOptions o;
-      o.signOnly = mode > 0;
-      o.floatSigns = mode == 2;
-      o.threads = threads;
-      PlaneStats st;
-      std::vector<double>& out = mode == 0 ? fast : mode == 1 ? mask : fmask;
-      const Timing t = best(5, [&] { out = evaluatePlane(tape, l, o, &st); });
-      if (mode == 0) values[threads] = t;
-      if (mode == 2) floatStats = st;
-      work[mode] = st;
-      const char* name[3] = {"pruned quadtree, double values", "sign only (--mask), double", "sign only, float + double fallback"};
-      char label[96];
-      std::snprintf(label, sizeof label, "%s, %d thr (tape %.0f)", name[mode], threads,
-                    st.tapeBatches ? double(st.tapeInstrs) / double(st.tapeBatches) : 0.0);
-      // CPU time is the figure on a shared machine (wall time includes other processes' turns)
-      std::printf("%-52s %10.1f %10.1f %8.1fx %8.2fx\n", label, t.wallMs, t.cpuMs, tb.cpuMs / t.cpuMs,
-                  values[threads].cpuMs / t.cpuMs);
+    Timing general[3] = {};
+    for (int dense : {0, 1}) {
+      for (int threads : {1, 2}) {
+        PlaneOptions o;
+        o.signOnly = mode > 0;
+        o.floatSigns = mode == 2;
+        o.threads = threads;
+        o.denseTapes = dense == 1;
+        PlaneStats st;
+        std::vector<double>& out = mode == 0 ? fast : mode == 1 ? mask : fmask;
+        std::vector<double> got;
+        const Timing t = best(dense ? 15 : 5, [&] { got = evaluatePlane(tape, l, o, &st); });
+        // the dense rows' images are the ones checked against the baseline below
+        if (dense) out = got;
+        if (!dense) general[threads] = t;
+        if (mode == 2 && dense) floatStats = st;
+        work[mode][dense] = st;
+        char label[96];
+        std::snprintf(label, sizeof label, "%s, %s, %d thr (tape %.0f)", name[mode], dense ? "dense" : "general",
+                      threads, st.tapeBatches ? double(st.tapeInstrs) / double(st.tapeBatches) : 0.0);
+        // CPU time is the figure on a shared machine (wall time includes other processes' turns)
+        std::printf("%-52s %10.1f %10.1f %8.1fx %8.2fx\n", label, t.wallMs, t.cpuMs, tb.cpuMs / t.cpuMs,
+                    general[threads].cpuMs / t.cpuMs);
+      }
     }
   }
   // Work that does not depend on the machine's load: tape instructions run by the interval
-  // passes (each also prunes a tape that long) and by the batches (one per 256 lanes).
+  // passes (one per tile; each also prunes a tape that long) and by the batches (one per
+  // 256 lanes).
   for (int mode = 0; mode < 3; ++mode)
-    std::printf("work, %s: %.2fM interval instructions, %.2fM batch instructions\n",
-                mode == 0 ? "double values" : mode == 1 ? "double signs" : "float signs", 1e-6 * double(work[mode].intervalInstrs),
-                1e-6 * double(work[mode].tapeInstrs));
+    for (int dense : {0, 1})
+      std::printf("work, %s, %s: %.2fM interval instructions, %.2fM batch instructions, %llu pixels in double\n",
+                  name[mode], dense ? "dense" : "general", 1e-6 * double(work[mode][dense].intervalInstrs),
+                  1e-6 * double(work[mode][dense].tapeInstrs),
+                  (unsigned long long)(mode == 2 ? work[mode][dense].doublePixels : work[mode][dense].pointEvals));
   std::printf("%-52s %10.1f\n", "Fidget, published (VM interpreter)", 6.0);
   std::printf("%-52s %10.1f\n", "Fidget, published (JIT)", 4.6);
   std::printf("float sign path: %llu pixels certified in float, %llu recomputed in double, %llu decided by tiles\n",
@@ -142,7 +155,9 @@ int main(int argc, char** argv) {
     if (cls(ref[i]) != cls(mask[i])) ++signs;
     if (cls(ref[i]) != cls(fmask[i])) ++floatSigns;
   }
-  std::printf("pruned values differing from the baseline's bits: %zu; pixels of another sign than the baseline's: "
-              "%zu sign-only, %zu float\n", differ, signs, floatSigns);
+  std::printf(
+      "pruned values differing from the baseline's bits: %zu; pixels of another sign than the baseline's: "
+      "%zu sign-only, %zu float\n",
+      differ, signs, floatSigns);
   return differ || signs || floatSigns ? 1 : 0;
 }

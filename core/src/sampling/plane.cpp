@@ -1,4 +1,5 @@
-// Quadtree evaluation of a plane lattice (see plane.h).
+// Quadtree evaluation of a plane lattice (see plane.h): the general path, for every model;
+// models of the arithmetic subset take plane_dense.cpp's (PlaneOptions::denseTapes).
 //
 // The image is cut into fixed 256-pixel tiles (the parallel grain, independent of the thread
 // count); each tile is classified by interval arithmetic over the box of its pixel centres,
@@ -215,7 +216,7 @@ std::vector<double> evaluatePlane(const TapePtr& tape, const PlaneLattice& l, co
   if (!(l.step > 0) || !std::isfinite(l.step)) throw std::invalid_argument("evaluatePlane: pixel step must be positive");
   if (l.u == l.v) throw std::invalid_argument("evaluatePlane: the image axes must differ");
   std::vector<double> out(size_t(l.width) * size_t(l.height));
-  if (DenseTape::supports(*tape)) {
+  if (opt.denseTapes && DenseTape::supports(*tape)) {
     PlaneStats st;
     evaluatePlaneDense(tape, l, opt, out, st);
     if (stats) *stats = st;

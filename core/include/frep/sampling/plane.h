@@ -44,6 +44,11 @@ struct PlaneOptions {
   // certified pixels are the float ones. Tapes the bound does not cover stay in double.
   bool floatSigns = false;
   int threads = 0;  // 0: TBB's default, 1: serial
+  // Models of the arithmetic subset (DenseTape::supports: + - * neg abs sqrt square min max)
+  // run on dense tapes, simplified per tile in one backward pass, four sibling tiles per
+  // interval pass (frep/expressions/dense_tape.h); false: the general path for every model
+  // (bench_slice's baseline). Same values and signs either way.
+  bool denseTapes = true;
 };
 
 // width * height values, row-major from the top row.
