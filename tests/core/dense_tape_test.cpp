@@ -203,8 +203,11 @@ TEST(DenseTape, FourBoxesAtOnceAreFourSingleBoxes) {
         EXPECT_EQ(bits(r.lo), bits(out4[j].lo));
         EXPECT_EQ(bits(r.hi), bits(out4[j].hi));
         EXPECT_EQ(d1, d4[j]);
-        for (size_t i = 0; i < root.size(); ++i)
-          if (root.code[i].op == Op::Min || root.code[i].op == Op::Max) ASSERT_EQ(one[i], four[4 * i + size_t(j)]);
+        for (size_t i = 0; i < root.size(); ++i) {
+          if (root.code[i].op == Op::Min || root.code[i].op == Op::Max) {
+            ASSERT_EQ(one[i], four[4 * i + size_t(j)]);
+          }
+        }
         ++lanes;
         decided += d1 > 0;
       }
