@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """frep sample on the chair, each row of issue 35's table against its baseline in one run:
-the default store (the workers' band distance) against --store raw, two local workers against
+the default store (the workers' band distance) and --store sdf-exact (the workers' exact distance to the
+samples' piecewise-linear zero set) against --store raw, two local workers against
 one, the master's peak RSS (the report's peak_rss_bytes) per size, and the sparse sampler's
 evaluations against a dense grid. Every configuration runs ROUNDS times in turn (alternated,
 so the machine's load falls on all of them alike) and the medians are compared; the machine is
@@ -52,7 +53,7 @@ def median(runs, key):
 rss = {}  # (res, store) -> median master peak RSS (MiB), 2 workers
 with tempfile.TemporaryDirectory() as tmp:
     for res in RESES:
-        configs = [("raw", 1), ("raw", 2), ("sdf", 1), ("sdf", 2)]
+        configs = [("raw", 1), ("raw", 2), ("sdf", 1), ("sdf", 2), ("sdf-exact", 2)]
         runs = {c: [] for c in configs}
         for _ in range(ROUNDS):
             for store, workers in configs:
@@ -68,6 +69,10 @@ with tempfile.TemporaryDirectory() as tmp:
         print("  default (sdf) / raw store, 2 workers: %.2fx wall (goal <= 1.3x), %.2fx CPU; RSS %.2fx" %
               (sdf2 / raw2, median(runs[("sdf", 2)], "cpu") / median(runs[("raw", 2)], "cpu"),
                median(runs[("sdf", 2)], "rss") / median(runs[("raw", 2)], "rss")))
+        exact2 = median(runs[("sdf-exact", 2)], "wall")
+        print("  sdf-exact / raw store, 2 workers: %.2fx wall (goal <= 1.5x), %.2fx CPU; RSS %.2fx" %
+              (exact2 / raw2, median(runs[("sdf-exact", 2)], "cpu") / median(runs[("raw", 2)], "cpu"),
+               median(runs[("sdf-exact", 2)], "rss") / median(runs[("raw", 2)], "rss")))
         for store in ("raw", "sdf"):
             print("  farm speed-up 1 -> 2 workers, --store %s: %.2fx (goal >= 1.9x)" %
                   (store, median(runs[(store, 1)], "wall") / median(runs[(store, 2)], "wall")))
@@ -78,6 +83,9 @@ with tempfile.TemporaryDirectory() as tmp:
         run(res, "sdf", 0, os.path.join(tmp, "sdf0.vdb"))
         same = [open(os.path.join(tmp, "sdf%d.vdb" % w), "rb").read() for w in (0, 1, 2)]
         print("  same bytes for 0, 1 and 2 workers: %s" % ("yes" if same[0] == same[1] == same[2] else "NO"))
+        run(res, "sdf-exact", 0, os.path.join(tmp, "sdf-exact0.vdb"))
+        same = [open(os.path.join(tmp, "sdf-exact%d.vdb" % w), "rb").read() for w in (0, 2)]
+        print("  sdf-exact: same bytes for 0 and 2 workers: %s" % ("yes" if same[0] == same[1] else "NO"))
 
 # Memory flat in the output size (issue 35): the master's peak RSS per size against the first
 # size's, in the same run. The output (leaves, file) grows about 4x a doubling of the resolution.
