@@ -71,11 +71,20 @@ std::string FarmReport::toJson() const {
                        {"unavailable", verifyUnavailable.empty() ? nlohmann::json() : nlohmann::json(verifyUnavailable)},
                        {"restreamed", restreamed}};
   j["workers_seen"] = workersSeen;
+  j["master_cpu_seconds"] = masterCpuSeconds;
+  j["master_cpu_after_last_brick"] = masterCpuAfterLastBrick;
   nlohmann::json w = nlohmann::json::object();
   for (auto& [id, s] : perWorker)
     w[id] = {{"bricks", s.bricks},
              {"point_evals", s.pointEvals},
              {"compute_seconds", s.computeSeconds},
+             {"results", s.results},
+             {"compute_cpu_seconds", s.computeCpuSeconds},
+             {"task_cpu_seconds", s.taskCpuSeconds},
+             {"process_cpu_seconds", s.processCpuSeconds},
+             {"idle_seconds", s.idleSeconds},
+             {"first_idle_seconds", s.firstIdleSeconds},
+             {"tail_idle_seconds", s.tailIdleSeconds},
              {"share", pointEvals ? double(s.pointEvals) / double(pointEvals) : 0.0}};
   j["per_worker"] = w;
   nlohmann::json p = nlohmann::json::array();

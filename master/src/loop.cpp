@@ -245,6 +245,7 @@ void Master::handle(zmq::socket_t& router, Incoming& in, const std::string& err)
     case Envelope::kHeartbeat:
       break;
     case Envelope::kResult:
+      noteWorkerTime(p.workerId, e.result());
       onResult(router, in, p);
       break;
     case Envelope::kFailed:
@@ -257,6 +258,37 @@ void Master::handle(zmq::socket_t& router, Incoming& in, const std::string& err)
     default:
       ++report_.malformed;
       break;
+  }
+}
+
+// The worker's account of its time, from every result it sends (the worker's word: a report's
+// diagnostics only, docs/farm.md "Scaling").
+void Master::noteWorkerTime(const std::string& workerId, const Result& r) {
+  WorkerShare& s = workerTime_[workerId];
+  ++s.results;
+  s.computeCpuSeconds += r.compute_cpu_seconds();
+  s.taskCpuSeconds += r.task_cpu_seconds();
+  s.processCpuSeconds = std::max(s.processCpuSeconds, r.process_cpu_seconds());
+  s.idleSeconds += r.idle_seconds();
+  if (s.firstIdleSeconds < 0) s.firstIdleSeconds = r.idle_seconds();
+  lastResultAt_[workerId] = Clock::now();
+}
+
+// The workers' time counters to the report, for the workers with a brick merged (the others
+// are not in it), and each one's tail: from its last result to the job's last.
+void Master::reportWorkerTime() {
+  Clock::time_point last{};
+  for (auto& [w, t] : lastResultAt_) last = std::max(last, t);
+  for (auto& [w, share] : report_.perWorker) {
+    auto t = workerTime_.find(w);
+    if (t == workerTime_.end()) continue;  // in-process, or bricks from the journal
+    share.results = t->second.results;
+    share.computeCpuSeconds = t->second.computeCpuSeconds;
+    share.taskCpuSeconds = t->second.taskCpuSeconds;
+    share.processCpuSeconds = t->second.processCpuSeconds;
+    share.idleSeconds = t->second.idleSeconds;
+    share.firstIdleSeconds = t->second.firstIdleSeconds;
+    share.tailIdleSeconds = std::chrono::duration<double>(last - lastResultAt_[w]).count();
   }
 }
 

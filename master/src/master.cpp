@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstring>
 #include <random>
+#include <time.h>
 
 #include "frep/farm/crc32.h"
 #include "master.h"
@@ -40,6 +41,13 @@ struct SignalScope {
 
 int decodeThreadsFor(int requested) { return requested > 0 ? requested : defaultDecodeThreads(); }
 
+// The master process's CPU so far (FarmReport::masterCpuSeconds).
+double processCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 }  // namespace
 
 Master::Master(const JobSpec& job, const FarmOptions& opt)
@@ -66,6 +74,7 @@ Master::Master(const JobSpec& job, const FarmOptions& opt)
 FarmOutcome Master::run() {
   SignalScope signals;
   start_ = Clock::now();
+  const double cpu0 = processCpuSeconds();
   if (streaming_) merger_ = std::thread([this] { mergeSlabs(); });
   std::optional<uint64_t> journalSeed;
   if (!opt_.journalPath.empty()) {
@@ -106,7 +115,13 @@ FarmOutcome Master::run() {
   // 600 MB). It stays in the page cache meanwhile, so only a crash of the machine itself
   // while the output is written can lose records, which a resume recomputes.
   if (journal_ && leases_.done() < bricks_.size()) journal_->flush();
-  return finish();
+  const double cpuLoop = processCpuSeconds();
+  reportWorkerTime();
+  FarmOutcome outcome = finish();
+  const double cpu1 = processCpuSeconds();
+  outcome.report.masterCpuSeconds = cpu1 - cpu0;
+  outcome.report.masterCpuAfterLastBrick = cpu1 - cpuLoop;
+  return outcome;
 }
 
 // --verify (FarmOptions::verifyFraction): the sample's seed (the journal's on a resume, else the

@@ -210,6 +210,12 @@ class Master {
   std::map<std::string, Peer>& peers() { return leases_.peers(); }
 
   void onResult(zmq::socket_t& router, Incoming& in, Peer& p);
+  void noteWorkerTime(const std::string& workerId, const Result& r);
+  void reportWorkerTime();
+  // By worker id: the time counters of every result received (WorkerShare's; they go to the
+  // report for the workers that have a brick merged), and when the last one came in.
+  std::map<std::string, WorkerShare> workerTime_;
+  std::map<std::string, Clock::time_point> lastResultAt_;
 
   void verifyArrivals(zmq::socket_t& router);
 

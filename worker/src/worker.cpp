@@ -4,6 +4,7 @@
 #include "frep/worker/worker.h"
 
 #include <spdlog/spdlog.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -35,6 +36,19 @@ std::string makeWorkerId() {
   gethostname(host, sizeof host - 1);
   std::random_device rd;
   return std::string(host) + "-" + std::to_string(getpid()) + "-" + std::to_string(rd() % 100000);
+}
+
+// CPU seconds of the calling thread, and of the whole process (the scaling counters of a Result).
+double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+double processCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 struct Outgoing {
@@ -116,17 +130,28 @@ class ComputeThread {
 
  private:
   void loop() {
+    auto idleSince = Clock::now();  // the compute thread's last brick ended (or it started)
     for (;;) {
       Lease lease;
+      double idle = 0;
       {
         std::unique_lock<std::mutex> l(mutex_);
         cv_.wait(l, [&] { return stop_ || !queue_.empty(); });
         if (stop_) return;
+        idle = std::chrono::duration<double>(Clock::now() - idleSince).count();
         lease = std::move(queue_.front());
         queue_.pop_front();
         running_ = std::make_unique<Lease>(lease);
       }
+      const double cpu0 = threadCpuSeconds();
       Outgoing out = compute(lease);
+      if (out.env.has_result()) {
+        Result* r = out.env.mutable_result();
+        r->set_idle_seconds(idle);
+        r->set_task_cpu_seconds(threadCpuSeconds() - cpu0);
+        r->set_process_cpu_seconds(processCpuSeconds());
+      }
+      idleSince = Clock::now();
       {
         std::lock_guard<std::mutex> l(mutex_);
         running_.reset();
@@ -173,8 +198,10 @@ class ComputeThread {
       if (task.lo_size() != 3 || task.hi_size() != 3) throw std::invalid_argument("task: lo/hi need 3 values");
       std::array<int32_t, 3> lo{task.lo(0), task.lo(1), task.lo(2)}, hi{task.hi(0), task.hi(1), task.hi(2)};
       auto t0 = Clock::now();
+      const double cpu0 = threadCpuSeconds();
       const Operation op = operationOf(job);
       BrickOutput b = computeBrick(tape, job, lo, hi, threads_);
+      const double computeCpu = threadCpuSeconds() - cpu0;
       double secs = std::chrono::duration<double>(Clock::now() - t0).count();
       out.payload = encodePayload(op, b);
       out.hasPayload = true;
@@ -190,6 +217,7 @@ class ComputeThread {
       r->set_nan_values(b.stats.nanValues);
       r->set_payload_crc32(crc32Of(out.payload.data(), out.payload.size()));
       r->set_compute_seconds(secs);
+      r->set_compute_cpu_seconds(computeCpu);
       for (uint64_t n : b.stats.domainErrors.n) r->add_domain_errors(n);
       r->set_extremum_searches(b.extremumSearches);
       r->set_extremum_uncertified(b.extremumUncertified);

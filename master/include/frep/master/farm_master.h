@@ -102,6 +102,16 @@ struct FarmOptions {
 struct WorkerShare {
   uint64_t bricks = 0, pointEvals = 0;
   double computeSeconds = 0;
+  // Where the worker's time went, by its own results (docs/farm.md, "Scaling"): every result it
+  // sent (merged or not: results - bricks are the duplicates it computed), the CPU its compute
+  // thread spent in computeBrick and on whole tasks (the difference: model look-up, encoding,
+  // CRC), its process's CPU by its last result (the rest: start-up, compiling the job, the I/O
+  // thread's receiving and sending), and the time its compute thread waited with no task.
+  uint64_t results = 0;
+  double computeCpuSeconds = 0, taskCpuSeconds = 0, processCpuSeconds = 0, idleSeconds = 0;
+  double firstIdleSeconds = -1;  // of those, the wait for its first task (start-up); -1: no result yet
+  // From its last result to the job's last one: done while others still computed (the tail).
+  double tailIdleSeconds = 0;
 };
 
 struct PoisonedBrick {
@@ -154,6 +164,9 @@ struct FarmReport {
   double extremumWidestGap = 0;  // the widest gap an uncertified search left (infinite: unknown)
   std::vector<std::string> errorBounds;  // one line per extremum node of the model
   int workersSeen = 0;
+  // The master's own CPU (its process, every thread; local workers are other processes): the
+  // whole job, and after its last brick came in (the final merge; farm_master.cpp, runJob).
+  double masterCpuSeconds = 0, masterCpuAfterLastBrick = 0;
   std::map<std::string, WorkerShare> perWorker;  // by worker id ("in-process" for --workers 0)
   std::vector<PoisonedBrick> poisoned;
   bool interrupted = false;  // SIGTERM/SIGINT: journal flushed, resume with --resume
