@@ -300,12 +300,18 @@ void LeaseTable::dispatch(LeaseTime now, const Send& send) {
     }
     queue.insert(queue.begin(), skipped.begin(), skipped.end());
   };
-  for (int round = 0; round < kCredit; ++round)
+  // With several peers, a peer's (round + 1)-th brick only while the queue holds `round` for
+  // every peer: near the end of the job a worker's credit would keep bricks queued behind its
+  // running one while another worker, done, waits with nothing (docs/farm.md, "Scaling").
+  for (int round = 0; round < kCredit; ++round) {
+    const size_t reachable =
+        size_t(std::count_if(peers_.begin(), peers_.end(), [](auto& kv) { return !kv.second.unreachable; }));
     for (auto& rid : rids) {
       auto it = peers_.find(rid);
       if (it == peers_.end() || it->second.unreachable || int(it->second.inflight.size()) > round ||
           holdsSuspect(it->second))
         continue;
+      if (round > 0 && reachable > 1 && reissue_.empty() && pending_.size() < size_t(round) * reachable) continue;
       // A suspect brick goes only alone to a worker that has shown it is alive, a fresh one
       // unless it has waited two liveness windows for one (onDeath).
       const PeerLease& cand = it->second;
@@ -329,6 +335,7 @@ void LeaseTable::dispatch(LeaseTime now, const Send& send) {
       if (!next) continue;
       lease(rid, it->second, bricks_[*next], now, send);
     }
+  }
   // Stragglers: nothing queued and a worker idle -> the oldest long-running brick, once more.
   if (!pending_.empty() || !suspects_.empty()) return;
   double threshold = std::max(1.0, 2 * medianBrickSeconds());

@@ -58,7 +58,7 @@ struct Fixture {
 };
 
 TEST(LeaseTable, EachPeerGetsItsCreditOfBricksInOrder) {
-  Fixture f(10);
+  Fixture f(20);
   f.join("a");
   f.join("b");
   f.dispatch();
@@ -71,7 +71,7 @@ TEST(LeaseTable, EachPeerGetsItsCreditOfBricksInOrder) {
   EXPECT_EQ(f.inflight("a"), (std::vector<uint64_t>{0, 2, 4, 6}));
   EXPECT_EQ(f.table.brick(0).phase, BrickPhase::Leased);
   EXPECT_EQ(f.table.brick(0).attempts, 1u);
-  EXPECT_EQ(f.table.brick(9).phase, BrickPhase::Pending);
+  EXPECT_EQ(f.table.brick(19).phase, BrickPhase::Pending);
   // A merged brick frees its holder's credit: the next pending brick goes to it.
   f.finish("a", 0);
   f.sent.clear();
@@ -79,6 +79,32 @@ TEST(LeaseTable, EachPeerGetsItsCreditOfBricksInOrder) {
   ASSERT_EQ(f.sent.size(), 1u);
   EXPECT_EQ(f.sent[0], std::make_pair(std::string("a"), uint64_t(8)));
   EXPECT_EQ(f.table.done(), 1u);
+}
+
+// Near the end of the job the credit shrinks: a peer's (r + 1)-th brick only while the queue
+// holds r for every peer, so that a worker does not keep bricks queued behind its running one
+// while another, done, has nothing (the tail of a 2-worker run).
+TEST(LeaseTable, NearTheEndAPeerGetsAnotherBrickOnlyWhileTheQueueHasOneForEveryPeer) {
+  Fixture f(5);
+  f.join("a");
+  f.join("b");
+  f.dispatch();
+  // a0 b1 (3 left); round 1 needs 2: a2 (2 left), b3 (1 left); round 2 needs 4: none.
+  EXPECT_EQ(f.inflight("a"), (std::vector<uint64_t>{0, 2}));
+  EXPECT_EQ(f.inflight("b"), (std::vector<uint64_t>{1, 3}));
+  EXPECT_EQ(f.table.brick(4).phase, BrickPhase::Pending);
+  // b finishes both: brick 4 goes to it (round 0), not as a's third.
+  f.finish("b", 1);
+  f.finish("b", 3);
+  f.sent.clear();
+  f.dispatch();
+  ASSERT_EQ(f.sent.size(), 1u);
+  EXPECT_EQ(f.sent[0], std::make_pair(std::string("b"), uint64_t(4)));
+  // A peer alone keeps its whole credit (AnIdlePeerGetsTheOldestStragglerOnce).
+  Fixture g(5);
+  g.join("a");
+  g.dispatch();
+  EXPECT_EQ(g.inflight("a"), (std::vector<uint64_t>{0, 1, 2, 3}));
 }
 
 TEST(LeaseTable, ASilentPeerIsDeadAfterItsWindowAndItsBricksGoBack) {
