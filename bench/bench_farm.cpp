@@ -382,11 +382,13 @@ int main(int argc, char** argv) {
   }
   applyAllocatorPolicy();  // the master here stands in for frep sample's, which applies it too
   const bool masterOnly = argc >= 2 && std::string(argv[1]) == "--master-only";
-  // --master-only --streaming: only the streamed runs (profiling the merge into a sink).
+  // --master-only --streaming: only the streamed runs (profiling the merge into a sink);
+  // --master-only --building: only the runs that build the whole output (decoding on all cores).
   const bool streamingOnly = masterOnly && argc == 3 && std::string(argv[2]) == "--streaming";
+  const bool buildingOnly = masterOnly && argc == 3 && std::string(argv[2]) == "--building";
   double brickSeconds = 0;
   if (!masterOnly) brickSeconds = workerSpeedUp();
-  if (!streamingOnly) taskCost();
+  if (!streamingOnly && !buildingOnly) taskCost();
 
   // 3. The master's own ceiling: a 1024^3 grid in 64^3 bricks = 4096 bricks, each answered at
   //    once with 128 leaf blocks (a surface crossing a 64^3 brick, 150 kB), with a journal.
@@ -411,7 +413,7 @@ int main(int argc, char** argv) {
   std::vector<double> rate[4], cpuPerBrick[4];
   for (int round = 0; round < 3; ++round)
     for (int mode = 0; mode < 4; ++mode) {
-      if (streamingOnly && mode < 2) continue;
+      if ((streamingOnly && mode < 2) || (buildingOnly && mode != 1)) continue;
       const int fakes = fakeCount[mode];
       MasterRun m = masterRun(fakes, 1024, 64, leavesPerBrick, mode == 0 ? 1 : 0, mode >= 2);
       rate[mode].push_back(double(m.bricks) / m.wall);
@@ -421,7 +423,7 @@ int main(int argc, char** argv) {
                   fakes, label[mode], (unsigned long long)m.bricks, m.wall, rate[mode].back(),
                   1e6 * m.processCpu / double(m.bricks), 1e6 * m.loopCpu / double(m.bricks), m.peakRssMb, 1e6 * m.fakesCpu / double(m.bricks));
     }
-  if (streamingOnly) return 0;
+  if (streamingOnly || buildingOnly) return 0;
   auto median = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
