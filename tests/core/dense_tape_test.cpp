@@ -194,6 +194,7 @@ TEST(DenseTape, FourBoxesAtOnceAreFourSingleBoxes) {
       // Unbounded and point boxes too: lanes that take the lane-by-lane path (applyOp).
       if (k % 5 == 0) boxes[rng() % 12].lo = -INFINITY;
       if (k % 7 == 0) boxes[rng() % 12] = Interval(0.25);
+      if (k % 3 == 0) boxes[rng() % 12] = Interval(-0.0, 0.0);  // zeros: the outward steps' edge
       uint32_t d4[4];
       Interval out4[4];
       di.eval4(root, boxes, four.data(), d4, out4);

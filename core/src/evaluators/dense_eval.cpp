@@ -77,6 +77,7 @@ namespace {
 #pragma GCC diagnostic ignored "-Wpsabi"
 typedef double V4 __attribute__((vector_size(32)));
 typedef int64_t M4 __attribute__((vector_size(32)));
+typedef uint64_t U4 __attribute__((vector_size(32)));  // bit steps wrap (NaN lanes, discarded)
 
 inline V4 load4(const double* p) {
   V4 v;
@@ -93,9 +94,9 @@ inline V4 vmax(V4 a, V4 b) { return sel(a < b, b, a); }  // std::max(a, b)
 inline V4 up4(V4 x) {
   const V4 zero = {0, 0, 0, 0}, inf = {INFINITY, INFINITY, INFINITY, INFINITY};
   const V4 y = x + zero;  // -0 -> +0
-  M4 bits;
+  U4 bits;
   std::memcpy(&bits, &y, sizeof bits);
-  bits += (y < zero) | 1;
+  bits += U4((y < zero) | 1);
   V4 r;
   std::memcpy(&r, &bits, sizeof r);
   return sel(x < inf, r, x);
