@@ -67,9 +67,9 @@ TEST(Farm, WorkerKilledMidBrickIsReplaced) {
   FarmOutcome ref = runJob(j, fast(0));
   FarmOptions o = fast(0);
   MasterThread m(j, o);
-  WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=30"});
+  WorkerProcess steady(m.endpoint(), {slowMs(30)});
   StartedFile victimStarted("victim");
-  WorkerProcess victim(m.endpoint(), {"FREP_TEST_SLOW_MS=400", victimStarted.env()});
+  WorkerProcess victim(m.endpoint(), {slowMs(400), victimStarted.env()});
   ASSERT_TRUE(victimStarted.wait()) << "the victim never started a brick";  // it holds one now
   kill(victim.pid, SIGKILL);
   victim.wait();
@@ -89,10 +89,10 @@ TEST(Farm, StoppedWorkerPastLivenessThenContinuedChangesNothing) {
   // The sleeper starts alone and is stopped once it holds a brick (a fixed delay missed that on
   // a loaded machine); the steady worker then has to finish the job.
   StartedFile started("sleeper");
-  WorkerProcess sleeper(m.endpoint(), {"FREP_TEST_SLOW_MS=40", started.env()});
+  WorkerProcess sleeper(m.endpoint(), {slowMs(40), started.env()});
   ASSERT_TRUE(started.wait()) << "the worker never started a brick";
   kill(sleeper.pid, SIGSTOP);
-  WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=40"});
+  WorkerProcess steady(m.endpoint(), {slowMs(40)});
   // It stays stopped until the master has counted it dead (5 x 100 ms of silence), unless the
   // job ended first.
   waitUntil([&] { return m.finished || log.count("silent past its liveness window") > 0; });
@@ -108,9 +108,9 @@ TEST(Farm, SigtermedWorkerHandsItsBrickBack) {
   FarmOutcome ref = runJob(j, fast(0));
   FarmOptions o = fast(0);
   MasterThread m(j, o);
-  WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=30"});
+  WorkerProcess steady(m.endpoint(), {slowMs(30)});
   StartedFile leaverStarted("leaver");
-  WorkerProcess leaver(m.endpoint(), {"FREP_TEST_SLOW_MS=500", leaverStarted.env()});
+  WorkerProcess leaver(m.endpoint(), {slowMs(500), leaverStarted.env()});
   ASSERT_TRUE(leaverStarted.wait()) << "the leaver never started a brick";  // it holds one now
   kill(leaver.pid, SIGTERM);
   EXPECT_EQ(leaver.wait(), 0);
@@ -180,7 +180,7 @@ TEST(Farm, AJournalRecordChangedBeforeTheMergeIsRefused) {
   o.journalPath = journal;
   o.heldPayloadBytes = 0;
   MasterThread m(job(96), o);  // 27 bricks, one slow worker: the job lasts seconds after its first record
-  WorkerProcess w(m.endpoint(), {"FREP_TEST_SLOW_MS=200"});
+  WorkerProcess w(m.endpoint(), {slowMs(200)});
   const std::uintmax_t firstPayload = 12 + 20;  // journal header, then the first record's
   auto firstRecordWritten = [&] {  // its header and its whole payload
     std::error_code ec;

@@ -12,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <future>
@@ -70,15 +71,36 @@ inline JobSpec partJob(const std::string& operation, int res) {
   return j;
 }
 
-// Heartbeats of 100 ms so that dead workers are found within half a second.
+// The factor by which every time the tests set or wait is stretched: FREP_TEST_TIME_SCALE (at
+// least 1, default 1). The sanitizer runs set it (tests/sanitize/run_sanitizers.sh): TSan slows
+// every process several times, and a heartbeat of 100 ms then misses its window on a loaded
+// machine. Heartbeats, liveness windows, timeouts and the pauses measured against them grow
+// together, so what a test compares (a death against a window, a window against a stall) holds.
+inline double timeScale() {
+  static const double scale = [] {
+    const char* e = std::getenv("FREP_TEST_TIME_SCALE");
+    const double v = e ? std::atof(e) : 1;
+    return v >= 1 ? v : 1;
+  }();
+  return scale;
+}
+inline int scaledMs(int ms) { return int(ms * timeScale()); }
+inline int scaledSec(int s) { return scaledMs(s * 1000) / 1000; }
+inline std::chrono::milliseconds scaled(std::chrono::milliseconds d) {
+  return std::chrono::milliseconds(scaledMs(int(d.count())));
+}
+// A test hook's pause (FREP_TEST_SLOW_MS=ms for the worker), scaled like the heartbeats.
+inline std::string slowMs(int ms) { return "FREP_TEST_SLOW_MS=" + std::to_string(scaledMs(ms)); }
+
+// Heartbeats of 100 ms (times the scale) so that dead workers are found within half a second.
 inline FarmOptions fast(int workers, int brick = 32) {
   FarmOptions o;
   o.workers = workers;
   o.brickVoxels = brick;
-  o.heartbeatMs = 100;
+  o.heartbeatMs = scaledMs(100);
   o.liveness = 5;
   o.workerExecutable = FREP_WORKER_PATH;
-  o.noWorkerTimeoutSec = 30;
+  o.noWorkerTimeoutSec = scaledSec(30);
   return o;
 }
 
@@ -100,9 +122,10 @@ inline void tearJournal(const std::string& path, int records, size_t tornBytes) 
 // Polls `pred` until it holds or `timeout` has passed; returns whether it held. Tests wait for
 // the condition they need (a worker holds a brick, the master logged what it did) instead of a
 // fixed time, which is slow where the machine is fast and too short where it is loaded.
+// Timeouts are scaled (timeScale()).
 template <class Pred>
 bool waitUntil(Pred pred, std::chrono::milliseconds timeout = std::chrono::seconds(30)) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  const auto deadline = std::chrono::steady_clock::now() + scaled(timeout);
   for (;;) {
     if (pred()) return true;
     if (std::chrono::steady_clock::now() >= deadline) return false;
@@ -176,7 +199,7 @@ struct WorkerProcess {
                          std::vector<std::string> extra = {}) {
     std::vector<std::string> args{FREP_WORKER_PATH, "--connect", endpoint, "--threads", "1", "--log-level", "off"};
     if (std::find(extra.begin(), extra.end(), "--master-timeout") == extra.end())
-      args.insert(args.end(), {"--master-timeout", "5"});
+      args.insert(args.end(), {"--master-timeout", std::to_string(scaledSec(5))});
     args.insert(args.end(), extra.begin(), extra.end());
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
@@ -189,7 +212,7 @@ struct WorkerProcess {
     envp.push_back(nullptr);
     EXPECT_EQ(posix_spawn(&pid, FREP_WORKER_PATH, nullptr, nullptr, argv.data(), envp.data()), 0);
   }
-  // The exit code (128 + signal if killed); -2 if it had to be killed after timeoutSec.
+  // The exit code (128 + signal if killed); -2 if it had to be killed after timeoutSec (scaled).
   int wait(int timeoutSec = 60) {
     int status = 0;
     if (!waitUntil([&] { return waitpid(pid, &status, WNOHANG) != 0; }, std::chrono::seconds(timeoutSec))) {
@@ -235,10 +258,11 @@ struct MasterThread {
   void join() { thread.join(); }
 };
 
-// The envelopes of one kind a scripted peer receives within `ms`, or until `count` of them arrived.
+// The envelopes of one kind a scripted peer receives within `ms` (scaled), or until `count` of
+// them arrived.
 inline std::vector<Envelope> collectEnvelopes(zmq::socket_t& s, Envelope::BodyCase kind, size_t count, int ms) {
   std::vector<Envelope> got;
-  auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(scaledMs(ms));
   while (got.size() < count && std::chrono::steady_clock::now() < deadline) {
     zmq::pollitem_t item{static_cast<void*>(s), 0, ZMQ_POLLIN, 0};
     zmq::poll(&item, 1, std::chrono::milliseconds(20));

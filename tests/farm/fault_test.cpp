@@ -118,7 +118,7 @@ TEST(Faults, StoppedMasterDoesNotCountItsWorkersDead) {
   ASSERT_GE(child, 0);
   if (child == 0) {  // the master, with two local workers that take 60 ms a brick
     close(fds[0]);
-    setenv("FREP_TEST_SLOW_MS", "60", 1);
+    setenv("FREP_TEST_SLOW_MS", std::to_string(scaledMs(60)).c_str(), 1);
     setenv("FREP_TEST_STARTED_FILE", started.path.c_str(), 1);
     char line[256];
     try {
@@ -136,8 +136,8 @@ TEST(Faults, StoppedMasterDoesNotCountItsWorkersDead) {
   EXPECT_TRUE(started.wait());  // workers joined, bricks running
   kill(child, SIGSTOP);
   // The stall itself is under test: the master must stay stopped for longer than the liveness
-  // window (0.5 s), three windows as the test says; nothing to wait for but time.
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  // window (0.5 s, scaled), three windows as the test says; nothing to wait for but time.
+  std::this_thread::sleep_for(scaled(std::chrono::milliseconds(1500)));
   kill(child, SIGCONT);
   std::string got;
   char buf[256];

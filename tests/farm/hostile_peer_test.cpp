@@ -21,9 +21,9 @@ namespace {
 FarmOptions clusterOptions() {
   FarmOptions o;
   o.brickVoxels = 32;
-  o.heartbeatMs = 100;
+  o.heartbeatMs = scaledMs(100);
   o.liveness = 3;
-  o.noWorkerTimeoutSec = 20;
+  o.noWorkerTimeoutSec = scaledSec(20);
   return o;
 }
 
@@ -456,7 +456,7 @@ TEST(HostilePeer, APeerThatFailsEverythingIsBannedAndTheJobCompletes) {
   // It fails bricks before the honest worker joins: those wait for another worker.
   waitUntil([&] { return failer.failed >= 8; }, std::chrono::seconds(5));
   EXPECT_GE(failer.failed, 8);
-  WorkerProcess honest(ep, {"FREP_TEST_SLOW_MS=20"});
+  WorkerProcess honest(ep, {slowMs(20)});
   master.join();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(honest.wait(30), 0);

@@ -63,9 +63,9 @@ TEST(MeshFarm, WorkerKilledMidJobChangesNothing) {
   MasterThread m(j, fast(0));
   // The steady worker keeps the queue busy past the victim's liveness window (27 x 100 ms), so
   // the victim's brick is requeued as a death, not merely copied as a straggler.
-  WorkerProcess steady(m.endpoint(), {"FREP_TEST_SLOW_MS=100"});
+  WorkerProcess steady(m.endpoint(), {slowMs(100)});
   StartedFile victimStarted("mesh_victim");
-  WorkerProcess victim(m.endpoint(), {"FREP_TEST_SLOW_MS=400", victimStarted.env()});
+  WorkerProcess victim(m.endpoint(), {slowMs(400), victimStarted.env()});
   ASSERT_TRUE(victimStarted.wait()) << "the victim never started a brick";  // it holds one now
   kill(victim.pid, SIGKILL);
   victim.wait();

@@ -23,8 +23,8 @@ namespace {
 FarmOptions clusterOptions() {
   FarmOptions o;
   o.brickVoxels = 32;
-  o.heartbeatMs = 100;
-  o.noWorkerTimeoutSec = 20;
+  o.heartbeatMs = scaledMs(100);
+  o.noWorkerTimeoutSec = scaledSec(20);
   return o;
 }
 
@@ -139,8 +139,8 @@ TEST(Protocol, BrickForAPeerThatVanishedGoesBackToTheQueue) {
   FarmOutcome ref = runJob(j, inProcess);
   ASSERT_EQ(ref.report.bricks, 2u);
   FarmOptions o = clusterOptions();
-  o.heartbeatMs = 400;  // liveness window 2.4 s: the vanished peer stays registered meanwhile
-  o.noWorkerTimeoutSec = 5;
+  o.heartbeatMs = scaledMs(400);  // liveness window 2.4 s: the vanished peer stays registered meanwhile
+  o.noWorkerTimeoutSec = scaledSec(5);
   MasterThread master(j, o);
   const std::string ep = master.endpoint();
 
@@ -372,7 +372,7 @@ struct FakeMaster {
   void welcome(const std::string& rid, const JobSpec& job, uint64_t jobId) {
     Envelope w;
     w.set_job_id(jobId);
-    w.mutable_welcome()->set_heartbeat_ms(100);
+    w.mutable_welcome()->set_heartbeat_ms(uint32_t(scaledMs(100)));
     *w.mutable_welcome()->mutable_job() = job;
     send(router, rid, w);
   }

@@ -55,7 +55,7 @@ struct RogueMaster {
   Incoming runBrick(const JobSpec& job, double* seconds) {
     Envelope w;
     w.set_job_id(jobIdOf(job));
-    w.mutable_welcome()->set_heartbeat_ms(100);
+    w.mutable_welcome()->set_heartbeat_ms(uint32_t(scaledMs(100)));
     *w.mutable_welcome()->mutable_job() = job;
     send(router, worker, w);
     Envelope t;

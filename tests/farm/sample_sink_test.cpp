@@ -216,9 +216,9 @@ FarmOutcome scriptedJob(const std::string& journal, const SampleSink& sink, bool
   JobSpec j = partJob("sample", 128);  // 4 x 4 x 4 bricks of 32
   FarmOptions o;
   o.brickVoxels = 32;
-  o.heartbeatMs = 500;
+  o.heartbeatMs = scaledMs(500);
   o.liveness = 10;
-  o.noWorkerTimeoutSec = 30;
+  o.noWorkerTimeoutSec = scaledSec(30);
   o.journalPath = journal;
   o.sampleSink = sink;
   MasterThread m(j, o);

@@ -28,9 +28,9 @@ constexpr int kBricks = 64, kPerSlab = 16;
 FarmOptions clusterOptions(double verify, uint64_t seed = 0) {
   FarmOptions o;
   o.brickVoxels = 16;
-  o.heartbeatMs = 100;
+  o.heartbeatMs = scaledMs(100);
   o.liveness = 5;
-  o.noWorkerTimeoutSec = 20;
+  o.noWorkerTimeoutSec = scaledSec(20);
   o.verifyFraction = verify;
   o.verifySeed = seed;
   return o;
@@ -329,7 +329,7 @@ TEST(Verify, WithoutAThirdWorkerADisagreementPoisonsAndALoneWorkerIsMergedUnchec
   JobSpec j = sphereJob();
   {
     FarmOptions o = clusterOptions(1);
-    o.noWorkerTimeoutSec = 2;
+    o.noWorkerTimeoutSec = scaledSec(2);
     MasterThread master(j, o);
     const std::string ep = master.endpoint();
     ForgingPeer forger(ep, "forger");
@@ -345,7 +345,7 @@ TEST(Verify, WithoutAThirdWorkerADisagreementPoisonsAndALoneWorkerIsMergedUnchec
   }
   {
     FarmOptions o = clusterOptions(0.5, 3);
-    o.noWorkerTimeoutSec = 2;
+    o.noWorkerTimeoutSec = scaledSec(2);
     MasterThread master(j, o);
     WorkerProcess lone(master.endpoint());
     master.join();
