@@ -5,6 +5,7 @@
 // every-pixel values, with the double signs in float.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -215,4 +216,84 @@ TEST(DenseTape, FourBoxesAtOnceAreFourSingleBoxes) {
     }
   }
   EXPECT_GT(decided, lanes / 4);
+}
+
+TEST(DenseTape, OneSimplifierAcrossRootsIsAFreshOne) {
+  // The simplifier enters a root's constants once; roots with more or fewer constants in turn
+  // must still give what a fresh simplifier gives.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-2.0, 2.0), w(0.01, 0.8);
+  DenseSimplifier shared;
+  size_t checked = 0;
+  for (int m = 0; m < 30; ++m) {
+    TapePtr tape = Tape::compile(arithmeticCsg(rng, 2 + m % 5), 3);
+    DenseTape root;
+    root.assign(*tape);
+    DenseIntervalEvaluator di;
+    di.bind(*tape);
+    std::vector<uint8_t> choices(root.size());
+    Interval box[3];
+    for (auto& b : box) {
+      const double c = u(rng), h = w(rng);
+      b = Interval(c - h, c + h);
+    }
+    uint32_t decided = 0;
+    di.eval(root, box, choices.data(), &decided);
+    DenseTape a, b;
+    shared.simplify(root, choices.data(), a);
+    DenseSimplifier().simplify(root, choices.data(), b);
+    ASSERT_EQ(a.size(), b.size()) << "model " << m;
+    EXPECT_EQ(a.numRegs, b.numRegs);
+    EXPECT_EQ(a.result, b.result);
+    for (size_t k = 0; k < a.size(); ++k) {
+      EXPECT_EQ(a.code[k].op, b.code[k].op);
+      EXPECT_EQ(a.code[k].out, b.code[k].out);
+      EXPECT_EQ(a.code[k].a, b.code[k].a);
+      EXPECT_EQ(a.code[k].b, b.code[k].b);
+    }
+    checked += a.size();
+  }
+  EXPECT_GT(checked, 100u);
+}
+
+TEST(DenseTape, SlicesOfEverySizeAreEveryPixelsValues) {
+  // From one pixel to images the planner splits twice above the top tiles (256 pixels),
+  // square or not, through leaf-sized images that skip the tile passes.
+  std::mt19937_64 rng(17);
+  const int sizes[][2] = {{1, 1}, {5, 3}, {16, 16}, {17, 40}, {257, 3}, {520, 700}, {1030, 90}};
+  for (const auto& s : sizes) {
+    TapePtr tape = Tape::compile(arithmeticCsg(rng, 5), 3);
+    PlaneLattice l;
+    l.normal = 2, l.at = -0.2;
+    l.origin[0] = -1.9, l.origin[1] = -2.0;
+    l.width = s[0], l.height = s[1];
+    l.step = 3.9 / double(std::max(s[0], s[1]));
+    std::vector<double> ref(size_t(l.width) * size_t(l.height));
+    BatchEvaluator<double> be;
+    be.reserve(*tape);
+    for (int r = 0; r < l.height; ++r)
+      for (int c0 = 0; c0 < l.width; c0 += int(BatchEvaluator<double>::kBatch)) {
+        const int n = std::min(int(BatchEvaluator<double>::kBatch), l.width - c0);
+        for (int k = 0; k < n; ++k) {
+          be.in(0)[k] = l.origin[0] + double(c0 + k) * l.step;
+          be.in(1)[k] = l.origin[1] + double(l.height - 1 - r) * l.step;
+          be.in(2)[k] = l.at;
+        }
+        const double* f = be.eval(*tape, size_t(n));
+        std::copy(f, f + n, ref.begin() + long(size_t(r) * size_t(l.width) + size_t(c0)));
+      }
+    for (int mode = 0; mode < 3; ++mode) {
+      PlaneOptions o;
+      o.signOnly = mode > 0;
+      o.floatSigns = mode == 2;
+      o.threads = 1 + mode % 2;
+      const std::vector<double> got = evaluatePlane(tape, l, o);
+      size_t wrong = 0;
+      for (size_t i = 0; i < ref.size(); ++i) {
+        if (mode == 0) wrong += bits(ref[i]) != bits(got[i]);
+        else wrong += (ref[i] >= 0) != (got[i] >= 0) || std::isnan(ref[i]) != std::isnan(got[i]);
+      }
+      EXPECT_EQ(wrong, 0u) << s[0] << " x " << s[1] << " mode " << mode;
+    }
+  }
 }

@@ -1,7 +1,8 @@
-// evaluatePlane on a DenseTape (plane_dense.h), in Fidget's shape: fixed top tiles (the
-// parallel grain) classified by intervals over the whole tape, each tile's tape simplified in
-// one backward pass (DenseSimplifier) into a per-depth buffer of its thread (no allocation once
-// warm), split in four down to leaf tiles of one batch, whose pixels are evaluated with the
+// evaluatePlane on a DenseTape (plane_dense.h), in Fidget's shape: the image split in four by
+// four-box interval passes down to top tiles (the parallel grain, planned on one thread), each
+// tile's tape simplified from its parent's in one backward pass (DenseSimplifier) into a
+// per-depth buffer of its thread (no allocation once warm), split in four down to leaf tiles
+// of one batch, whose pixels are evaluated with the
 // leaf's short, densely numbered tape. Float leaves (signOnly + floatSigns) keep a pixel's float
 // value where it exceeds the certified bound over the leaf's box (FloatErrorBound) and recompute
 // the others in double on the same tape, so every sign is the double path's.
@@ -29,6 +30,9 @@ constexpr int kLeafTile = 16;
 // Buffers per depth: the top tile's, then one per halving down to the leaves.
 constexpr int kMaxDepth = 16;
 static_assert((kTopTile >> (kMaxDepth - 2)) <= kLeafTile, "a depth's buffers for every halving");
+// The planner's deepest split: at most 4^6 tasks, each then up to 1/64 of the image's side (a
+// lattice would need sides of millions of pixels to outgrow the tasks' kMaxDepth buffers).
+constexpr int kPlanDepth = 6;
 
 struct Worker {
   DenseIntervalEvaluator interval;
@@ -84,29 +88,40 @@ class DensePlane {
     w.ready = true;
   }
 
-  // A top tile: one single-box pass over the whole tape first (its simplified tape, some 10x
-  // shorter on Prospero, is what the quadrants' four-lane pass and simplifications then walk).
-  void top(Worker& w, int c0, int c1, int r0, int r1) {
-    const Rect t{c0, c1, r0, r1};
-    Interval* box = w.boxes[0].data();
-    setBox(box, t);
-    if (w.choices[0].size() < root_.size()) w.choices[0].resize(root_.size());
-    uint32_t decided = 0;
-    const Interval iv = w.interval.eval(root_, box, w.choices[0].data(), &decided);
-    if (decide(w, t, iv, root_.size())) return;
-    const DenseTape* own = &root_;
-    if (decided) {
-      w.simplifier.simplify(root_, w.choices[0].data(), w.tapes[0]);
-      own = &w.tapes[0];
-    }
-    if (isLeaf(t)) leaf(w, c0, c1, r0, r1, *own, box);
-    else group(w, t, *own, 0);
-  }
-
- private:
   struct Rect {
     int c0, c1, r0, r1;  // pixels [c0, c1) x [r0, r1)
   };
+  // A tile of at most kTopTile (or a part the planner stopped at) with its simplified tape
+  // (the root's: rootTape).
+  struct Task {
+    Rect t;
+    DenseTape tape;
+    bool rootTape = false;
+  };
+
+  // The serial part, on one worker: the image split in four by four-box interval passes down
+  // to top tiles, each tile's tape simplified from its parent's, not from the root's (on
+  // Prospero 1024^2, one pass over the root and four over 512^2 tapes instead of sixteen
+  // single-box passes and simplifications of the root).
+  void plan(Worker& w, std::vector<Task>& tasks) {
+    const Rect all{0, l_.width, 0, l_.height};
+    if (isTop(all)) tasks.push_back(Task{all, DenseTape(), true});
+    else spread(w, all, root_, 0, tasks);
+  }
+  // A task, on any worker.
+  void run(Worker& w, const Task& task) {
+    const DenseTape& tape = task.rootTape ? root_ : task.tape;
+    if (isLeaf(task.t)) {
+      Interval* box = w.boxes[0].data();
+      setBox(box, task.t);
+      leaf(w, task.t.c0, task.t.c1, task.t.r0, task.t.r1, tape, box);
+    } else {
+      group(w, task.t, tape, 0);
+    }
+  }
+
+ private:
+  bool isTop(const Rect& t) const { return t.c1 - t.c0 <= kTopTile && t.r1 - t.r0 <= kTopTile; }
   bool isLeaf(const Rect& t) const { return t.c1 - t.c0 <= leafSide_ && t.r1 - t.r0 <= leafSide_; }
   void setBox(Interval* b, const Rect& t) const {
     if (l_.u < root_.numVars) b[l_.u] = Interval(colCoord(t.c0), colCoord(t.c1 - 1));
@@ -127,11 +142,11 @@ class DensePlane {
     return true;
   }
 
-  // The quadrants of tile p (p itself when it is a leaf already), classified in one four-lane
-  // pass of p's tape over their boxes; each is then filled (signOnly, decided), evaluated as a
-  // leaf, or split in turn, with the tape simplified by its own choices.
-  void group(Worker& w, const Rect& p, const DenseTape& tape, int depth) {
-    Rect kids[4];
+  // The quadrants of tile p (p itself when it is a leaf already) in kids, classified in one
+  // four-lane pass of p's tape over their boxes (depth + 1's buffers; depth 0's box is a leaf
+  // task's); returns how many.
+  int quadrants(Worker& w, const Rect& p, const DenseTape& tape, int depth, Rect* kids, uint32_t* decided,
+                Interval* iv) {
     int n = 0;
     if (isLeaf(p)) {
       kids[n++] = p;
@@ -143,23 +158,48 @@ class DensePlane {
       if (rm < p.r1) kids[n++] = Rect{p.c0, cm, rm, p.r1};
       if (cm < p.c1 && rm < p.r1) kids[n++] = Rect{cm, p.c1, rm, p.r1};
     }
-    // Lanes past n repeat the last tile (computed and ignored); depth + 1's box buffers, as
-    // depth 0's holds the top tile's.
+    // Lanes past n repeat the last tile (computed and ignored).
     Interval* boxes = w.boxes[size_t(depth + 1)].data();
     for (int j = 0; j < 4; ++j) setBox(boxes + size_t(j) * nvb_, kids[std::min(j, n - 1)]);
     std::vector<uint8_t>& choices = w.choices[size_t(depth + 1)];
     if (choices.size() < 4 * tape.size()) choices.resize(4 * tape.size());
+    w.interval.eval4(tape, boxes, choices.data(), decided, iv);
+    return n;
+  }
+  // Quadrant j's tape: tape simplified by its choices into depth + 1's buffer, or tape itself
+  // when nothing was decided.
+  const DenseTape* simplified(Worker& w, const DenseTape& tape, int depth, int j, uint32_t decided) {
+    if (!decided) return &tape;
+    w.simplifier.simplify(tape, w.choices[size_t(depth + 1)].data() + j, w.tapes[size_t(depth + 1)], 4);
+    return &w.tapes[size_t(depth + 1)];
+  }
+
+  // plan's recursion: the quadrants of p that are top tiles (or at the depth limit) become tasks.
+  void spread(Worker& w, const Rect& p, const DenseTape& tape, int depth, std::vector<Task>& tasks) {
+    Rect kids[4];
     uint32_t decided[4];
     Interval iv[4];
-    w.interval.eval4(tape, boxes, choices.data(), decided, iv);
+    const int n = quadrants(w, p, tape, depth, kids, decided, iv);
+    for (int j = 0; j < n; ++j) {
+      if (decide(w, kids[j], iv[j], tape.size())) continue;
+      const DenseTape* own = simplified(w, tape, depth, j, decided[j]);
+      if (isTop(kids[j]) || depth + 1 >= kPlanDepth) tasks.push_back(Task{kids[j], *own, false});
+      else spread(w, kids[j], *own, depth + 1, tasks);
+    }
+  }
+
+  // Each quadrant of tile p is filled (signOnly, decided), evaluated as a leaf, or split in
+  // turn, with the tape simplified by its own choices.
+  void group(Worker& w, const Rect& p, const DenseTape& tape, int depth) {
+    Rect kids[4];
+    uint32_t decided[4];
+    Interval iv[4];
+    const int n = quadrants(w, p, tape, depth, kids, decided, iv);
+    const Interval* boxes = w.boxes[size_t(depth + 1)].data();
     for (int j = 0; j < n; ++j) {
       const Rect& t = kids[j];
       if (decide(w, t, iv[j], tape.size())) continue;
-      const DenseTape* own = &tape;
-      if (decided[j]) {
-        w.simplifier.simplify(tape, choices.data() + j, w.tapes[size_t(depth + 1)], 4);
-        own = &w.tapes[size_t(depth + 1)];
-      }
+      const DenseTape* own = simplified(w, tape, depth, j, decided[j]);
       if (isLeaf(t)) leaf(w, t.c0, t.c1, t.r0, t.r1, *own, boxes + size_t(j) * nvb_);
       else group(w, t, *own, depth + 1);
     }
@@ -256,16 +296,15 @@ class DensePlane {
 void evaluatePlaneDense(const TapePtr& tape, const PlaneLattice& l, const PlaneOptions& opt, std::vector<double>& out,
                         PlaneStats& stats) {
   DensePlane plane(tape, l, opt, out);
-  const int tilesX = (l.width + kTopTile - 1) / kTopTile, tilesY = (l.height + kTopTile - 1) / kTopTile;
   tbb::enumerable_thread_specific<Worker> workers;
-  parallelChunks(size_t(tilesX) * size_t(tilesY), 1, opt.threads, [&](size_t b, size_t e) {
+  std::vector<DensePlane::Task> tasks;
+  Worker& planner = workers.local();
+  plane.prepare(planner);
+  plane.plan(planner, tasks);
+  parallelChunks(tasks.size(), 1, opt.threads, [&](size_t b, size_t e) {
     Worker& w = workers.local();
     plane.prepare(w);
-    for (size_t t = b; t < e; ++t) {
-      const int tx = int(t % size_t(tilesX)), ty = int(t / size_t(tilesX));
-      const int c0 = tx * kTopTile, r0 = ty * kTopTile;
-      plane.top(w, c0, std::min(c0 + kTopTile, l.width), r0, std::min(r0 + kTopTile, l.height));
-    }
+    for (size_t t = b; t < e; ++t) plane.run(w, tasks[t]);
   });
   for (const Worker& w : workers) {
     stats.pointEvals += w.stats.pointEvals;

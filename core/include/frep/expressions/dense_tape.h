@@ -48,6 +48,7 @@ class DenseSimplifier {
 
  private:
   std::vector<uint32_t> bind_;  // parent register -> out register of its live value
+  uint32_t boundFixed_ = 0;     // bind_[r] == r for r below it
   std::vector<uint32_t> free_;
   std::vector<DenseInstr> scratch_;  // the simplified code, written back to front
 };
