@@ -254,14 +254,20 @@ class DensePlane {
       double* row = &out_[index(c0, r)];
       for (int c = 0; c < cols; ++c) row[c] = double(f[k + size_t(c)]);
     }
+    // The uncertain lanes counted in float lanes first (most batches have none): |f| > fb is
+    // |f| > bound, fb being the largest float <= bound (a float above fb is above bound).
+    float fb = float(bound);
+    if (double(fb) > bound) fb = std::nextafter(fb, 0.0f);
+    uint32_t uncertain = 0;
+    for (size_t i = 0; i < n; ++i) uncertain += !(std::fabs(f[i]) > fb);
+    w.stats.floatPixels += n - uncertain;
+    if (uncertain == 0) return;
     w.redo.resize(n + 1);
     size_t m = 0;
     for (size_t i = 0; i < n; ++i) {
       w.redo[m] = uint32_t(i);
-      m += !(std::fabs(double(f[i])) > bound);
+      m += !(std::fabs(f[i]) > fb);
     }
-    w.stats.floatPixels += n - m;
-    if (m == 0) return;
     // The uncertain pixels, packed into one double batch on the same tape.
     w.dbatch.reserve(tape);
     double* us = l_.u < root_.numVars ? w.dbatch.in(l_.u) : nullptr;
