@@ -38,7 +38,9 @@ double eval(const Expr& e, const V3& p) {
 }
 
 double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-V3 cross(const V3& a, const V3& b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
+V3 cross(const V3& a, const V3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
 
 // The box corner + sum_i t_i g_i (t in [0, 1]^3) written as six planes (a min of affine
 // functions, recognised as a convex polytope).
@@ -285,5 +287,59 @@ TEST(MeshConvexSum, SignOnlyBatchesClassifyEveryPointAsTheValues) {
     EXPECT_GT(in, 20);
     EXPECT_GT(out, 20);
     EXPECT_GT(cheaper, 20);  // the distance was skipped, not computed anyway
+  }
+}
+
+TEST(MeshConvexSum, ClassesOfClusteredPointsHoldForThinAndThickOperands) {
+  // A point in no T ⊕ B takes the class its lattice cell recorded when the cell is smaller than
+  // B's inner radius allows, else the translate's own. Clusters of points in one lattice cell
+  // (about 0.02 here), for B much thinner than a cell (no shared class allowed) to thicker,
+  // each class checked against the union of the two grown blocks, in sign-only batches and in
+  // values, the value exact outside.
+  const double h = 0.4;
+  for (const double w : {0.002, 0.006, 0.012, 0.02, 0.3}) {
+    const V3 clo{-w, -0.5 * w, -0.7 * w}, chi{0.8 * w, w, 0.3 * w};
+    Expr sum;
+    ASSERT_TRUE(minkowski::meshConvexSum(lPrism(h), axisBox(clo, chi), 3, &sum));
+    const V3 lo1{clo[0], clo[1], clo[2]}, hi1{2 + chi[0], 1 + chi[1], h + chi[2]};
+    const V3 lo2{clo[0], clo[1], clo[2]}, hi2{1 + chi[0], 2 + chi[1], h + chi[2]};
+    auto exact = [&](const double* p) {
+      const V3 q{p[0], p[1], p[2]};
+      return std::max(boxDistance(q, lo1, hi1), boxDistance(q, lo2, hi2));
+    };
+    TapePtr tape = Tape::compile(sum, 3);
+    BatchEvaluator<double> values, signs;
+    signs.setFieldSignsOnly(true);
+    std::mt19937 rng(17);
+    // Centres near the boundary (within 0.05 of a face of the L), points within 0.012 of them.
+    std::uniform_real_distribution<double> u(-0.2, 2.2), jitter(-0.012, 0.012), near(-0.05, 0.05);
+    int in = 0, out = 0;
+    for (int round = 0; round < 40; ++round) {
+      const size_t n = BatchEvaluator<double>::kBatch;
+      values.reserve(*tape);
+      signs.reserve(*tape);
+      double c[3] = {0, 0, 0};
+      for (size_t i = 0; i < n; ++i) {
+        if (i % 16 == 0) {
+          c[0] = u(rng), c[1] = u(rng), c[2] = u(rng) * h / 2.2;
+          const int face = int(rng() % 3);  // onto x = 1, y = 1 or z = h, then off it a little
+          c[face] = (face == 2 ? h : 1.0) + near(rng);
+        }
+        for (uint32_t k = 0; k < 3; ++k) values.in(k)[i] = signs.in(k)[i] = c[k] + jitter(rng);
+      }
+      const double* f = values.eval(*tape, n);
+      const double* s = signs.eval(*tape, n);
+      for (size_t i = 0; i < n; ++i) {
+        const double p[3] = {values.in(0)[i], values.in(1)[i], values.in(2)[i]};
+        const double e = exact(p);
+        if (std::abs(e) < 1e-9) continue;
+        ASSERT_EQ(s[i] >= 0, e > 0) << "w " << w << " at " << p[0] << " " << p[1] << " " << p[2];
+        ASSERT_EQ(f[i] >= 0, e > 0) << "w " << w << " at " << p[0] << " " << p[1] << " " << p[2];
+        if (e < 0) EXPECT_NEAR(f[i], e, 1e-9);
+        (e > 0 ? in : out) += 1;
+      }
+    }
+    EXPECT_GT(in, 300) << w;
+    EXPECT_GT(out, 300) << w;
   }
 }

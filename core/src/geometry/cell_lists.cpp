@@ -48,10 +48,24 @@ CellLists::Lists& CellLists::listsOf(uint64_t owner) {
   Lists& l = lists[next];
   next = (next + 1) % kOwners;
   l.owner = owner;
-  l.cells.clear();
-  l.items.clear();
-  l.hasLast = false;
+  l.clear();
   return l;
+}
+
+void CellLists::Lists::clear() {
+  slots.assign(1024, Slot{kEmpty, 0, 0});
+  used = 0;
+  items.clear();
+  hasLast = false;
+}
+
+// Twice the slots, every key placed again; the new slot of key.
+CellLists::Slot* CellLists::Lists::grow(uint64_t key) {
+  std::vector<Slot> old(slots.size() * 2, Slot{kEmpty, 0, 0});
+  old.swap(slots);
+  for (const Slot& s : old)
+    if (s.key != kEmpty) *find(s.key) = s;
+  return find(key);
 }
 
 }  // namespace frep

@@ -26,7 +26,9 @@ using V3 = std::array<double, 3>;
 V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 V3 add(const V3& a, const V3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-V3 cross(const V3& a, const V3& b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
+V3 cross(const V3& a, const V3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
 double norm(const V3& a) { return std::sqrt(dot(a, a)); }
 
 // A closed triangle mesh in world coordinates.
@@ -86,11 +88,13 @@ std::optional<Mesh> closedMeshOf(const Expr& e, bool* isPolytope) {
   Mesh out;
   const std::vector<double>& xyz = m->vertices();
   for (size_t i = 0; i + 2 < xyz.size(); i += 3)
-    out.v.push_back({(xyz[i] - shift[0]) / scale[0], (xyz[i + 1] - shift[1]) / scale[1], (xyz[i + 2] - shift[2]) / scale[2]});
+    out.v.push_back(
+        {(xyz[i] - shift[0]) / scale[0], (xyz[i + 1] - shift[1]) / scale[1], (xyz[i + 2] - shift[2]) / scale[2]});
   const std::vector<uint32_t>& tr = m->triangles();
   const bool mirrored = scale[0] * scale[1] * scale[2] < 0;  // keep the triangles outward
   for (size_t i = 0; i + 2 < tr.size(); i += 3)
-    out.t.push_back(mirrored ? std::array<uint32_t, 3>{tr[i], tr[i + 2], tr[i + 1]} : std::array<uint32_t, 3>{tr[i], tr[i + 1], tr[i + 2]});
+    out.t.push_back(mirrored ? std::array<uint32_t, 3>{tr[i], tr[i + 2], tr[i + 1]}
+                             : std::array<uint32_t, 3>{tr[i], tr[i + 1], tr[i + 2]});
   out.what = *isPolytope ? "convex polytope (" + std::to_string(p->planes) + " planes)"
                          : m->describe() + " (" + std::to_string(out.t.size()) + " triangles)";
   return out;
@@ -99,8 +103,8 @@ std::optional<Mesh> closedMeshOf(const Expr& e, bool* isPolytope) {
 // B as the convex polytope of a closed mesh: vertices, outward facet planes, edge directions.
 struct Convex {
   std::vector<V3> v;
-  std::vector<std::array<V3, 3>> faces;  // triangles
-  std::vector<V3> faceN;                 // unit outward normals
+  std::vector<std::array<V3, 3>> faces;        // triangles
+  std::vector<V3> faceN;                       // unit outward normals
   std::vector<std::array<uint32_t, 2>> edges;  // unique edges between non-coplanar faces
   double support(const V3& u) const {
     double h = -INFINITY;
@@ -269,6 +273,7 @@ class MeshConvexSumField : public DistanceField {
       for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], x.lo[k]), hi[k] = std::max(hi[k], x.hi[k]);
     lattice_ = CellLattice::over(lo, hi, 128, 0);
     cellBoxes_ = std::move(boxes);
+    cellClasses_ = lattice_.size * std::sqrt(3.0) < 1.9 * memoRadius_;
     convolutionPieces(a, b, bDirs, tol, tri);
     pruneInterior(soup, soupTris, tol);
     pieces_ = soupTris.size() / 3;
@@ -324,6 +329,16 @@ class MeshConvexSumField : public DistanceField {
     bool inside;
   };
   static constexpr int kSignMemos = 4;
+  // The class of the points of a lattice cell that lie in no T ⊕ B, per thread (4096 cells,
+  // direct-mapped): one class serves them all when the cell's diameter is below 2 memoRadius_
+  // (cellClasses_). Such points are at least 2 memoRadius_ (less rounding) from ∂A + b0, so a
+  // segment joining two of them, no longer than the diameter, cannot cross it.
+  struct ClassOfCell {
+    uint64_t owner, key;
+    bool inside;
+  };
+  static thread_local ClassOfCell tClassOfCell[4096];
+  bool cellClasses_ = false;
   static thread_local SignMemo tSignMemo[kSignMemos];
   static thread_local int tSignMemoNext;
   std::vector<std::array<double, 4>> planes_;  // u . x <= h
@@ -447,7 +462,9 @@ class MeshConvexSumField : public DistanceField {
       const double* v[3] = {&soup[3 * tris[t]], &soup[3 * tris[t + 1]], &soup[3 * tris[t + 2]]};
       double c[3], r2 = 0;
       for (int k = 0; k < 3; ++k) c[k] = (v[0][k] + v[1][k] + v[2][k]) / 3;
-      for (const double* p : v) r2 = std::max(r2, (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]));
+      for (const double* p : v)
+        r2 =
+            std::max(r2, (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]));
       const double shifted[3] = {c[0] - b0_[0], c[1] - b0_[1], c[2] - b0_[2]};
       double inA = a_->value(shifted);
       if (complement_) inA = -inA;
@@ -465,18 +482,28 @@ class MeshConvexSumField : public DistanceField {
   // The field of (A or A^c) ⊕ B, q the nearest boundary point where it is negative.
   // In a T ⊕ B the largest c_T is returned alone (a lower bound of the depth, like the max with
   // f_A: the sign certificates need no more), which saves the query of A near the surface;
-  // outside, dist(x, sum) <= dist(x - b0, A) bounds the boundary pieces' search.
+  // elsewhere f_A(x - b0) where it is >= 0, else (outside) the distance to the boundary pieces,
+  // their search bounded by dist(x, sum) <= dist(x - b0, A) — or not at all where the lattice
+  // cell's class says outside already (the pieces' own lists need no bound).
   double sumField(const double* p, double* q) const {
-    const double inside = insideValue(p);
-    if (inside >= 0) return inside;
-    return -soup_->distance(p, q, -inside);
+    const double g = cellsValue(p);
+    if (g >= 0) return g;
+    ClassOfCell* cached = cellClass(p);
+    if (cached && cached->owner == id_ && !cached->inside) return -soup_->distance(p, q);
+    const double inA = translateValue(p);
+    if (cached && !std::isnan(inA)) *cached = {id_, cached->key, inA >= 0};
+    if (inA >= 0) return inA;
+    return -soup_->distance(p, q, -inA);
   }
   // sumField's class without the distance to the pieces: outside, its value is -dist <= 0,
   // which reads as outside except on a piece (-0, inside), where either class is right. A point
-  // in no cell within memoRadius_ of one classified before has its class (see the constructor).
+  // in no cell has the class its lattice cell recorded (cellClass), or that of a point within
+  // memoRadius_ classified before (see the constructor).
   double sumClass(const double* p) const {
     const double g = cellsValue(p, true);
     if (g >= 0) return g;
+    ClassOfCell* cached = cellClass(p);
+    if (cached && cached->owner == id_) return cached->inside ? memoRadius_ : -INFINITY;
     if (memoRadius_ > 0)
       for (SignMemo& m : tSignMemo) {
         if (m.owner != id_) continue;
@@ -489,13 +516,19 @@ class MeshConvexSumField : public DistanceField {
       tSignMemo[tSignMemoNext] = {id_, {p[0], p[1], p[2]}, inA >= 0};
       tSignMemoNext = (tSignMemoNext + 1) % kSignMemos;
     }
+    if (cached) *cached = {id_, cached->key, inA >= 0};
     return inA >= 0 ? inA : -INFINITY;
   }
-  // The largest c_T, or f_A's value at p - b0 when no cell holds p: sumField's value where it
-  // is >= 0, else negative and dist(x, sum) <= its magnitude.
-  double insideValue(const double* p) const {
-    const double g = cellsValue(p);
-    return g >= 0 ? g : translateValue(p);
+  // This thread's record of the class of p's lattice cell (for the points in no cell): this
+  // field's when its owner is id_ and it holds the cell's key (else to be filled), or nothing
+  // when cells are too large for one class (cellClasses_) or p is off the lattice.
+  ClassOfCell* cellClass(const double* p) const {
+    uint64_t key;
+    int64_t ijk[3];
+    if (!cellClasses_ || !lattice_.cellOf(p, key, ijk)) return nullptr;
+    ClassOfCell* c = &tClassOfCell[(key * 0x9E3779B97F4A7C15ULL) >> 52];
+    if (c->key != key) c->owner = 0, c->key = key;
+    return c;
   }
   // f_A(p - b0), negated for the complement: the translate A + b0's field.
   // classOnly: a value of the same sign (MeshField::classValue) will do.
@@ -537,24 +570,44 @@ class MeshConvexSumField : public DistanceField {
     }
     return g;
   }
-  // The cells whose boxes meet the lattice cell holding p (at most 512), or nothing.
+  // The cells that can hold a point of the lattice cell holding p (at most 512), or nothing:
+  // those whose boxes meet it, less those a facet plane of theirs separates from it, ordered by
+  // their c_T at the cell's centre, largest first. A point's max c_T then often comes first
+  // (the class search ends at it; the max prunes the rest), and a dropped cell has c_T < 0 at
+  // every point of the lattice cell, which no caller reads (only g >= 0 counts).
   const uint32_t* cellsNear(const double* p, uint32_t& count) const {
     return CellLists::at(id_, lattice_, p, count, [&](const double* lo, const double* hi, std::vector<uint32_t>& out) {
       Bvh::Box q;
       for (int k = 0; k < 3; ++k) q.lo[k] = lo[k], q.hi[k] = hi[k];
-      const size_t first = out.size();
-      bool fits = true;
       // A little beyond the cell: a point may be placed in it from a few ulps outside.
       const double eps = 1e-9 * lattice_.size;
+      const double centre[3] = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
+      std::vector<std::pair<double, uint32_t>> found;
+      bool fits = true;
       cellBvh_.nearBox(q, eps, [&](uint32_t, uint32_t i) {
         const Bvh::Box& b = cellBoxes_[i];
         for (int k = 0; k < 3; ++k)
           if (b.lo[k] > q.hi[k] + eps || b.hi[k] < q.lo[k] - eps) return true;
-        out.push_back(i);
-        fits = out.size() - first <= 512;
+        const Cell& c = cells_[i];
+        double atCentre = INFINITY;
+        for (uint32_t k = c.first; k < c.first + c.count; ++k) {
+          const auto& u = planes_[k];
+          double least = 0;  // min of u . x over the cell grown by eps
+          for (int a = 0; a < 3; ++a) least += u[size_t(a)] * (u[size_t(a)] > 0 ? lo[a] - eps : hi[a] + eps);
+          if (least > u[3] + eps) return true;  // the plane separates them (eps: its rounding)
+          atCentre = std::min(atCentre, u[3] - (u[0] * centre[0] + u[1] * centre[1] + u[2] * centre[2]));
+        }
+        found.push_back({atCentre, i});
+        fits = found.size() <= 512;
         return fits;
       });
-      return fits;
+      if (!fits) return false;
+      // Largest first; ties by index, so a list never depends on the hierarchy's visiting order.
+      std::sort(found.begin(), found.end(), [](const auto& x, const auto& y) {
+        return x.first != y.first ? x.first > y.first : x.second < y.second;
+      });
+      for (const auto& f : found) out.push_back(f.second);
+      return true;
     });
   }
   bool sameGeometry(const DistanceField& o) const override {
@@ -565,6 +618,7 @@ class MeshConvexSumField : public DistanceField {
 
 thread_local MeshConvexSumField::SignMemo MeshConvexSumField::tSignMemo[MeshConvexSumField::kSignMemos] = {};
 thread_local int MeshConvexSumField::tSignMemoNext = 0;
+thread_local MeshConvexSumField::ClassOfCell MeshConvexSumField::tClassOfCell[4096] = {};
 
 void scaleMesh(Mesh& m, double s) {
   if (s == 1) return;

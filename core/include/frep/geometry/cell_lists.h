@@ -7,7 +7,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -51,15 +50,16 @@ class CellLists {
   static const uint32_t* get(uint64_t owner, uint64_t key, uint32_t& count, Build&& build) {
     Lists& l = listsOf(owner);
     if (!(l.hasLast && l.lastKey == key)) {  // runs of queries stay in one cell
-      auto it = l.cells.find(key);
-      if (it == l.cells.end()) {
-        if (l.items.size() > kMaxItems) l.cells.clear(), l.items.clear();
+      Slot* slot = l.find(key);
+      if (slot->key != key) {
+        if (l.items.size() > kMaxItems) l.clear(), slot = l.find(key);
         const uint32_t first = uint32_t(l.items.size());
         const bool has = build(l.items);
         if (!has) l.items.resize(first);
-        it = l.cells.emplace(key, std::make_pair(first, has ? uint32_t(l.items.size() - first) : kNone)).first;
+        *slot = {key, first, has ? uint32_t(l.items.size() - first) : kNone};
+        if (++l.used * 2 > l.slots.size()) slot = l.grow(key);
       }
-      l.hasLast = true, l.lastKey = key, l.last = it->second;
+      l.hasLast = true, l.lastKey = key, l.last = {slot->first, slot->count};
     }
     if (l.last.second == kNone) return nullptr;
     count = l.last.second;
@@ -68,13 +68,29 @@ class CellLists {
 
  private:
   static constexpr size_t kMaxItems = size_t(1) << 23;  // 32 MB a thread and owner, then cleared
+  static constexpr uint64_t kEmpty = UINT64_MAX;        // no lattice key is (keys have 60 bits)
+  // An open-addressing table of the cells' (first, count) in `items`: one probe of a flat array
+  // where a node-based map chased three pointers (a fifth of the sum's class queries went there).
+  struct Slot {
+    uint64_t key;
+    uint32_t first, count;
+  };
   struct Lists {
     uint64_t owner = 0;
-    std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> cells;  // key -> (first, count)
+    std::vector<Slot> slots;  // a power of two, at most half used
+    size_t used = 0;
     std::vector<uint32_t> items;
     bool hasLast = false;  // the last cell asked for
     uint64_t lastKey = 0;
     std::pair<uint32_t, uint32_t> last;
+    // The slot holding key, or the empty slot where it goes.
+    Slot* find(uint64_t key) {
+      const size_t mask = slots.size() - 1;
+      for (size_t i = (key * 0x9E3779B97F4A7C15ULL) >> 32 & mask;; i = (i + 1) & mask)
+        if (slots[i].key == key || slots[i].key == kEmpty) return &slots[i];
+    }
+    Slot* grow(uint64_t key);
+    void clear();
   };
   static Lists& listsOf(uint64_t owner);
 };
