@@ -1,9 +1,10 @@
 #!/bin/sh
-# Sanitizer runs of the core and farm tests (CI: deploy/test.sh; issue 34). Two builds of only
-# the targets needed, core_tests and farm_tests (with the frep-worker they start), each in its
-# own directory: ASan+UBSan (any error fails the run, leaks too) and TSan (the multithreaded
-# master, the worker's compute thread, TBB loops). A report is a failure: the script exits 1
-# with the report's first lines. Usage: run_sanitizers.sh [asan|tsan|all] (default all).
+# Sanitizer runs of the tests (CI: deploy/test.sh; issue 34). Two builds of only the targets
+# needed, each in its own directory: ASan+UBSan of core_tests, lang_tests, cli_unit_tests,
+# cli_tests and farm_tests (with the frep and frep-worker processes they start; any error fails
+# the run, leaks too) and TSan of farm_tests (the multithreaded master, the worker's I/O and
+# compute threads). A report is a failure: the script exits 1 with the report's first lines.
+# Usage: run_sanitizers.sh [asan|tsan|all] (default all).
 # FREP_ASAN_BUILD / FREP_TSAN_BUILD name the build directories (default build-asan, build-tsan).
 # Each run's filter leaves out the few tests that take minutes under the sanitizer (named below,
 # with their time); they run in the Release ctest.
@@ -31,8 +32,9 @@ build() {
 
 # binary, filter, log: the gtest binary under the sanitizer; a failed test or a report of any
 # process it started fails. Reports go to files (log_path, set by the caller to $REPORTS/<tool>,
-# one file per process): the frep-worker processes the farm tests start are sanitized too, and
-# their reports would otherwise be lost (a worker that dies is replaced, and the job succeeds).
+# one file per process): the frep and frep-worker processes the CLI and farm tests start are
+# sanitized too, and their reports would otherwise be lost (a worker that dies is replaced and
+# the job succeeds; a test of frep reads its stderr and exit code, not a report).
 run() {
   bin=$1 filter=$2 log=$3
   start=$(date +%s)
@@ -75,6 +77,13 @@ SLOW_CORE=$SLOW_CORE:MinkowskiBidisc.RandomTwoAxisSumsAgreeInSignWithTheCertifie
 ALONE_FARM=Faults.StoppedMasterDoesNotCountItsWorkersDead
 ASAN_CORE_FILTER=${ASAN_CORE_FILTER-"-$SLOW_CORE"}
 ASAN_FARM_FILTER=${ASAN_FARM_FILTER-"-$ALONE_FARM"}
+# The language test that takes minutes under ASan+UBSan: MorphologyClosedForm.ClosingOfTwoBalls...
+# (47 s in Release; not done after 279 s under ASan+UBSan at load 7.5, 2026-12-06). The other
+# 275 language tests took 328 s there, the slowest LangFuzz.MutatedSeeds 87 s.
+SLOW_LANG=MorphologyClosedForm.ClosingOfTwoBallsFillsTheNeck
+ASAN_LANG_FILTER=${ASAN_LANG_FILTER-"-$SLOW_LANG"}
+ASAN_CLI_UNIT_FILTER=${ASAN_CLI_UNIT_FILTER-"*"}
+ASAN_CLI_FILTER=${ASAN_CLI_FILTER-"*"}
 # TSan: the whole farm (the master's thread and merge thread, the workers' I/O and compute
 # threads, CURVE's authenticator) and the core's interrupter tests (a cancel from another
 # thread). Under TSan, TBB runs each loop on its calling thread (core/src/interrupt/
@@ -82,23 +91,31 @@ ASAN_FARM_FILTER=${ASAN_FARM_FILTER-"-$ALONE_FARM"}
 # so the core's other tests, single-threaded there, are ASan's.
 # An empty filter (e.g. TSAN_CORE_FILTER= ) leaves that binary out of that build altogether (CI).
 TSAN_CORE_FILTER=${TSAN_CORE_FILTER-"Interrupt.*"}
-# Faults.EmbeddedFarmRespawnsDyingWorkersWhileBricksFinish is left out: its workers die on their
-# second brick once their first result has left, so it counts on which brick a fresh worker takes
-# first; TSan's slowness on a loaded machine changed that order once (brick 1 poisoned after six
-# deaths, 26 s; it passed the TSan run before, and passes in Release). No TSan report.
-TSAN_FARM_FILTER=${TSAN_FARM_FILTER-"-$ALONE_FARM:Faults.EmbeddedFarmRespawnsDyingWorkersWhileBricksFinish"}
+TSAN_FARM_FILTER=${TSAN_FARM_FILTER-"-$ALONE_FARM"}
+# The farm tests' heartbeats, liveness windows, timeouts and test pauses are multiplied by
+# FREP_TEST_TIME_SCALE (tests/farm/farm_test_util.h): a sanitized process is several times slower
+# (TSan 5 to 15), and on a loaded machine a 100 ms heartbeat then misses its 0.5 s window.
+ASAN_TIME_SCALE=${ASAN_TIME_SCALE-2}
+TSAN_TIME_SCALE=${TSAN_TIME_SCALE-4}
 
-# tool, build flags: one build and its three runs.
+# tool, build flags: one build and its runs; a binary whose filter is empty is neither built
+# nor run (frep and frep-worker are built as the CLI and farm tests' dependencies).
 sanitize() {
   tool=$1 flags=$2
   TARGETS=
   if [ -n "$CORE_FILTER" ]; then TARGETS=core_tests; fi
+  if [ -n "$LANG_FILTER" ]; then TARGETS="$TARGETS lang_tests"; fi
+  if [ -n "$CLI_UNIT_FILTER" ]; then TARGETS="$TARGETS cli_unit_tests"; fi
+  if [ -n "$CLI_FILTER" ]; then TARGETS="$TARGETS cli_tests"; fi
   if [ -n "$FARM_FILTER" ]; then TARGETS="$TARGETS farm_tests"; fi
   start=$(date +%s)
   build "$dir" "$flags"
   echo "run_sanitizers: $tool build: $(( $(date +%s) - start )) s"
   REPORTS=$dir/reports
   if [ -n "$CORE_FILTER" ]; then run "$dir/bin/core_tests" "$CORE_FILTER" "$dir/core_tests.log"; fi
+  if [ -n "$LANG_FILTER" ]; then run "$dir/bin/lang_tests" "$LANG_FILTER" "$dir/lang_tests.log"; fi
+  if [ -n "$CLI_UNIT_FILTER" ]; then run "$dir/bin/cli_unit_tests" "$CLI_UNIT_FILTER" "$dir/cli_unit_tests.log"; fi
+  if [ -n "$CLI_FILTER" ]; then run "$dir/bin/cli_tests" "$CLI_FILTER" "$dir/cli_tests.log"; fi
   if [ -n "$FARM_FILTER" ]; then
     run "$dir/bin/farm_tests" "$FARM_FILTER" "$dir/farm_tests.log"
     run "$dir/bin/farm_tests" "$ALONE_FARM" "$dir/farm_tests_alone.log"
@@ -109,14 +126,17 @@ if [ "$WHICH" = asan ] || [ "$WHICH" = all ]; then
   dir=${FREP_ASAN_BUILD:-$REPO/build-asan}
   export ASAN_OPTIONS="detect_leaks=1:check_initialization_order=1:strict_init_order=1:log_path=$dir/reports/asan"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:log_path=$dir/reports/ubsan"
-  CORE_FILTER=$ASAN_CORE_FILTER FARM_FILTER=$ASAN_FARM_FILTER
+  export FREP_TEST_TIME_SCALE=$ASAN_TIME_SCALE
+  CORE_FILTER=$ASAN_CORE_FILTER FARM_FILTER=$ASAN_FARM_FILTER LANG_FILTER=$ASAN_LANG_FILTER
+  CLI_UNIT_FILTER=$ASAN_CLI_UNIT_FILTER CLI_FILTER=$ASAN_CLI_FILTER
   sanitize asan+ubsan "-fsanitize=address,undefined -fno-sanitize-recover=undefined"
-  unset ASAN_OPTIONS UBSAN_OPTIONS
+  unset ASAN_OPTIONS UBSAN_OPTIONS FREP_TEST_TIME_SCALE
 fi
 if [ "$WHICH" = tsan ] || [ "$WHICH" = all ]; then
   dir=${FREP_TSAN_BUILD:-$REPO/build-tsan}
   export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$HERE/tsan.supp log_path=$dir/reports/tsan"
-  CORE_FILTER=$TSAN_CORE_FILTER FARM_FILTER=$TSAN_FARM_FILTER
+  export FREP_TEST_TIME_SCALE=$TSAN_TIME_SCALE
+  CORE_FILTER=$TSAN_CORE_FILTER FARM_FILTER=$TSAN_FARM_FILTER LANG_FILTER= CLI_UNIT_FILTER= CLI_FILTER=
   sanitize tsan "-fsanitize=thread"
-  unset TSAN_OPTIONS
+  unset TSAN_OPTIONS FREP_TEST_TIME_SCALE
 fi
