@@ -343,3 +343,92 @@ TEST(MeshConvexSum, ClassesOfClusteredPointsHoldForThinAndThickOperands) {
     EXPECT_GT(out, 300) << w;
   }
 }
+
+// An L prism s ([0,2]x[0,1] ∪ [0,1]x[0,2]) x [0, h] + shift as a closed mesh (lPrism's faces).
+Expr lPrismAt(double s, double h, const V3& shift) {
+  const double L[6][2] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  std::vector<double> xyz;
+  for (double z : {0.0, h})
+    for (const auto& p : L) xyz.insert(xyz.end(), {s * p[0] + shift[0], s * p[1] + shift[1], z + shift[2]});
+  const uint32_t cap[4][3] = {{3, 4, 5}, {3, 5, 0}, {3, 0, 1}, {3, 1, 2}};
+  std::vector<uint32_t> tris;
+  for (const auto& t : cap) {
+    tris.insert(tris.end(), {t[0] + 6, t[1] + 6, t[2] + 6});
+    tris.insert(tris.end(), {t[0], t[2], t[1]});
+  }
+  for (uint32_t i = 0; i < 6; ++i) {
+    const uint32_t j = (i + 1) % 6;
+    tris.insert(tris.end(), {i, j, j + 6});
+    tris.insert(tris.end(), {i, j + 6, i + 6});
+  }
+  return fieldExpr(std::make_shared<MeshField>(xyz, tris, "L tool"), X(), Y(), Z());
+}
+
+TEST(MeshConvexSum, NonConvexToolIsCutIntoConvexPieces) {
+  // L ⊕ L' with both operands non-convex: the tool (star-shaped) is cut into convex pyramids,
+  // and the sum is the union of the four block sums A_i ⊕ B_j (a block ⊕ a block is the block
+  // of summed corners): exact outside, the sign everywhere. Then a block eroded by the L tool,
+  // (C ⊖ B_1) ∩ (C ⊖ B_2): exact inside.
+  const double h = 0.4, s = 0.1, hb = 0.05;
+  const V3 shift{-0.07, -0.04, -0.02};
+  // Either operand as the one cut: the big L's pieces against the small L (where every piece
+  // shows), then the small L's.
+  const std::array<std::array<V3, 2>, 2> A{{{V3{0, 0, 0}, V3{2, 1, h}}, {V3{0, 0, 0}, V3{1, 2, h}}}};
+  const std::array<std::array<V3, 2>, 2> B{
+      {{V3{shift[0], shift[1], shift[2]}, V3{2 * s + shift[0], s + shift[1], hb + shift[2]}},
+       {V3{shift[0], shift[1], shift[2]}, V3{s + shift[0], 2 * s + shift[1], hb + shift[2]}}}};
+  std::mt19937 rng(23);
+  for (const bool bigCut : {true, false}) {
+    Expr sum;
+    ASSERT_TRUE(bigCut ? minkowski::meshConvexSum(lPrismAt(s, hb, shift), lPrism(h), 3, &sum)
+                       : minkowski::meshConvexSum(lPrism(h), lPrismAt(s, hb, shift), 3, &sum));
+    auto unionOfSums = [&](const V3& p) {
+      double f = -INFINITY;
+      for (const auto& a : A)
+        for (const auto& b : B) {
+          const V3 lo{a[0][0] + b[0][0], a[0][1] + b[0][1], a[0][2] + b[0][2]};
+          const V3 hi{a[1][0] + b[1][0], a[1][1] + b[1][1], a[1][2] + b[1][2]};
+          f = std::max(f, boxDistance(p, lo, hi));
+        }
+      return f;
+    };
+    std::uniform_real_distribution<double> u(-0.4, 2.4), uz(-0.3, 0.7);
+    int in = 0, out = 0;
+    for (int i = 0; i < 3000; ++i) {
+      const V3 p{u(rng), u(rng), uz(rng)};
+      const double e = unionOfSums(p), f = eval(sum, p);
+      if (std::abs(e) < 1e-9) continue;
+      ASSERT_EQ(f >= 0, e > 0) << p[0] << " " << p[1] << " " << p[2];
+      if (e < 0) EXPECT_NEAR(f, e, 1e-9) << p[0] << " " << p[1] << " " << p[2];
+      (e > 0 ? in : out) += 1;
+    }
+    EXPECT_GT(in, 300);
+    EXPECT_GT(out, 300);
+  }
+
+  const V3 clo{-1, -1, -1}, chi{3, 2.5, 1.4};
+  Expr diff;
+  ASSERT_TRUE(minkowski::meshConvexDifference(axisBox(clo, chi), lPrismAt(s, hb, shift), 3, &diff));
+  auto eroded = [&](const V3& p) {
+    // C ⊖ B_j is the block [clo - lo_j, chi - hi_j]; the erosion is their intersection.
+    V3 lo{-INFINITY, -INFINITY, -INFINITY}, hi{INFINITY, INFINITY, INFINITY};
+    for (const auto& b : B)
+      for (int k = 0; k < 3; ++k)
+        lo[size_t(k)] = std::max(lo[size_t(k)], clo[size_t(k)] - b[0][size_t(k)]),
+        hi[size_t(k)] = std::min(hi[size_t(k)], chi[size_t(k)] - b[1][size_t(k)]);
+    return boxDistance(p, lo, hi);
+  };
+  std::uniform_real_distribution<double> w(-1.3, 3.3);
+  int inside = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const V3 p{w(rng), w(rng), 0.6 * w(rng)};
+    const double e = eroded(p), f = eval(diff, p);
+    if (std::abs(e) < 1e-9) continue;
+    ASSERT_EQ(f >= 0, e > 0) << p[0] << " " << p[1] << " " << p[2];
+    if (e > 0) {
+      ++inside;
+      EXPECT_NEAR(f, e, 1e-9);
+    }
+  }
+  EXPECT_GT(inside, 300);
+}

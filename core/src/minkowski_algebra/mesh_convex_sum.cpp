@@ -17,138 +17,14 @@
 #include "frep/geometry/distance_fields.h"
 #include "frep/minkowski_algebra/convex_polytope.h"
 #include "frep/minkowski_algebra/registry.h"
+#include "frep/minkowski_algebra/star_pieces.h"
+#include "mesh_operands.h"
 
 namespace frep::minkowski {
 namespace {
 
-using V3 = std::array<double, 3>;
-
-V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-V3 add(const V3& a, const V3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-V3 cross(const V3& a, const V3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double norm(const V3& a) { return std::sqrt(dot(a, a)); }
-
-// A closed triangle mesh in world coordinates.
-struct Mesh {
-  std::vector<V3> v;
-  std::vector<std::array<uint32_t, 3>> t;
-  std::string what;
-};
-
-// e = s x_i + k with constants s != 0 and k (translations and scalings: a morph's (1 - t) A
-// reads A at x / (1 - t)); the field reads the mesh at s x + k, so the solid is (mesh - k) / s.
-bool axisMap(const Expr& e, uint32_t i, double& s, double& k) {
-  if (e.op() == Op::Var) return e.node().index == i ? (s = 1, k = 0, true) : false;
-  double s0, k0;
-  switch (e.op()) {
-    case Op::Add:
-    case Op::Sub: {
-      const bool constFirst = e.arg(0).isConst();
-      if (!constFirst && !e.arg(1).isConst()) return false;
-      if (!axisMap(e.arg(constFirst ? 1 : 0), i, s0, k0)) return false;
-      const double c = e.arg(constFirst ? 0 : 1).constValue();
-      if (e.op() == Op::Add) s = s0, k = k0 + c;
-      else if (constFirst) s = -s0, k = c - k0;
-      else s = s0, k = k0 - c;
-      return true;
-    }
-    case Op::Mul:
-    case Op::Div: {
-      if (!e.arg(1).isConst() && !(e.op() == Op::Mul && e.arg(0).isConst())) return false;
-      const bool constFirst = e.op() == Op::Mul && e.arg(0).isConst();
-      if (!axisMap(e.arg(constFirst ? 1 : 0), i, s0, k0)) return false;
-      double c = e.arg(constFirst ? 0 : 1).constValue();
-      if (e.op() == Op::Div) c = 1 / c;
-      s = s0 * c, k = k0 * c;
-      return std::isfinite(s) && std::isfinite(k) && s != 0;
-    }
-    default:
-      return false;
-  }
-}
-
-std::optional<Mesh> closedMeshOf(const Expr& e, bool* isPolytope) {
-  *isPolytope = false;
-  const Expr* field = &e;
-  std::optional<ConvexPolytope> p;
-  if (e.op() != Op::Field || !dynamic_cast<const MeshField*>(e.node().fn.get())) {
-    p = convexPolytopeOf(e);
-    if (!p) return std::nullopt;
-    field = &p->field;
-    *isPolytope = true;
-  }
-  const auto* m = dynamic_cast<const MeshField*>(field->node().fn.get());
-  if (!m || !m->check().closed()) return std::nullopt;
-  V3 scale{1, 1, 1}, shift{0, 0, 0};
-  for (uint32_t i = 0; i < 3; ++i)
-    if (!axisMap(field->arg(i), i, scale[i], shift[i])) return std::nullopt;
-  Mesh out;
-  const std::vector<double>& xyz = m->vertices();
-  for (size_t i = 0; i + 2 < xyz.size(); i += 3)
-    out.v.push_back(
-        {(xyz[i] - shift[0]) / scale[0], (xyz[i + 1] - shift[1]) / scale[1], (xyz[i + 2] - shift[2]) / scale[2]});
-  const std::vector<uint32_t>& tr = m->triangles();
-  const bool mirrored = scale[0] * scale[1] * scale[2] < 0;  // keep the triangles outward
-  for (size_t i = 0; i + 2 < tr.size(); i += 3)
-    out.t.push_back(mirrored ? std::array<uint32_t, 3>{tr[i], tr[i + 2], tr[i + 1]}
-                             : std::array<uint32_t, 3>{tr[i], tr[i + 1], tr[i + 2]});
-  out.what = *isPolytope ? "convex polytope (" + std::to_string(p->planes) + " planes)"
-                         : m->describe() + " (" + std::to_string(out.t.size()) + " triangles)";
-  return out;
-}
-
-// B as the convex polytope of a closed mesh: vertices, outward facet planes, edge directions.
-struct Convex {
-  std::vector<V3> v;
-  std::vector<std::array<V3, 3>> faces;        // triangles
-  std::vector<V3> faceN;                       // unit outward normals
-  std::vector<std::array<uint32_t, 2>> edges;  // unique edges between non-coplanar faces
-  double support(const V3& u) const {
-    double h = -INFINITY;
-    for (const V3& p : v) h = std::max(h, dot(u, p));
-    return h;
-  }
-};
-
-double extentOf(const std::vector<V3>& pts) {
-  double s = 0;
-  for (const V3& p : pts) s = std::max({s, std::abs(p[0]), std::abs(p[1]), std::abs(p[2])});
-  return std::max(s, 1e-300);
-}
-
-// The mesh as a convex body, or nothing when some vertex lies outside a face's plane.
-std::optional<Convex> convexOf(const Mesh& m, double scale) {
-  if (m.t.size() > 4096) return std::nullopt;  // a tool, not a part: the check is quadratic
-  Convex c;
-  c.v = m.v;
-  const double tol = 1e-9 * scale;
-  std::map<std::pair<uint32_t, uint32_t>, std::vector<size_t>> edgeFaces;
-  for (const auto& t : m.t) {
-    const V3 n0 = cross(sub(m.v[t[1]], m.v[t[0]]), sub(m.v[t[2]], m.v[t[0]]));
-    const double len = norm(n0);
-    if (!(len > 0)) continue;  // a degenerate triangle bounds nothing
-    const V3 n{n0[0] / len, n0[1] / len, n0[2] / len};
-    const double h = dot(n, m.v[t[0]]);
-    for (const V3& p : m.v)
-      if (dot(n, p) > h + tol) return std::nullopt;
-    c.faces.push_back({m.v[t[0]], m.v[t[1]], m.v[t[2]]});
-    c.faceN.push_back(n);
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t a = t[size_t(k)], b = t[size_t((k + 1) % 3)];
-      edgeFaces[{std::min(a, b), std::max(a, b)}].push_back(c.faces.size() - 1);
-    }
-  }
-  for (const auto& [e, fs] : edgeFaces) {
-    bool crease = fs.size() != 2;
-    if (!crease) crease = dot(c.faceN[fs[0]], c.faceN[fs[1]]) < 1 - 1e-12;
-    if (crease) c.edges.push_back({e.first, e.second});
-  }
-  if (c.faces.size() < 4) return std::nullopt;
-  return c;
-}
+using namespace vec3;
+using namespace mesh_operands;
 
 // The convex hull of points on a plane with unit normal u, fanned into triangles (emit(p, q, r));
 // nothing when they span no area (the face of a sum in a direction that is not a facet's).
@@ -183,21 +59,71 @@ void facetTriangles(const V3& u, const std::vector<V3>& pts, double tol, Emit&& 
 // See mesh_convex_sum.h. complement: the field of A^c ⊕ B (for the difference, B = -B).
 class MeshConvexSumField : public DistanceField {
  public:
-  MeshConvexSumField(const Mesh& a, std::shared_ptr<const MeshField> aField, const Convex& b, bool complement,
-                     std::string name)
+  // B is the union of the convex pieces bs (one for a convex B; star_pieces.h otherwise, all
+  // sharing a point, so B is connected): A ⊕ B = (A + b0) ∪ ⋃_{T, i} (T ⊕ B_i), and the
+  // boundary pieces of every A ⊕ B_i together cover its boundary.
+  MeshConvexSumField(const Mesh& a, std::shared_ptr<const MeshField> aField, const std::vector<Convex>& bs,
+                     bool complement, std::string name)
       : a_(std::move(aField)), complement_(complement), name_(std::move(name)) {
-    // b0: B's vertex centroid, an interior point; every cell T ⊕ B then holds the r-neighbourhood
-    // of T + b0 (r: b0's distance to B's facets), so a point in no cell is at least r from
-    // ∂A + b0 and its class under f_A(x - b0) holds within r of it (sumClass's memo).
-    for (const V3& p : b.v) b0_ = {b0_[0] + p[0], b0_[1] + p[1], b0_[2] + p[2]};
-    b0_ = {b0_[0] / double(b.v.size()), b0_[1] / double(b.v.size()), b0_[2] / double(b.v.size())};
+    // b0: the first piece's vertex centroid, an interior point; every cell T ⊕ B_0 then holds
+    // the r-neighbourhood of T + b0 (r: b0's distance to B_0's facets), so a point in no cell is
+    // at least r from ∂A + b0 and its class under f_A(x - b0) holds within r of it (sumClass).
+    const Convex& b0Piece = bs.front();
+    for (const V3& p : b0Piece.v) b0_ = {b0_[0] + p[0], b0_[1] + p[1], b0_[2] + p[2]};
+    const double nb = double(b0Piece.v.size());
+    b0_ = {b0_[0] / nb, b0_[1] / nb, b0_[2] / nb};
     memoRadius_ = INFINITY;
-    for (const V3& n : b.faceN) memoRadius_ = std::min(memoRadius_, b.support(n) - dot(n, b0_));
+    for (const V3& n : b0Piece.faceN) memoRadius_ = std::min(memoRadius_, b0Piece.support(n) - dot(n, b0_));
     if (!(memoRadius_ > 0) || !std::isfinite(memoRadius_)) memoRadius_ = 0;
     memoRadius_ *= 0.5;  // half: rounding of the cells' tests cannot matter
-    double scale = std::max(extentOf(a.v), extentOf(b.v));
+    double scale = extentOf(a.v);
+    for (const Convex& b : bs) scale = std::max(scale, extentOf(b.v));
     const double tol = 1e-9 * scale;
-    // Edge directions of B, one per parallel class.
+    std::vector<double> soup;
+    std::vector<uint32_t> soupTris;
+    auto tri = [&](const V3& p, const V3& q, const V3& r) {
+      const uint32_t base = uint32_t(soup.size() / 3);
+      for (const V3* x : {&p, &q, &r}) soup.insert(soup.end(), x->begin(), x->end());
+      soupTris.insert(soupTris.end(), {base, base + 1, base + 2});
+    };
+    std::vector<Bvh::Box> boxes;
+    std::vector<std::vector<V3>> pieceDirs;
+    for (const Convex& b : bs) {
+      pieceDirs.push_back(edgeDirections(b));
+      addCells(a, b, pieceDirs.back(), tol, boxes);
+    }
+    cellBvh_.build(boxes);
+    // Lists for a lattice of 128 cells along the boxes' longest side: a point's query then
+    // tests one short list instead of walking the many overlapping boxes of the hierarchy.
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (const Bvh::Box& x : boxes)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], x.lo[k]), hi[k] = std::max(hi[k], x.hi[k]);
+    lattice_ = CellLattice::over(lo, hi, 128, 0);
+    cellBoxes_ = std::move(boxes);
+    cellClasses_ = lattice_.size * std::sqrt(3.0) < 1.9 * memoRadius_;
+    for (size_t i = 0; i < bs.size(); ++i) convolutionPieces(a, bs[i], pieceDirs[i], tol, tri);
+    pruneInterior(soup, soupTris, tol);
+    pieces_ = soupTris.size() / 3;
+    soup_ = std::make_shared<MeshField>(std::move(soup), std::move(soupTris), "boundary pieces");
+    uint64_t h = a_->contentHash() ^ (complement_ ? 0x9e3779b97f4a7c15ULL : 0);
+    for (const Convex& b : bs)
+      for (const V3& p : b.v)
+        for (double d : p) {
+          uint64_t bits;
+          std::memcpy(&bits, &d, sizeof bits);
+          h = (h ^ bits) * 0x100000001b3ULL;
+        }
+    hash_ = h;
+  }
+
+  double value(const double p[3]) const override {
+    const double f = sumField(p, nullptr);
+    return complement_ ? -f : f;
+  }
+
+ private:
+  // Edge directions of B, one per parallel class.
+  static std::vector<V3> edgeDirections(const Convex& b) {
     std::vector<V3> bDirs;
     for (const auto& e : b.edges) {
       V3 d = sub(b.v[e[1]], b.v[e[0]]);
@@ -208,14 +134,12 @@ class MeshConvexSumField : public DistanceField {
       for (const V3& k : bDirs) known = known || std::abs(dot(k, d)) > 1 - 1e-12;
       if (!known) bDirs.push_back(d);
     }
-    std::vector<double> soup;
-    std::vector<uint32_t> soupTris;
-    auto tri = [&](const V3& p, const V3& q, const V3& r) {
-      const uint32_t base = uint32_t(soup.size() / 3);
-      for (const V3* x : {&p, &q, &r}) soup.insert(soup.end(), x->begin(), x->end());
-      soupTris.insert(soupTris.end(), {base, base + 1, base + 2});
-    };
-    std::vector<Bvh::Box> boxes;
+    return bDirs;
+  }
+
+  // The cells T ⊕ B of every triangle T of A: their planes and boxes.
+  void addCells(const Mesh& a, const Convex& b, const std::vector<V3>& bDirs, double tol,
+                std::vector<Bvh::Box>& boxes) {
     V3 bLo{INFINITY, INFINITY, INFINITY}, bHi{-INFINITY, -INFINITY, -INFINITY};  // B's box
     for (const V3& p : b.v)
       for (size_t k = 0; k < 3; ++k) bLo[k] = std::min(bLo[k], p[k]), bHi[k] = std::max(bHi[k], p[k]);
@@ -265,33 +189,9 @@ class MeshConvexSumField : public DistanceField {
       }
       boxes.push_back(box);
     }
-    cellBvh_.build(boxes);
-    // Lists for a lattice of 128 cells along the boxes' longest side: a point's query then
-    // tests one short list instead of walking the many overlapping boxes of the hierarchy.
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (const Bvh::Box& x : boxes)
-      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], x.lo[k]), hi[k] = std::max(hi[k], x.hi[k]);
-    lattice_ = CellLattice::over(lo, hi, 128, 0);
-    cellBoxes_ = std::move(boxes);
-    cellClasses_ = lattice_.size * std::sqrt(3.0) < 1.9 * memoRadius_;
-    convolutionPieces(a, b, bDirs, tol, tri);
-    pruneInterior(soup, soupTris, tol);
-    pieces_ = soupTris.size() / 3;
-    soup_ = std::make_shared<MeshField>(std::move(soup), std::move(soupTris), "boundary pieces");
-    uint64_t h = a_->contentHash() ^ (complement_ ? 0x9e3779b97f4a7c15ULL : 0);
-    for (const V3& p : b.v)
-      for (double d : p) {
-        uint64_t bits;
-        std::memcpy(&bits, &d, sizeof bits);
-        h = (h ^ bits) * 0x100000001b3ULL;
-      }
-    hash_ = h;
   }
 
-  double value(const double p[3]) const override {
-    const double f = sumField(p, nullptr);
-    return complement_ ? -f : f;
-  }
+ public:
   void signs(const double* u, const double* v, const double* w, double* out, size_t n) const override {
     for (size_t i = 0; i < n; ++i) {
       const double p[3] = {u[i], v[i], w[i]};
@@ -469,10 +369,17 @@ class MeshConvexSumField : public DistanceField {
       double inA = a_->value(shifted);
       if (complement_) inA = -inA;
       bool interior = inA > std::sqrt(r2) + tol;
-      if (!interior)
-        cellBvh_.containing(v[0], [&](uint32_t cell) {
-          interior = interior || (depth(cell, v[0]) > tol && depth(cell, v[1]) > tol && depth(cell, v[2]) > tol);
-        });
+      // A cell holding v[0] with a margin is in v[0]'s lattice list (or, without one, among the
+      // boxes that hold it): either way the same cells decide, the list the fewer.
+      auto inCell = [&](uint32_t cell) {
+        interior = depth(cell, v[0]) > tol && depth(cell, v[1]) > tol && depth(cell, v[2]) > tol;
+        return !interior;
+      };
+      uint32_t count = 0;
+      const uint32_t* list = interior ? nullptr : cellsNear(v[0], count);
+      if (list)
+        for (uint32_t j = 0; j < count && inCell(list[j]); ++j) {}
+      else if (!interior) cellBvh_.containing(v[0], inCell);
       if (!interior) kept.insert(kept.end(), {tris[t], tris[t + 1], tris[t + 2]});
     }
     if (kept.empty() && !tris.empty()) kept.assign(tris.begin(), tris.begin() + 3);  // MeshField needs one
@@ -620,16 +527,13 @@ thread_local MeshConvexSumField::SignMemo MeshConvexSumField::tSignMemo[MeshConv
 thread_local int MeshConvexSumField::tSignMemoNext = 0;
 thread_local MeshConvexSumField::ClassOfCell MeshConvexSumField::tClassOfCell[4096] = {};
 
-void scaleMesh(Mesh& m, double s) {
-  if (s == 1) return;
-  for (V3& p : m.v)
-    for (double& x : p) x *= s;
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%g × ", s);
-  m.what = buf + m.what;
-}
+// A tool cut into more pieces than this is left to the search: each piece adds a copy of A's cells.
+constexpr size_t kMaxPieces = 64;
 
-bool build(const Expr& aExpr, const Expr& bExpr, bool difference, Expr* out, double scaleA = 1, double scaleB = 1) {
+// pieces: a B that is not convex may be cut into convex pieces (star_pieces.h), each of which
+// adds a copy of A's cells, so the callers try the convex forms first.
+bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, Expr* out, double scaleA = 1,
+           double scaleB = 1) {
   bool aPoly = false, bPoly = false;
   std::optional<Mesh> b = closedMeshOf(bExpr, &bPoly);
   if (!b) return false;
@@ -637,23 +541,38 @@ bool build(const Expr& aExpr, const Expr& bExpr, bool difference, Expr* out, dou
   if (!a) return false;
   scaleMesh(*a, scaleA);
   scaleMesh(*b, scaleB);
-  std::optional<Convex> cb = convexOf(*b, std::max(extentOf(a->v), extentOf(b->v)));
-  if (!cb) return false;
-  if (difference)
-    for (V3& p : cb->v) p = {-p[0], -p[1], -p[2]};
-  if (difference) {
-    for (auto& f : cb->faces)
-      for (V3& p : f) p = {-p[0], -p[1], -p[2]};
-    for (V3& n : cb->faceN) n = {-n[0], -n[1], -n[2]};
+  const double scale = std::max(extentOf(a->v), extentOf(b->v));
+  std::vector<Convex> bs;
+  std::string bWhat = b->what;
+  if (std::optional<Convex> cb = convexOf(*b, scale)) {
+    if (pieces) return false;  // the convex form was tried first
+    bs.push_back(std::move(*cb));
+  } else {
+    if (!pieces || b->t.size() > 4096) return false;
+    auto star = starConvexPieces(b->v, b->t, 1e-6 * scale, kMaxPieces);
+    if (!star) return false;
+    for (const PieceMesh& pm : *star) {
+      std::optional<Convex> c = convexOf(Mesh{pm.v, pm.t, ""}, scale);
+      if (!c) return false;
+      bs.push_back(std::move(*c));
+    }
+    bWhat += " as " + std::to_string(bs.size()) + " convex pieces";
   }
+  if (difference)
+    for (Convex& cb : bs) {
+      for (V3& p : cb.v) p = {-p[0], -p[1], -p[2]};
+      for (auto& f : cb.faces)
+        for (V3& p : f) p = {-p[0], -p[1], -p[2]};
+      for (V3& n : cb.faceN) n = {-n[0], -n[1], -n[2]};
+    }
   std::vector<double> xyz;
   for (const V3& p : a->v) xyz.insert(xyz.end(), p.begin(), p.end());
   std::vector<uint32_t> tris;
   for (const auto& t : a->t) tris.insert(tris.end(), t.begin(), t.end());
   auto aField = std::make_shared<MeshField>(std::move(xyz), std::move(tris), a->what);
   if (aExpr.op() == Op::Field) aField->setSetErrorBound(aExpr.node().fn->setErrorBound() * scaleA);
-  const std::string name = a->what + (difference ? " ⊖ " : " ⊕ ") + b->what;
-  auto field = std::make_shared<MeshConvexSumField>(*a, aField, *cb, difference, name);
+  const std::string name = a->what + (difference ? " ⊖ " : " ⊕ ") + bWhat;
+  auto field = std::make_shared<MeshConvexSumField>(*a, aField, bs, difference, name);
   *out = fieldExpr(field, Expr::x(0), Expr::x(1), Expr::x(2));
   ExactTerm t;
   t.kind = ExactTerm::Kind::MeshPolytope;
@@ -671,17 +590,21 @@ bool build(const Expr& aExpr, const Expr& bExpr, bool difference, Expr* out, dou
 
 bool meshConvexSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
   if (dims != 3) return false;
-  return build(a, b, false, out) || build(b, a, false, out);
+  for (bool pieces : {false, true})
+    if (build(a, b, false, pieces, out) || build(b, a, false, pieces, out)) return true;
+  return false;
 }
 
 bool meshConvexMorph(const Expr& a, const Expr& b, double t, Expr* out) {
   if (!(t > 0 && t < 1)) return false;
-  return build(a, b, false, out, 1 - t, t) || build(b, a, false, out, t, 1 - t);
+  for (bool pieces : {false, true})
+    if (build(a, b, false, pieces, out, 1 - t, t) || build(b, a, false, pieces, out, t, 1 - t)) return true;
+  return false;
 }
 
 bool meshConvexDifference(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
   if (dims != 3) return false;
-  return build(a, b, true, out);
+  return build(a, b, true, false, out) || build(a, b, true, true, out);
 }
 
 }  // namespace frep::minkowski
