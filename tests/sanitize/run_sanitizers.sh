@@ -42,6 +42,13 @@ run() {
   status=0
   "$bin" --gtest_filter="$filter" >"$log" 2>&1 || status=$?
   what="$(basename "$bin") under $(basename "$(dirname "$(dirname "$bin")")")"
+  # A report printed to stderr instead (UBSan's, in the test process or in a frep-worker whose
+  # stderr is the test's: a worker that dies of it is replaced and its job passes) fails too.
+  if grep -aqE "runtime error:|ERROR: AddressSanitizer|ERROR: LeakSanitizer|WARNING: ThreadSanitizer" "$log"; then
+    grep -aE -A12 "runtime error:|ERROR: AddressSanitizer|ERROR: LeakSanitizer|WARNING: ThreadSanitizer" "$log" | head -60
+    echo "run_sanitizers: $what: a sanitizer report in the test log ($log)"
+    exit 1
+  fi
   if [ -n "$(ls "$REPORTS")" ]; then
     for r in "$REPORTS"/*; do
       echo "--- $r"
