@@ -11,6 +11,7 @@ Cases (every operand written the way a user would, HyperFun primitives or STL fi
   octa_stl_ball   the octahedron as an STL file (+) hfSphere
   bunny_ball      Stanford bunny (npm `bunny`, holes fanned shut) (+) frBall (non-convex)
   bunny_tetra     bunny (+) a tetrahedral tool as an STL file (mesh (+) mesh)
+  bunny_ltool     bunny (+) an L-shaped tool as an STL file (mesh (+) non-convex mesh)
   bunny_block     bunny (+) hfBlock
   morph_blocks    frMorphMinkowski of two hfBlocks, t = 0.6: (0.4 A) (+) (0.6 B)
 Exact volumes: Steiner's formula V + S r + M r^2 + 4/3 pi r^3 for convex polytopes (+) ball (M the
@@ -82,6 +83,19 @@ TETRA_V = [[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]]
 TETRA_T = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
 OCTA_V = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
 OCTA_T = [(0, 2, 4), (2, 1, 4), (1, 3, 4), (3, 0, 4), (2, 0, 5), (1, 2, 5), (3, 1, 5), (0, 3, 5)]
+
+
+# A non-convex tool: the L prism ([0,2]x[0,1] ∪ [0,1]x[0,2]) x [0,1], centred, triangles outward
+# (the L faces fanned from the reflex corner; outward() assumes a convex body).
+def l_tool(s):
+    L = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]
+    v = [[s * (x - 0.75), s * (y - 0.75), s * (z - 0.5)] for z in (0, 1) for (x, y) in L]
+    cap = [(3, 4, 5), (3, 5, 0), (3, 0, 1), (3, 1, 2)]
+    t = [(a + 6, b + 6, c + 6) for (a, b, c) in cap] + [(a, c, b) for (a, b, c) in cap]
+    for i in range(6):
+        j = (i + 1) % 6
+        t += [(i, j, j + 6), (i, j + 6, i + 6)]
+    return v, t
 
 
 def scaled(verts, s):
@@ -317,6 +331,15 @@ def build_cases(work, npm_dir, have_npm):
             "my_model(x[3], a[1]) { my_model = frMinkowski(x, opa, opb); }\n",
             1.15, "peer", scad="minkowski() { import(\"%s\"); import(\"%s\"); }" % (bunny, tool),
             manifold={"a": {"stl": bunny}, "b": {"stl": tool}}, what="mesh (+) convex mesh")
+        ltool_v, ltool_t = l_tool(0.05)
+        ltool = os.path.join(work, "ltool.stl")
+        write_stl(ltool, ltool_v, ltool_t)
+        add("bunny_ltool",
+            'opa(x[3], a[1]) { opa = frMesh(x, "bunny.stl"); }\n'
+            'opb(x[3], a[1]) { opb = frMesh(x, "ltool.stl"); }\n'
+            "my_model(x[3], a[1]) { my_model = frMinkowski(x, opa, opb); }\n",
+            1.15, "peer", scad="minkowski() { import(\"%s\"); import(\"%s\"); }" % (bunny, ltool),
+            manifold={"a": {"stl": bunny}, "b": {"stl": ltool}}, what="mesh (+) non-convex mesh")
         add("bunny_block",
             'opa(x[3], a[1]) { opa = frMesh(x, "bunny.stl"); }\n'
             "opb(x[3], a[1]) { array v[3]; v = [-0.05, -0.04, -0.03]; opb = hfBlock(x, v, 0.1, 0.08, 0.06); }\n"
