@@ -140,11 +140,12 @@ if [ "$WHICH" = asan ] || [ "$WHICH" = all ]; then
   dir=${FREP_ASAN_BUILD:-$REPO/build-asan}
   export ASAN_OPTIONS="detect_leaks=1:check_initialization_order=1:strict_init_order=1:log_path=$dir/reports/asan"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:log_path=$dir/reports/ubsan"
+  export LSAN_OPTIONS="suppressions=$HERE/lsan.supp:print_suppressions=0"
   export FREP_TEST_TIME_SCALE=$ASAN_TIME_SCALE
   CORE_FILTER=$ASAN_CORE_FILTER FARM_FILTER=$ASAN_FARM_FILTER LANG_FILTER=$ASAN_LANG_FILTER
   CLI_UNIT_FILTER=$ASAN_CLI_UNIT_FILTER CLI_FILTER=$ASAN_CLI_FILTER
   sanitize asan+ubsan "-fsanitize=address,undefined -fno-sanitize-recover=undefined"
-  unset ASAN_OPTIONS UBSAN_OPTIONS FREP_TEST_TIME_SCALE
+  unset ASAN_OPTIONS UBSAN_OPTIONS LSAN_OPTIONS FREP_TEST_TIME_SCALE
 fi
 if [ "$WHICH" = tsan ] || [ "$WHICH" = all ]; then
   dir=${FREP_TSAN_BUILD:-$REPO/build-tsan}
