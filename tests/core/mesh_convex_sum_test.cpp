@@ -335,7 +335,9 @@ TEST(MeshConvexSum, ClassesOfClusteredPointsHoldForThinAndThickOperands) {
         if (std::abs(e) < 1e-9) continue;
         ASSERT_EQ(s[i] >= 0, e > 0) << "w " << w << " at " << p[0] << " " << p[1] << " " << p[2];
         ASSERT_EQ(f[i] >= 0, e > 0) << "w " << w << " at " << p[0] << " " << p[1] << " " << p[2];
-        if (e < 0) EXPECT_NEAR(f[i], e, 1e-9);
+        if (e < 0) {
+          EXPECT_NEAR(f[i], e, 1e-9);
+        }
         (e > 0 ? in : out) += 1;
       }
     }
@@ -399,7 +401,9 @@ TEST(MeshConvexSum, NonConvexToolIsCutIntoConvexPieces) {
       const double e = unionOfSums(p), f = eval(sum, p);
       if (std::abs(e) < 1e-9) continue;
       ASSERT_EQ(f >= 0, e > 0) << p[0] << " " << p[1] << " " << p[2];
-      if (e < 0) EXPECT_NEAR(f, e, 1e-9) << p[0] << " " << p[1] << " " << p[2];
+      if (e < 0) {
+        EXPECT_NEAR(f, e, 1e-9) << p[0] << " " << p[1] << " " << p[2];
+      }
       (e > 0 ? in : out) += 1;
     }
     EXPECT_GT(in, 300);

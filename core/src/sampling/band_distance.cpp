@@ -98,16 +98,9 @@ void bandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOptions
         const double disc = gn * gn - 2 * f0 * nHn;
         s = disc > 0 ? 2 * f0 / (gn + std::sqrt(disc)) : f0 / gn;  // no real root: first order
       }
-      const uint64_t bit = uint64_t(1) << (n & 63);
       const float d = float(std::fabs(s));
       const bool inside = f0 >= 0;
-      if (d < background) {
-        // An outside voxel keeps its sign (sample.h storedValue): never -0.
-        l.values[size_t(n)] = inside ? d : (d > 0 ? -d : -std::numeric_limits<float>::denorm_min());
-      } else {
-        l.values[size_t(n)] = inside ? background : -background;
-        l.active[size_t(n >> 6)] &= ~bit;
-      }
+      detail::storeBandDistance(l, n, d, inside, background);
     }
   };
   // Leaves in parallel (in-process runs sample a brick on every core): each writes only its own

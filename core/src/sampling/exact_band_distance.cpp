@@ -294,16 +294,9 @@ void exactBandDistance(const TapePtr& tape, const GridSpec& grid, const SampleOp
           cell(row + z, o, best);
         }
       }
-      const uint64_t bit = uint64_t(1) << (n & 63);
       const float d = float(std::sqrt(best) * h);
       const bool inside = insideValue(l.values[size_t(n)]);
-      if (d < background) {
-        // An outside voxel keeps its sign (sample.h storedValue): never -0.
-        l.values[size_t(n)] = inside ? d : (d > 0 ? -d : -std::numeric_limits<float>::denorm_min());
-      } else {
-        l.values[size_t(n)] = inside ? background : -background;
-        l.active[size_t(n >> 6)] &= ~bit;
-      }
+      detail::storeBandDistance(l, n, d, inside, background);
     }
   };
   // Leaves in parallel (in-process runs sample a brick on every core): each writes only its own

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "frep/sampling/band_distance.h"
@@ -39,5 +40,17 @@ class HaloField {
   std::vector<float>* value_;  // the thread's array, kept between calls
   std::vector<int64_t> evaluated_;
 };
+
+// Voxel n of a band leaf set to the distance d (>= 0) signed by `inside`: an outside voxel keeps
+// its sign (sample.h storedValue: never -0); at or past the band's edge the background, and the
+// voxel leaves the band.
+inline void storeBandDistance(LeafBlock& l, int64_t n, float d, bool inside, float background) {
+  if (d < background) {
+    l.values[size_t(n)] = inside ? d : (d > 0 ? -d : -std::numeric_limits<float>::denorm_min());
+  } else {
+    l.values[size_t(n)] = inside ? background : -background;
+    l.active[size_t(n >> 6)] &= ~(uint64_t(1) << (n & 63));
+  }
+}
 
 }  // namespace frep::detail
