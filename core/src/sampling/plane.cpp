@@ -60,22 +60,12 @@ class PlaneEvaluator {
       : l_(l), opt_(opt), out_(out), nvars_(std::max<uint32_t>(tape->numVars(), 1)),
         float_(opt.signOnly && opt.floatSigns && FloatErrorBound::supports(*tape)) {}
 
-  double colCoord(int c) const { return l_.origin[0] + double(c) * l_.step; }
-  double rowCoord(int r) const { return l_.origin[1] + double(l_.height - 1 - r) * l_.step; }
-
-  // Value of coordinate `var` other than u and v.
-  double held(uint32_t var) const {
-    if (int(var) == l_.normal) return l_.at;
-    if (var >= 3 && var - 3 < l_.fixed.size()) return l_.fixed[var - 3];
-    return 0.0;
-  }
-
   // Pixels [c0, c1) x [r0, r1) with the tape that the enclosing tile decided.
   void tile(PlaneWorker& w, int c0, int c1, int r0, int r1, const TapePtr& tape) {
     w.box.resize(nvars_);
-    for (uint32_t var = 0; var < nvars_; ++var) w.box[var] = Interval(held(var));
-    if (l_.u < nvars_) w.box[l_.u] = Interval(colCoord(c0), colCoord(c1 - 1));
-    if (l_.v < nvars_) w.box[l_.v] = Interval(rowCoord(r1 - 1), rowCoord(r0));
+    for (uint32_t var = 0; var < nvars_; ++var) w.box[var] = Interval(l_.held(var));
+    if (l_.u < nvars_) w.box[l_.u] = Interval(l_.colCoord(c0), l_.colCoord(c1 - 1));
+    if (l_.v < nvars_) w.box[l_.v] = Interval(l_.rowCoord(r1 - 1), l_.rowCoord(r0));
     ++w.stats.intervalEvals;
     w.stats.intervalInstrs += tape->size();
     const Interval iv = w.interval.eval(*tape, w.box.data());
@@ -110,13 +100,13 @@ class PlaneEvaluator {
     w.batch.reserve(tape);
     for (uint32_t var = 0; var < tape.numVars(); ++var) {
       if (var == l_.u || var == l_.v) continue;
-      std::fill(w.batch.in(var), w.batch.in(var) + n, held(var));
+      std::fill(w.batch.in(var), w.batch.in(var) + n, l_.held(var));
     }
     size_t k = 0;
     for (int r = r0; r < r1; ++r)
       for (int c = c0; c < c1; ++c, ++k) {
-        if (l_.u < tape.numVars()) w.batch.in(l_.u)[k] = colCoord(c);
-        if (l_.v < tape.numVars()) w.batch.in(l_.v)[k] = rowCoord(r);
+        if (l_.u < tape.numVars()) w.batch.in(l_.u)[k] = l_.colCoord(c);
+        if (l_.v < tape.numVars()) w.batch.in(l_.v)[k] = l_.rowCoord(r);
       }
     const double* f = w.batch.eval(tape, n);
     k = 0;
@@ -149,7 +139,7 @@ class PlaneEvaluator {
     fb.reserve(tape);
     for (uint32_t var = 0; var < tape.numVars(); ++var) {
       if (var == l_.u || var == l_.v) continue;
-      std::fill(fb.in(var), fb.in(var) + n, float(held(var)));
+      std::fill(fb.in(var), fb.in(var) + n, float(l_.held(var)));
     }
     // Coordinates rounded to float (the error bound counts that rounding); the lanes of a
     // var the tape does not read go to a scratch row.
@@ -157,8 +147,8 @@ class PlaneEvaluator {
     float* vs = l_.v < tape.numVars() ? fb.in(l_.v) : w.scratch.data();
     size_t k = 0;
     for (int r = r0; r < r1; ++r) {
-      const float v = float(rowCoord(r));
-      for (int c = c0; c < c1; ++c, ++k) us[k] = float(colCoord(c)), vs[k] = v;
+      const float v = float(l_.rowCoord(r));
+      for (int c = c0; c < c1; ++c, ++k) us[k] = float(l_.colCoord(c)), vs[k] = v;
     }
     const float* f = fb.eval(tape, n);
     w.redo.clear();
@@ -182,12 +172,12 @@ class PlaneEvaluator {
     w.batch.reserve(tape);
     for (uint32_t var = 0; var < tape.numVars(); ++var) {
       if (var == l_.u || var == l_.v) continue;
-      std::fill(w.batch.in(var), w.batch.in(var) + m, held(var));
+      std::fill(w.batch.in(var), w.batch.in(var) + m, l_.held(var));
     }
     for (size_t j = 0; j < m; ++j) {
       const int c = c0 + int(w.redo[j] % uint32_t(cols)), r = r0 + int(w.redo[j] / uint32_t(cols));
-      if (l_.u < tape.numVars()) w.batch.in(l_.u)[j] = colCoord(c);
-      if (l_.v < tape.numVars()) w.batch.in(l_.v)[j] = rowCoord(r);
+      if (l_.u < tape.numVars()) w.batch.in(l_.u)[j] = l_.colCoord(c);
+      if (l_.v < tape.numVars()) w.batch.in(l_.v)[j] = l_.rowCoord(r);
     }
     const double* g = w.batch.eval(tape, m);
     for (size_t j = 0; j < m; ++j) {

@@ -55,16 +55,9 @@ class DensePlane {
       : tape_(tape), l_(l), opt_(opt), out_(out), float_(opt.signOnly && opt.floatSigns) {
     root_.assign(*tape);
     nvb_ = std::max<uint32_t>(root_.numVars, 1);
-    for (int c = 0; c < l.width; ++c) colD_.push_back(colCoord(c)), colF_.push_back(float(colCoord(c)));
+    for (int c = 0; c < l.width; ++c) colD_.push_back(l_.colCoord(c)), colF_.push_back(float(l_.colCoord(c)));
   }
 
-  double colCoord(int c) const { return l_.origin[0] + double(c) * l_.step; }
-  double rowCoord(int r) const { return l_.origin[1] + double(l_.height - 1 - r) * l_.step; }
-  double held(uint32_t var) const {
-    if (int(var) == l_.normal) return l_.at;
-    if (var >= 3 && var - 3 < l_.fixed.size()) return l_.fixed[var - 3];
-    return 0.0;
-  }
   size_t index(int c, int r) const { return size_t(r) * size_t(l_.width) + size_t(c); }
 
   // Per thread, once: the root's constants, and the lanes of the held coordinates (the tapes
@@ -78,12 +71,12 @@ class DensePlane {
     for (auto& boxes : w.boxes) {
       boxes.resize(4 * nvb_);
       for (size_t j = 0; j < 4; ++j)
-        for (uint32_t var = 0; var < root_.numVars; ++var) boxes[j * nvb_ + var] = Interval(held(var));
+        for (uint32_t var = 0; var < root_.numVars; ++var) boxes[j * nvb_ + var] = Interval(l_.held(var));
     }
     for (uint32_t var = 0; var < root_.numVars; ++var) {
       if (var == l_.u || var == l_.v) continue;
-      std::fill(w.fbatch.in(var), w.fbatch.in(var) + DenseBatchEvaluator<float>::kBatch, float(held(var)));
-      std::fill(w.dbatch.in(var), w.dbatch.in(var) + DenseBatchEvaluator<double>::kBatch, held(var));
+      std::fill(w.fbatch.in(var), w.fbatch.in(var) + DenseBatchEvaluator<float>::kBatch, float(l_.held(var)));
+      std::fill(w.dbatch.in(var), w.dbatch.in(var) + DenseBatchEvaluator<double>::kBatch, l_.held(var));
     }
     w.ready = true;
   }
@@ -124,8 +117,8 @@ class DensePlane {
   bool isTop(const Rect& t) const { return t.c1 - t.c0 <= kTopTile && t.r1 - t.r0 <= kTopTile; }
   bool isLeaf(const Rect& t) const { return t.c1 - t.c0 <= leafSide_ && t.r1 - t.r0 <= leafSide_; }
   void setBox(Interval* b, const Rect& t) const {
-    if (l_.u < root_.numVars) b[l_.u] = Interval(colCoord(t.c0), colCoord(t.c1 - 1));
-    if (l_.v < root_.numVars) b[l_.v] = Interval(rowCoord(t.r1 - 1), rowCoord(t.r0));
+    if (l_.u < root_.numVars) b[l_.u] = Interval(l_.colCoord(t.c0), l_.colCoord(t.c1 - 1));
+    if (l_.v < root_.numVars) b[l_.v] = Interval(l_.rowCoord(t.r1 - 1), l_.rowCoord(t.r0));
   }
 
   // Counts tile t's interval pass (over a tape of `size` instructions); with signOnly, fills it
@@ -214,7 +207,7 @@ class DensePlane {
       for (size_t k = 0, r = size_t(r0); r < size_t(r1); ++r, k += cols) std::copy(cs, cs + cols, b.in(l_.u) + k);
     if (l_.v < root_.numVars)
       for (size_t k = 0, r = size_t(r0); r < size_t(r1); ++r, k += cols)
-        std::fill(b.in(l_.v) + k, b.in(l_.v) + k + cols, T(rowCoord(int(r))));
+        std::fill(b.in(l_.v) + k, b.in(l_.v) + k + cols, T(l_.rowCoord(int(r))));
   }
   // Every column's u, in double and rounded to float (the leaves' coordinates, computed once).
   template <typename T>
@@ -274,8 +267,8 @@ class DensePlane {
     double* vs = l_.v < root_.numVars ? w.dbatch.in(l_.v) : nullptr;
     for (size_t j = 0; j < m; ++j) {
       const int c = c0 + int(w.redo[j] % uint32_t(cols)), r = r0 + int(w.redo[j] / uint32_t(cols));
-      if (us) us[j] = colCoord(c);
-      if (vs) vs[j] = rowCoord(r);
+      if (us) us[j] = l_.colCoord(c);
+      if (vs) vs[j] = l_.rowCoord(r);
     }
     const double* g = w.dbatch.eval(tape, m);
     for (size_t j = 0; j < m; ++j) {

@@ -22,6 +22,15 @@ struct PlaneLattice {
   double origin[2] = {0, 0};  // (u, v) of the bottom-left pixel
   double step = 1.0;          // pixel spacing in model units
   int width = 0, height = 0;  // row 0 is the top row (v = origin[1] + (height - 1) * step)
+
+  double colCoord(int c) const { return origin[0] + double(c) * step; }
+  double rowCoord(int r) const { return origin[1] + double(height - 1 - r) * step; }
+  // Value of coordinate `var` other than u and v.
+  double held(uint32_t var) const {
+    if (int(var) == normal) return at;
+    if (var >= 3 && var - 3 < fixed.size()) return fixed[var - 3];
+    return 0.0;
+  }
 };
 
 struct PlaneStats {
