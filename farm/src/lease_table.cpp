@@ -133,7 +133,10 @@ LeaseClock::duration LeaseTable::turn(LeaseTime last, LeaseTime now) {
   if (now - last <= policy_.liveWindow) return LeaseClock::duration::zero();
   ++stats_.masterStalls;
   const auto gap = now - last;
-  for (auto& [rid, p] : peers_) p.expiry = std::max(p.expiry, now + policy_.liveWindow);
+  // A worker's backoff after a silence of `gap` is at most gap + the first one (the earlier ones
+  // and their windows add up to the current one minus the first), capped.
+  const LeaseClock::duration sleep = std::min<LeaseClock::duration>(gap + kReconnectFirstBackoff, kReconnectMaxBackoff);
+  for (auto& [rid, p] : peers_) p.expiry = std::max(p.expiry, now + sleep + policy_.liveWindow);
   for (uint64_t id : leased_) bricks_[id].firstLease += gap;
   return gap;
 }

@@ -22,6 +22,7 @@
 #include "frep/worker/brick.h"
 #include "frep/net/curve.h"
 #include "frep/net/wire.h"
+#include "frep/farm/lease_table.h"
 
 namespace frep::farm {
 
@@ -233,7 +234,7 @@ class ComputeThread {
   }
 
   int threads_;
-  uint64_t started_ = 0;  // bricks this worker started (FREP_TEST_DIE_AFTER)
+  uint64_t started_ = 0;         // bricks this worker started (FREP_TEST_DIE_AFTER)
   bool announcedStart_ = false;  // FREP_TEST_STARTED_FILE written
   zmq::socket_t wakeSend_;
   ModelCache cache_;
@@ -264,7 +265,7 @@ int runWorker(const WorkerOptions& opt) {
   const std::string workerId = makeWorkerId();
   int heartbeatMs = 500, liveness = 5;
   auto lastMasterContact = Clock::now();
-  int backoffMs = 1000;
+  int backoffMs = int(kReconnectFirstBackoff.count());
   uint64_t jobId = 0;                  // the job of the last welcome (jobIdOf(*job))
   std::shared_ptr<const JobSpec> job;  // its spec: tasks carry only its id
 
@@ -321,8 +322,7 @@ int runWorker(const WorkerOptions& opt) {
       }
       if (items[1].revents & ZMQ_POLLIN) {
         zmq::message_t m;
-        while (wakeRecv.recv(m, zmq::recv_flags::dontwait)) {
-        }
+        while (wakeRecv.recv(m, zmq::recv_flags::dontwait)) {}
       }
       Outgoing out;
       while (compute.popResult(out)) send(sock, "", out.env, out.hasPayload ? &out.payload : nullptr);
@@ -332,7 +332,7 @@ int runWorker(const WorkerOptions& opt) {
         std::string err;
         while (receive(sock, false, in, &err)) {
           heard = lastMasterContact = now;
-          backoffMs = 1000;
+          backoffMs = int(kReconnectFirstBackoff.count());
           if (!err.empty()) {
             spdlog::warn("worker {}: malformed message from master: {}", workerId, err);
             continue;
@@ -407,7 +407,7 @@ int runWorker(const WorkerOptions& opt) {
       }
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(backoffMs));
-    backoffMs = std::min(backoffMs * 2, 32000);
+    backoffMs = std::min(backoffMs * 2, int(kReconnectMaxBackoff.count()));
   }
 }
 

@@ -27,6 +27,11 @@ constexpr int kCredit = 4;  // bricks in flight per worker (hides latency)
 constexpr size_t kIndependentFailures = 2;
 constexpr uint64_t kBanAfterRefuted = 3;
 constexpr size_t kMaxSkippedForPeer = 64;  // bricks a peer failed passed over per dispatch (bounded scan)
+// A worker that hears nothing from its master for a live window reconnects after the first
+// backoff, doubling it per silent attempt up to the last (worker.cpp); the master, waking from
+// its own stall, gives its workers that long to come back (LeaseTable::turn).
+constexpr std::chrono::milliseconds kReconnectFirstBackoff{1000};
+constexpr std::chrono::milliseconds kReconnectMaxBackoff{32000};
 
 enum class BrickPhase { Pending, Leased, Done, Poisoned };
 enum class Departure { Left, Dead, Dropped };
@@ -124,8 +129,9 @@ class LeaseTable {
   // Drops the peers silent past their window (counted dead); returns how many.
   size_t expire(LeaseTime now);
   // The loop's turn at `now` after the one at `last`: a gap longer than the live window is the
-  // master's own stall, not its peers' silence: every peer's window and every lease timer moves
-  // on by it. Returns the gap if so (counted), else zero.
+  // master's own stall, not its peers' silence: every lease timer moves on by it, and every peer
+  // has until the end of the reconnect backoff it may be sleeping in (as long as the gap, up to
+  // kReconnectMaxBackoff) plus a window. Returns the gap if so (counted), else zero.
   LeaseClock::duration turn(LeaseTime last, LeaseTime now);
 
   // ---- leases ----
