@@ -133,6 +133,14 @@ farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, cons
   return o;
 }
 
+std::string smallJobInProcess(const FarmRequest& f, const std::array<int32_t, 3>& dims) {
+  if (f.workers != -1 || !f.listen.empty() || f.expectWorkers != 0 || !f.verify.empty() || f.replicate != 1) return "";
+  const uint64_t points = uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
+  if (points > kInProcessMaxPoints) return "";
+  return "small job (" + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" + std::to_string(dims[2]) +
+         " grid points, at most 64^3): computed in-process, as starting workers would cost more; --workers N to use them";
+}
+
 int chooseBrick(const std::array<int32_t, 3>& dims, int workers, const std::string& listen, int expectWorkers) {
   int n = !listen.empty() ? expectWorkers
           : workers < 0   ? int(std::max(1u, std::thread::hardware_concurrency()))
@@ -272,7 +280,8 @@ void requireComplete(const farm::FarmReport& report) {
 std::string bricksSummary(const farm::FarmReport& report) {
   return "bricks " + std::to_string(report.bricks) + " (" + std::to_string(report.bricksComputed) + " computed, " +
          std::to_string(report.bricksFromJournal) + " from the journal), workers " +
-         std::to_string(report.workersSeen) + ", retries " + std::to_string(report.retries) + ", " +
+         std::to_string(report.workersSeen) + (report.inProcessRule.empty() ? "" : " (in-process: small job)") +
+         ", retries " + std::to_string(report.retries) + ", " +
          formatNumber(std::round(report.wallSeconds * 1000) / 1000) + " s" + verificationSummary(report);
 }
 

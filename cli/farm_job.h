@@ -34,6 +34,14 @@ void checkJobSize(const GridSpec& grid, int brick);
 // OUT.journal; `threads` is the in-process run's thread count (--workers 0).
 farm::FarmOptions farmOptions(const FarmRequest& f, const std::string& out, const std::string& logLevel, int threads);
 
+// The default when --workers is not given: a job of at most kInProcessMaxPoints grid points (one
+// default brick, 64^3) is computed in-process on all cores, as the farm's start costs more than
+// such a job (each worker's exec, library loading and model compile, the job's exchange; measured
+// in docs/cli.md). Not with --listen, --expect-workers, --verify or --replicate (they need
+// workers). Returns the reason, for the log and the report, or "" (the farm runs).
+constexpr uint64_t kInProcessMaxPoints = uint64_t(64) * 64 * 64;
+std::string smallJobInProcess(const FarmRequest& f, const std::array<int32_t, 3>& dims);
+
 // The brick edge when --brick is not given: 64, halved (down to 16) until the grid has at
 // least two bricks per worker (workers < 0: one per core; in cluster mode --expect-workers, else
 // 64). Any brick gives the same output bytes; this only keeps every worker busy.

@@ -133,8 +133,11 @@ int runMesh(const MeshRequest& request) {
     throw badArgs("frep mesh needs at most three coordinates; '" + m.model.objectName + "' has " +
                   std::to_string(m.dims) + " (map them with -x, e.g. -x X,Y,Z,0.5)");
   GridSpec grid = makeGrid(box, 3, res);
+  // No --workers and a grid of one default brick at most: in-process (smallJobInProcess).
+  const std::string inProcessRule = smallJobInProcess(request.farm, grid.dims);
+  if (!inProcessRule.empty()) options.workers = 0;
   if (request.farm.brick == -1)
-    options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
+    options.brickVoxels = chooseBrick(grid.dims, options.workers, request.farm.listen, request.farm.expectWorkers);
   for (int a = 0; a < 3; ++a)
     if (grid.dims[a] < 2 || grid.dims[a] >= kMaxMeshGridPoints)
       throw badArgs("--res/-g: the grid needs 2 to " + std::to_string(kMaxMeshGridPoints - 1) + " points per axis");
@@ -189,9 +192,11 @@ int runMesh(const MeshRequest& request) {
   spdlog::info("meshing '{}' on {}x{}x{} points of {}", m.model.objectName, grid.dims[0], grid.dims[1], grid.dims[2],
                grid.voxel);
   const auto start = std::chrono::steady_clock::now();
+  if (!inProcessRule.empty()) spdlog::info("{}", inProcessRule);
   jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
   farm::FarmReport& report = outcome.report;
+  report.inProcessRule = inProcessRule;
   requireComplete(reportOut, report, request.farm.strict);
   Mesh& mesh = outcome.mesh;
   const double meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

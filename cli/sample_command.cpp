@@ -60,8 +60,11 @@ int runSample(const SampleRequest& request) {
   Resolution res = resolutionFrom(request.region.res, request.region.cells, 128);
   farm::FarmOptions options = farmOptions(request.farm, request.region.out, request.logLevel, request.threads);
   GridSpec grid = makeWorldLatticeGrid(box, res);
+  // No --workers and a grid of one default brick at most: in-process (smallJobInProcess).
+  const std::string inProcessRule = smallJobInProcess(request.farm, grid.dims);
+  if (!inProcessRule.empty()) options.workers = 0;
   if (request.farm.brick == -1)
-    options.brickVoxels = chooseBrick(grid.dims, request.farm.workers, request.farm.listen, request.farm.expectWorkers);
+    options.brickVoxels = chooseBrick(grid.dims, options.workers, request.farm.listen, request.farm.expectWorkers);
   checkJobSize(grid, options.brickVoxels);  // before the model is even read: refused at once
   LoadedModel m = loadModel(request.model, true);
   // The master receives, journals, decodes and streams every brick: its buffers come and go by
@@ -110,9 +113,11 @@ int runSample(const SampleRequest& request) {
     builder.reset();  // its memory first
     builder.emplace(farm::gridOf(job), request.band, spill);
   };
+  if (!inProcessRule.empty()) spdlog::info("{}", inProcessRule);
   jsonPhase("compute");
   farm::FarmOutcome outcome = runFarmJob(job, options);
   farm::FarmReport& report = outcome.report;
+  report.inProcessRule = inProcessRule;
   requireComplete(reportOut, report, request.farm.strict);
   report.cutFaces = cut.names();
   if (job.distance())

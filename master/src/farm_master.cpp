@@ -71,6 +71,7 @@ std::string FarmReport::toJson() const {
                        {"unavailable", verifyUnavailable.empty() ? nlohmann::json() : nlohmann::json(verifyUnavailable)},
                        {"restreamed", restreamed}};
   j["workers_seen"] = workersSeen;
+  j["in_process_rule"] = inProcessRule.empty() ? nlohmann::json() : nlohmann::json(inProcessRule);
   j["master_cpu_seconds"] = masterCpuSeconds;
   j["master_cpu_after_last_brick"] = masterCpuAfterLastBrick;
   nlohmann::json w = nlohmann::json::object();

@@ -1,6 +1,6 @@
 // `frep mesh` on the farm, end to end through the built binaries: the same bytes for any worker
-// count and brick size (PLY, OBJ, STL), the report beside the output, SIGTERM and --resume,
-// poisoned bricks, JSON progress, and the farm options' errors.
+// count and brick size (PLY, OBJ, STL), the report beside the output, small jobs in-process by
+// default, SIGTERM and --resume, poisoned bricks, JSON progress, and the farm options' errors.
 #include <chrono>
 #include <thread>
 
@@ -54,6 +54,41 @@ TEST_F(MeshFarmCli, SameBytesForAnyWorkerCountAndBrickSize) {
     EXPECT_FALSE(readText(path(std::string("a.") + ext)) == readText(path(std::string("b.") + ext)));  // simplified
     EXPECT_TRUE(fileExists(path(std::string("b.") + ext + ".report.json")));
   }
+}
+
+// Without --workers, a grid of at most 64^3 points is computed in-process (the farm's start
+// would cost more, docs/cli.md) and the report and summary say so; one point more, or an explicit
+// --workers, and workers compute it. The bytes are the farm's either way.
+TEST_F(MeshFarmCli, SmallJobWithoutWorkerCountRunsInProcess) {
+  RunResult small = run(meshArgs("s.ply", 64));
+  ASSERT_EQ(small.code, 0) << small.err;
+  std::string report = readText(path("s.ply.report.json"));
+  EXPECT_NE(report.find("\"in_process_rule\": \"small job (64x64x64 grid points"), std::string::npos) << report;
+  EXPECT_EQ(jsonNumber(report, "workers_seen"), 0) << report;
+  EXPECT_NE(small.out.find("workers 0 (in-process: small job)"), std::string::npos) << small.out;
+  EXPECT_NE(small.err.find("small job (64x64x64 grid points, at most 64^3): computed in-process"), std::string::npos)
+      << small.err;
+  RunResult farm = run(meshArgs("f.ply", 64) + " --workers 2");
+  ASSERT_EQ(farm.code, 0) << farm.err;
+  report = readText(path("f.ply.report.json"));
+  EXPECT_NE(report.find("\"in_process_rule\": null"), std::string::npos) << report;
+  EXPECT_EQ(jsonNumber(report, "workers_seen"), 2) << report;
+  EXPECT_TRUE(readText(path("s.ply")) == readText(path("f.ply"))) << "output bytes differ";
+  RunResult big = run(meshArgs("b.ply", 65));  // 65^3 points: one more than a default brick
+  ASSERT_EQ(big.code, 0) << big.err;
+  report = readText(path("b.ply.report.json"));
+  EXPECT_NE(report.find("\"in_process_rule\": null"), std::string::npos) << report;
+  EXPECT_GE(jsonNumber(report, "workers_seen"), 1) << report;
+  EXPECT_EQ(big.out.find("in-process"), std::string::npos) << big.out;
+  // frep sample follows the same rule; --verify needs workers, so it keeps them.
+  RunResult sample = run("sample part.hf -b 1 --res 32 --no-progress -O s.vdb");
+  ASSERT_EQ(sample.code, 0) << sample.err;
+  EXPECT_NE(readText(path("s.vdb.report.json")).find("\"in_process_rule\": \"small job"), std::string::npos);
+  RunResult verified = run("sample part.hf -b 1 --res 32 --no-progress --verify 1 -O v.vdb");
+  ASSERT_EQ(verified.code, 0) << verified.err;
+  report = readText(path("v.vdb.report.json"));
+  EXPECT_NE(report.find("\"in_process_rule\": null"), std::string::npos) << report;
+  EXPECT_GE(jsonNumber(report, "workers_seen"), 1) << report;
 }
 
 TEST_F(MeshFarmCli, SigtermStopsTheMasterWhichResumesLater) {

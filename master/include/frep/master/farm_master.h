@@ -164,6 +164,7 @@ struct FarmReport {
   double extremumWidestGap = 0;  // the widest gap an uncertified search left (infinite: unknown)
   std::vector<std::string> errorBounds;  // one line per extremum node of the model
   int workersSeen = 0;
+  std::string inProcessRule;  // why the CLI ran the job in-process unasked (no --workers), or ""
   // The master's own CPU (its process, every thread; local workers are other processes): the
   // whole job, and after its last brick came in (the final merge; farm_master.cpp, runJob).
   double masterCpuSeconds = 0, masterCpuAfterLastBrick = 0;
