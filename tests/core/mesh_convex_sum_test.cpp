@@ -367,7 +367,7 @@ Expr lPrismAt(double s, double h, const V3& shift) {
 }
 
 TEST(MeshConvexSum, NonConvexToolIsCutIntoConvexPieces) {
-  // L ⊕ L' with both operands non-convex: the tool (star-shaped) is cut into convex pyramids,
+  // L ⊕ L' with both operands non-convex: the tool is covered by convex pieces (two bars),
   // and the sum is the union of the four block sums A_i ⊕ B_j (a block ⊕ a block is the block
   // of summed corners): exact outside, the sign everywhere. Then a block eroded by the L tool,
   // (C ⊖ B_1) ∩ (C ⊖ B_2): exact inside.
@@ -384,6 +384,10 @@ TEST(MeshConvexSum, NonConvexToolIsCutIntoConvexPieces) {
     Expr sum;
     ASSERT_TRUE(bigCut ? minkowski::meshConvexSum(lPrismAt(s, hb, shift), lPrism(h), 3, &sum)
                        : minkowski::meshConvexSum(lPrism(h), lPrismAt(s, hb, shift), 3, &sum));
+    // The cut L is covered by its two overlapping bars (convex_cover.h), not ten pyramids.
+    const auto term = minkowski::lookupExact(sum);
+    ASSERT_TRUE(term);
+    EXPECT_NE(term->operand.find(" as 2 convex pieces"), std::string::npos) << term->operand;
     auto unionOfSums = [&](const V3& p) {
       double f = -INFINITY;
       for (const auto& a : A)

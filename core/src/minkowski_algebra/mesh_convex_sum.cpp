@@ -15,6 +15,7 @@
 
 #include "frep/geometry/cell_lists.h"
 #include "frep/geometry/distance_fields.h"
+#include "frep/minkowski_algebra/convex_cover.h"
 #include "frep/minkowski_algebra/convex_polytope.h"
 #include "frep/minkowski_algebra/registry.h"
 #include "frep/minkowski_algebra/star_pieces.h"
@@ -59,8 +60,8 @@ void facetTriangles(const V3& u, const std::vector<V3>& pts, double tol, Emit&& 
 // See mesh_convex_sum.h. complement: the field of A^c ⊕ B (for the difference, B = -B).
 class MeshConvexSumField : public DistanceField {
  public:
-  // B is the union of the convex pieces bs (one for a convex B; star_pieces.h otherwise, all
-  // sharing a point, so B is connected): A ⊕ B = (A + b0) ∪ ⋃_{T, i} (T ⊕ B_i), and the
+  // B is the union of the convex pieces bs (one for a convex B; convex_cover.h or
+  // star_pieces.h otherwise, B connected either way): A ⊕ B = (A + b0) ∪ ⋃_{T, i} (T ⊕ B_i), and the
   // boundary pieces of every A ⊕ B_i together cover its boundary.
   MeshConvexSumField(const Mesh& a, std::shared_ptr<const MeshField> aField, const std::vector<Convex>& bs,
                      bool complement, std::string name)
@@ -530,7 +531,7 @@ thread_local MeshConvexSumField::ClassOfCell MeshConvexSumField::tClassOfCell[40
 // A tool cut into more pieces than this is left to the search: each piece adds a copy of A's cells.
 constexpr size_t kMaxPieces = 64;
 
-// pieces: a B that is not convex may be cut into convex pieces (star_pieces.h), each of which
+// pieces: a B that is not convex may be covered by convex pieces (convex_cover.h), each of which
 // adds a copy of A's cells, so the callers try the convex forms first.
 bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, Expr* out, double scaleA = 1,
            double scaleB = 1) {
@@ -549,7 +550,10 @@ bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, E
     bs.push_back(std::move(*cb));
   } else {
     if (!pieces || b->t.size() > 4096) return false;
-    auto star = starConvexPieces(b->v, b->t, 1e-6 * scale, kMaxPieces);
+    // A cover by overlapping convex pieces (convex_cover.h: fewer and fuller, any tool), else
+    // the pyramids from a kernel point.
+    auto star = convexCover(b->v, b->t, kMaxPieces);
+    if (!star) star = starConvexPieces(b->v, b->t, 1e-6 * scale, kMaxPieces);
     if (!star) return false;
     for (const PieceMesh& pm : *star) {
       std::optional<Convex> c = convexOf(Mesh{pm.v, pm.t, ""}, scale);
