@@ -3,6 +3,7 @@
 // polytope (closed forms at points whose nearest feature is a face, an edge or a vertex).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -96,9 +97,130 @@ TEST(ConvexPolytope, SumWithABallIsTheOffsetOfTheExactDistance) {
   ASSERT_TRUE(minkowski::distanceBallSum(tetrahedron(h), ball, 3, &sum));
   const double far = 0.25;  // beyond the vertex (-h, -h, -h) by `far` along each axis
   EXPECT_NEAR(eval(sum, -h - far, -h - far, -h - far), r - far * std::sqrt(3.0), 1e-12);
-  EXPECT_GT(eval(sum, -h - 0.1, -h - 0.1, -h - 0.1), 0);  // 0.173 from the vertex: in the sum
+  EXPECT_GT(eval(sum, -h - 0.1, -h - 0.1, -h - 0.1), 0);                  // 0.173 from the vertex: in the sum
   EXPECT_LT(eval(min(sum, Expr(1.0)), -h - 0.2, -h - 0.2, -h - 0.2), 0);  // 0.346: outside
   const auto described = minkowski::describeExact(sum);
   ASSERT_FALSE(described.empty());
   EXPECT_NE(described[0].find("convex polytope of 4 facets"), std::string::npos) << described[0];
+}
+
+namespace {
+
+// The exact distance from p to the box [lo, hi] outside it (0 inside).
+double boxOutsideDistance(const double p[3], const double lo[3], const double hi[3]) {
+  double s = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double d = std::max({lo[a] - p[a], 0.0, p[a] - hi[a]});
+    s += d * d;
+  }
+  return std::sqrt(s);
+}
+
+// The box [lo, hi] as the min of its six planes (HyperFun's hfBlock in min/max form).
+Expr block(const double lo[3], const double hi[3]) {
+  const Expr c[3] = {X(), Y(), Z()};
+  Expr e;
+  for (int a = 0; a < 3; ++a) {
+    const Expr slab = min(c[a] - lo[a], hi[a] - c[a]);
+    e = a == 0 ? slab : min(e, slab);
+  }
+  return e;
+}
+
+}  // namespace
+
+// An L-shaped slab written as a block minus a block (the HyperFun way: s1 \ s2) is the union
+// of two boxes: the normal form keeps the two non-empty terms of block1 ∩ (outside one plane of
+// block2), and the field is the exact distance to their union outside it.
+TEST(PolytopeUnion, BlockMinusBlockIsAUnionOfBoxesWithTheExactOutsideDistance) {
+  const double lo1[3] = {-1, -1, -0.25}, hi1[3] = {1, 1, 0.25};
+  const double lo2[3] = {-0.2, -0.2, -1}, hi2[3] = {1.3, 1.3, 1};
+  const Expr slab = rIntersection(block(lo1, hi1), -block(lo2, hi2), 0.0);
+  EXPECT_FALSE(minkowski::convexPolytopeOf(slab).has_value());
+  auto u = minkowski::polytopeUnionOf(slab);
+  ASSERT_TRUE(u.has_value());
+  EXPECT_EQ(u->pieces, 2u);
+  EXPECT_EQ(u->boxes, 2u);
+  // The pieces: x in [-1, -0.2] (full y), y in [-1, -0.2] (full x); they overlap in a corner.
+  const double pa[2][3] = {{-1, -1, -0.25}, {-1, -1, -0.25}}, pb[2][3] = {{-0.2, 1, 0.25}, {1, -0.2, 0.25}};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coord(-1.6, 1.6);
+  int outside = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const double p[3] = {coord(rng), coord(rng), coord(rng)};
+    const double f = eval(u->field, p[0], p[1], p[2]), original = eval(slab, p[0], p[1], p[2]);
+    if (std::abs(original) > 1e-9) EXPECT_EQ(f > 0, original > 0) << p[0] << " " << p[1] << " " << p[2];
+    const double d = std::min(boxOutsideDistance(p, pa[0], pb[0]), boxOutsideDistance(p, pa[1], pb[1]));
+    if (d > 0) {
+      ++outside;
+      EXPECT_NEAR(f, -d, 1e-12) << p[0] << " " << p[1] << " " << p[2];
+    }
+  }
+  EXPECT_GT(outside, 2000);
+  // In the notch (inside the second block), the nearest point is on the first piece's face
+  // x = -0.2: not a distance to the second block's planes (0.2 or 0.3 from the point).
+  EXPECT_NEAR(eval(u->field, 0.3, 0.4, 0), -0.5, 1e-12);
+}
+
+// A tetrahedron minus a block that takes its upper half leaves one general piece, the same
+// polytope as the tetrahedron cut by z <= 0: the same exact distance inside and out.
+TEST(PolytopeUnion, GeneralPiecesKeepTheExactDistanceOfTheirPolytope) {
+  const double lo[3] = {-2, -2, 0}, hi[3] = {2, 2, 2};
+  auto u = minkowski::polytopeUnionOf(min(tetrahedron(0.5), -block(lo, hi)));
+  ASSERT_TRUE(u.has_value());
+  EXPECT_EQ(u->pieces, 1u);
+  EXPECT_EQ(u->boxes, 0u);
+  auto cut = minkowski::convexPolytopeOf(min(tetrahedron(0.5), -Z()));
+  ASSERT_TRUE(cut.has_value());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> coord(-1.2, 1.2);
+  for (int i = 0; i < 1000; ++i) {
+    const double x = coord(rng), y = coord(rng), z = coord(rng);
+    EXPECT_NEAR(eval(u->field, x, y, z), eval(cut->field, x, y, z), 1e-12) << x << " " << y << " " << z;
+  }
+}
+
+TEST(PolytopeUnion, UnboundedEmptyCurvedAndOversizedFormsAreRefused) {
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, big[3] = {2, 2, 2}, nbig[3] = {-2, -2, -2};
+  EXPECT_FALSE(minkowski::polytopeUnionOf(max(block(lo, hi), X())).has_value());  // a half-space
+  EXPECT_FALSE(
+      minkowski::polytopeUnionOf(max(tetrahedron(0.5), X() + Y())).has_value());  // a half-space beside a tetrahedron
+  EXPECT_FALSE(minkowski::polytopeUnionOf(min(block(lo, hi), -block(nbig, big))).has_value());  // empty
+  EXPECT_FALSE(minkowski::polytopeUnionOf(max(block(lo, hi), 0.5 - X() * X())).has_value());    // curved
+  // Seven nested differences of slabs: 2^7 terms, past the limit.
+  Expr many = block(lo, hi);
+  for (int k = 0; k < 7; ++k) many = min(many, max(X() - 0.1 * k, -0.05 * k - Y()));
+  EXPECT_FALSE(minkowski::polytopeUnionOf(many).has_value());
+  // Two disjoint boxes: a union of two pieces.
+  const double lo2[3] = {3, 3, 3}, hi2[3] = {4, 4, 4};
+  auto two = minkowski::polytopeUnionOf(max(block(lo, hi), block(lo2, hi2)));
+  ASSERT_TRUE(two.has_value());
+  EXPECT_EQ(two->pieces, 2u);
+}
+
+// L-slab ⊕ ball: the offset of the union's distance (Roerdink eq. 1: the sum distributes over
+// the union), reported as such; its erosion by the ball is not taken (not exact inside).
+TEST(PolytopeUnion, SumWithABallTakesTheOffsetPathErosionDoesNot) {
+  const double lo1[3] = {-1, -1, -0.25}, hi1[3] = {1, 1, 0.25};
+  const double lo2[3] = {-0.2, -0.2, -1}, hi2[3] = {1.3, 1.3, 1};
+  const Expr slab = min(block(lo1, hi1), -block(lo2, hi2));
+  const double r = 0.3;
+  minkowski::Shape s;
+  s.kind = minkowski::ShapeKind::Sphere;
+  s.size[0] = r;
+  const Expr ball = r * r - X() * X() - Y() * Y() - Z() * Z();
+  minkowski::ExactTerm t;
+  t.sum = minkowski::sumOf(s);
+  t.pieces = 1;
+  minkowski::registerExact(ball, t);
+  Expr sum;
+  ASSERT_TRUE(minkowski::distanceBallSum(slab, ball, 3, &sum));
+  EXPECT_NEAR(eval(sum, 0.3, 0.4, 0), r - 0.5, 1e-12);  // in the notch, 0.5 from its face x = -0.2
+  EXPECT_NEAR(eval(sum, -1.1, 0.5, 0), r - 0.1, 1e-12);
+  EXPECT_NEAR(eval(sum, 0.5, -0.5, 0.5), r - 0.25, 1e-12);
+  const auto described = minkowski::describeExact(sum);
+  ASSERT_FALSE(described.empty());
+  EXPECT_NE(described[0].find("union of 2 convex pieces"), std::string::npos) << described[0];
+  Expr eroded;
+  EXPECT_FALSE(minkowski::distanceBallDifference(slab, ball, 3, &eroded));
 }

@@ -71,41 +71,57 @@ bool halfSpaces(const Expr& e, std::vector<Affine>& planes) {
 }
 
 bool solve3(const Affine& p, const Affine& q, const Affine& r, std::array<double, 3>& x) {
-  const double det = p[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (q[0] * r[2] - q[2] * r[0]) +
-                     p[2] * (q[0] * r[1] - q[1] * r[0]);
+  const double det =
+      p[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (q[0] * r[2] - q[2] * r[0]) + p[2] * (q[0] * r[1] - q[1] * r[0]);
   if (std::abs(det) < 1e-12) return false;
   const double b[3] = {-p[3], -q[3], -r[3]};
-  x[0] = (b[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (b[1] * r[2] - q[2] * b[2]) + p[2] * (b[1] * r[1] - q[1] * b[2])) / det;
-  x[1] = (p[0] * (b[1] * r[2] - q[2] * b[2]) - b[0] * (q[0] * r[2] - q[2] * r[0]) + p[2] * (q[0] * b[2] - b[1] * r[0])) / det;
-  x[2] = (p[0] * (q[1] * b[2] - b[1] * r[1]) - p[1] * (q[0] * b[2] - b[1] * r[0]) + b[0] * (q[0] * r[1] - q[1] * r[0])) / det;
+  x[0] =
+      (b[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (b[1] * r[2] - q[2] * b[2]) + p[2] * (b[1] * r[1] - q[1] * b[2])) /
+      det;
+  x[1] =
+      (p[0] * (b[1] * r[2] - q[2] * b[2]) - b[0] * (q[0] * r[2] - q[2] * r[0]) + p[2] * (q[0] * b[2] - b[1] * r[0])) /
+      det;
+  x[2] =
+      (p[0] * (q[1] * b[2] - b[1] * r[1]) - p[1] * (q[0] * b[2] - b[1] * r[0]) + b[0] * (q[0] * r[1] - q[1] * r[0])) /
+      det;
   return std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
 }
 
 double eval(const Affine& a, const std::array<double, 3>& x) { return a[0] * x[0] + a[1] * x[1] + a[2] * x[2] + a[3]; }
 
-}  // namespace
+using Point = std::array<double, 3>;
 
-std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e) {
-  std::vector<Affine> planes;
-  if (!halfSpaces(minMaxForm(e), planes) || planes.size() < 4) return std::nullopt;
-  // Vertices: feasible intersections of three planes, merged within a tolerance of the extent.
-  std::vector<std::array<double, 3>> verts;
-  double scale = 1;
-  for (const Affine& p : planes) scale = std::max(scale, std::abs(p[3]));
-  const double tol = 1e-9 * scale;
+// The vertices of the intersection of `planes`: feasible intersections of three planes, merged
+// within `tol`.
+std::vector<Point> verticesOf(const std::vector<Affine>& planes, double tol) {
+  std::vector<Point> verts;
   for (size_t i = 0; i < planes.size(); ++i)
     for (size_t j = i + 1; j < planes.size(); ++j)
       for (size_t k = j + 1; k < planes.size(); ++k) {
-        std::array<double, 3> x;
+        Point x;
         if (!solve3(planes[i], planes[j], planes[k], x)) continue;
         bool feasible = true;
         for (const Affine& p : planes) feasible = feasible && eval(p, x) >= -tol;
         if (!feasible) continue;
         bool known = false;
         for (const auto& v : verts)
-          known = known || (std::abs(v[0] - x[0]) <= tol && std::abs(v[1] - x[1]) <= tol && std::abs(v[2] - x[2]) <= tol);
+          known =
+              known || (std::abs(v[0] - x[0]) <= tol && std::abs(v[1] - x[1]) <= tol && std::abs(v[2] - x[2]) <= tol);
         if (!known) verts.push_back(x);
       }
+  return verts;
+}
+
+// The merge tolerance of a set of planes: relative to their largest offset.
+double toleranceOf(const std::vector<Affine>& planes) {
+  double scale = 1;
+  for (const Affine& p : planes) scale = std::max(scale, std::abs(p[3]));
+  return 1e-9 * scale;
+}
+
+// The closed outward mesh of the polytope with these planes and vertices, as its exact signed
+// distance; nothing when the facets do not close (unbounded) or enclose no volume (flat).
+std::optional<ConvexPolytope> meshOf(const std::vector<Affine>& planes, const std::vector<Point>& verts, double tol) {
   if (verts.size() < 4) return std::nullopt;
   // Facets: the vertices on each plane, ordered by angle about their centroid, fanned outward
   // (the outward normal is -n: inside is n . X + d >= 0).
@@ -118,23 +134,23 @@ std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e) {
     for (uint32_t v = 0; v < verts.size(); ++v)
       if (std::abs(eval(p, verts[v])) <= 1e3 * tol) on.push_back(v);
     if (on.size() < 3) continue;
-    std::array<double, 3> c{0, 0, 0};
+    Point c{0, 0, 0};
     for (uint32_t v : on)
       for (int a = 0; a < 3; ++a) c[size_t(a)] += verts[v][size_t(a)] / double(on.size());
     // A basis (u, w) of the plane with u x w = -n, so counter-clockwise in it is outward.
-    const std::array<double, 3> n{p[0], p[1], p[2]};
-    std::array<double, 3> u = std::abs(n[0]) < 0.9 ? std::array<double, 3>{0, -n[2], n[1]}
-                                                   : std::array<double, 3>{n[2], 0, -n[0]};
+    const Point n{p[0], p[1], p[2]};
+    Point u = std::abs(n[0]) < 0.9 ? Point{0, -n[2], n[1]} : Point{n[2], 0, -n[0]};
     const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
     for (double& x : u) x /= ul;
-    const std::array<double, 3> w{-(n[1] * u[2] - n[2] * u[1]), -(n[2] * u[0] - n[0] * u[2]), -(n[0] * u[1] - n[1] * u[0])};
+    const Point w{-(n[1] * u[2] - n[2] * u[1]), -(n[2] * u[0] - n[0] * u[2]), -(n[0] * u[1] - n[1] * u[0])};
     std::vector<std::pair<double, uint32_t>> ring;
     for (uint32_t v : on) {
       const double dx = verts[v][0] - c[0], dy = verts[v][1] - c[1], dz = verts[v][2] - c[2];
       ring.push_back({std::atan2(dx * w[0] + dy * w[1] + dz * w[2], dx * u[0] + dy * u[1] + dz * u[2]), v});
     }
     std::sort(ring.begin(), ring.end());
-    for (size_t t = 1; t + 1 < ring.size(); ++t) tris.insert(tris.end(), {ring[0].second, ring[t].second, ring[t + 1].second});
+    for (size_t t = 1; t + 1 < ring.size(); ++t)
+      tris.insert(tris.end(), {ring[0].second, ring[t].second, ring[t + 1].second});
     ++facets;
   }
   auto mesh = std::make_shared<MeshField>(xyz, tris, "convex polytope of " + std::to_string(facets) + " facets");
@@ -146,6 +162,143 @@ std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e) {
   out.facets = facets;
   out.vertices = verts.size();
   return out;
+}
+
+// ---- unions of polytopes ----
+
+using Term = std::vector<Affine>;  // an intersection of half-spaces (none: the whole space)
+constexpr size_t kMaxTerms = 64, kMaxTermPlanes = 64;
+
+// The disjunctive normal form of e (negated when `negated`): the union of `out`'s terms. False
+// when a leaf is not affine or the form outgrows the limits.
+bool normalForm(const Expr& e, bool negated, std::vector<Term>& out) {
+  out.clear();
+  if (e.op() == Op::Neg) return normalForm(e.arg(0), !negated, out);
+  if (e.op() == Op::Min || e.op() == Op::Max) {
+    std::vector<Term> a, b;
+    if (!normalForm(e.arg(0), negated, a) || !normalForm(e.arg(1), negated, b)) return false;
+    if ((e.op() == Op::Min) != negated) {  // an intersection: every pair of terms
+      if (a.size() * b.size() > kMaxTerms) return false;
+      for (const Term& s : a)
+        for (const Term& t : b) {
+          if (s.size() + t.size() > kMaxTermPlanes) return false;
+          out.push_back(s);
+          out.back().insert(out.back().end(), t.begin(), t.end());
+        }
+      return true;
+    }
+    if (a.size() + b.size() > kMaxTerms) return false;
+    out = std::move(a);
+    out.insert(out.end(), b.begin(), b.end());
+    return true;
+  }
+  Affine a;
+  if (!affineOf(e, a)) return false;
+  if (negated)
+    for (double& c : a) c = -c;
+  const double len = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  if (!(len > 0)) {  // a constant: the whole space or nothing
+    if (a[3] >= 0) out.push_back({});
+    return true;
+  }
+  for (double& c : a) c /= len;
+  out.push_back({a});
+  return true;
+}
+
+enum class Extent { Bounded, Empty, Unbounded };
+
+// A term whose normals all lie along the axes: the box [lo, hi], empty when flat.
+Extent boxOf(const Term& t, Point& lo, Point& hi) {
+  lo.fill(-INFINITY);
+  hi.fill(INFINITY);
+  for (const Affine& p : t) {
+    const int axis = p[0] != 0 ? 0 : p[1] != 0 ? 1 : 2;
+    if (p[axis] > 0) lo[size_t(axis)] = std::max(lo[size_t(axis)], -p[3] / p[axis]);
+    else hi[size_t(axis)] = std::min(hi[size_t(axis)], -p[3] / p[axis]);
+  }
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(lo[size_t(a)]) || !std::isfinite(hi[size_t(a)])) return Extent::Unbounded;
+  for (int a = 0; a < 3; ++a)
+    if (!(lo[size_t(a)] < hi[size_t(a)])) return Extent::Empty;
+  return Extent::Bounded;
+}
+
+bool axisAligned(const Term& t) {
+  for (const Affine& p : t)
+    if (int(p[0] != 0) + int(p[1] != 0) + int(p[2] != 0) != 1) return false;
+  return true;
+}
+
+// The exact signed distance of the box (positive inside): with q = |X - c| - h per axis,
+// -(|max(q, 0)| + min(max_i q_i, 0)).
+Expr boxDistance(const Point& lo, const Point& hi) {
+  Expr q[3], outside2;
+  for (int a = 0; a < 3; ++a) {
+    const double c = 0.5 * (lo[size_t(a)] + hi[size_t(a)]), h = 0.5 * (hi[size_t(a)] - lo[size_t(a)]);
+    q[a] = abs(Expr::x(uint32_t(a)) - Expr(c)) - Expr(h);
+    const Expr o = square(max(q[a], Expr(0.0)));
+    outside2 = a == 0 ? o : outside2 + o;
+  }
+  return -(sqrt(outside2) + min(max(q[0], max(q[1], q[2])), Expr(0.0)));
+}
+
+// A general term: bounded when no vertex of it clipped by a far box lies on that box.
+Extent polytopeOfTerm(const Term& t, std::optional<ConvexPolytope>& out) {
+  const double tol = toleranceOf(t);
+  const double far = 1e6 * (tol / 1e-9);
+  Term clipped = t;
+  for (int a = 0; a < 3; ++a)
+    for (double s : {1.0, -1.0}) {
+      Affine p{0, 0, 0, far};
+      p[size_t(a)] = s;
+      clipped.push_back(p);
+    }
+  const std::vector<Point> verts = verticesOf(clipped, tol);
+  for (const Point& v : verts)
+    for (double c : v)
+      if (std::abs(c) >= far * (1 - 1e-9)) return Extent::Unbounded;
+  out = meshOf(t, verts, tol);
+  return out ? Extent::Bounded : Extent::Empty;
+}
+
+}  // namespace
+
+std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e) {
+  std::vector<Affine> planes;
+  if (!halfSpaces(minMaxForm(e), planes) || planes.size() < 4) return std::nullopt;
+  const double tol = toleranceOf(planes);
+  return meshOf(planes, verticesOf(planes, tol), tol);
+}
+
+std::string PolytopeUnion::describe() const {
+  return "union of " + std::to_string(pieces) + " convex pieces (" + std::to_string(boxes) + " of them boxes)";
+}
+
+std::optional<PolytopeUnion> polytopeUnionOf(const Expr& e) {
+  std::vector<Term> terms;
+  if (!normalForm(minMaxForm(e), false, terms)) return std::nullopt;
+  PolytopeUnion u;
+  for (const Term& t : terms) {
+    Expr piece;
+    if (axisAligned(t)) {
+      Point lo, hi;
+      const Extent x = boxOf(t, lo, hi);
+      if (x == Extent::Unbounded) return std::nullopt;
+      if (x == Extent::Empty) continue;
+      piece = boxDistance(lo, hi);
+      ++u.boxes;
+    } else {
+      std::optional<ConvexPolytope> p;
+      const Extent x = polytopeOfTerm(t, p);
+      if (x == Extent::Unbounded) return std::nullopt;
+      if (x == Extent::Empty) continue;
+      piece = p->field;
+    }
+    u.field = u.pieces++ == 0 ? piece : max(u.field, piece);
+  }
+  if (u.pieces == 0) return std::nullopt;
+  return u;
 }
 
 }  // namespace frep::minkowski

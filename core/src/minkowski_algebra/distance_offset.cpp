@@ -85,10 +85,9 @@ Expr offsetField(const Expr& f, const Ball& b, bool erosion, ExactTerm t) {
   return r;
 }
 
-
 // An operand that is not an exact distance but has a registered distance twin (hfCylinder,
-// hfTorus), or is an intersection of half-spaces, is replaced by that exact signed distance
-// (same set: the sum's set is unchanged).
+// hfTorus), or is an intersection of half-spaces, is replaced by that exact signed distance,
+// a union of such intersections by one exact outside (same set: the sum's is unchanged).
 Expr exactOperand(const Expr& field, Exactness& x) {
   if (std::optional<ExactTerm> t = lookupExact(field); t && t->kind == ExactTerm::Kind::Distance) {
     x = {true, true, t->operand};
@@ -96,10 +95,16 @@ Expr exactOperand(const Expr& field, Exactness& x) {
   }
   x = exactnessOf(field);
   if (x.outside && x.inside) return field;
-  std::optional<ConvexPolytope> p = convexPolytopeOf(field);
-  if (!p) return field;
-  x = exactnessOf(p->field);
-  return p->field;
+  if (std::optional<ConvexPolytope> p = convexPolytopeOf(field)) {
+    x = exactnessOf(p->field);
+    return p->field;
+  }
+  // A union of polytopes (a difference of blocks, say): exact outside only, enough for a sum.
+  if (std::optional<PolytopeUnion> u = polytopeUnionOf(field)) {
+    x = {true, false, u->describe()};
+    return u->field;
+  }
+  return field;
 }
 
 }  // namespace

@@ -19,12 +19,30 @@
 namespace frep::minkowski {
 
 struct ConvexPolytope {
-  Expr field;       // the exact signed distance (positive inside) of the polytope
+  Expr field;  // the exact signed distance (positive inside) of the polytope
   size_t planes = 0, facets = 0, vertices = 0;
 };
 
 // The polytope of `e` over x[0..2], or nothing when e is not (sign-exactly) a min of affine
 // functions, holds more than 64 planes, or is empty, flat or unbounded.
 std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e);
+
+// A union of convex polytopes: a min/max form (negations included) whose leaves are affine,
+// e.g. hfBlock \ hfBlock. Its disjunctive normal form max_i min_j (n_ij . X + d_ij) is a union
+// of intersections of half-spaces (min distributes over max; -min(a, b) = max(-a, -b)); empty
+// and flat terms are dropped (the solid is regularised), the others become polytopes as above,
+// an axis-aligned one (all its normals along axes, as hfBlock's) as a box with a closed-form
+// distance. field = max_i of the pieces' exact signed distances: exact outside the union (the
+// distance to a union is the least of the distances), a lower bound of the depth inside.
+// Minkowski sums with a ball distribute over the union (Roerdink eq. 1) and take the offset path.
+struct PolytopeUnion {
+  Expr field;
+  size_t pieces = 0, boxes = 0;  // boxes: the pieces written in closed form
+  std::string describe() const;  // "union of 2 convex pieces (2 of them boxes)"
+};
+
+// Nothing when e is not such a form, needs more than 64 terms or 64 planes in one, or is
+// unbounded or empty.
+std::optional<PolytopeUnion> polytopeUnionOf(const Expr& e);
 
 }  // namespace frep::minkowski
