@@ -11,6 +11,7 @@
 #include "core/random_csg.h"
 #include "frep/evaluators/eval.h"
 #include "frep/evaluators/float_error.h"
+#include "frep/primitives/ops.h"
 #include "frep/sampling/plane.h"
 
 using namespace frep;
@@ -180,4 +181,55 @@ TEST(PlaneFloat, UnsupportedOpsStayInDouble) {
   EXPECT_FALSE(FloatErrorBound::supports(*tape));
   const PlaneStats st = expectSameSigns(tape, lattice(64, -1.0, 2.0 / 63));
   EXPECT_EQ(st.floatPixels, 0u);
+}
+
+// R-functions (any parameter in (-1, 1)) and divisions by values away from 0: the bound covers
+// the float and double batch values at random points of random boxes (the blended unions and
+// blocks of examples/chair.hf are built of these), and stays useful (far below the values).
+TEST(PlaneFloat, BoundCoversRFunctionsAndDivisions) {
+  Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  auto block = [&](double cx, double cy, double cz, double h, double al) {
+    return rIntersection(rIntersection(h - square(x - cx), h - square(y - cy), al), h - square(z - cz), al);
+  };
+  const Expr b1 = block(0.1, -0.2, 0.3, 0.3, 0.0), b2 = block(-0.4, 0.2, 0.1, 0.2, 0.0);
+  const Expr u = rUnion(b1, b2, 0.0);
+  // hfBlendUni's displacement a0 / (1 + (f1/a1)^2 + (f2/a2)^2) on a union
+  const Expr blend = u + 0.02 / (1.0 + square(b1 / 0.1) + square(b2 / 0.1));
+  const std::vector<Expr> models{u, blend, rUnion(block(0.0, 0.0, 0.0, 0.25, 0.3), b2, -0.5),
+                                 rIntersection(b1, -b2, 0.7), x / (2.0 + y * y) - z / (z * z + 0.5)};
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> c(-1.2, 1.2), w(0.0, 1.0), t(0.0, 1.0);
+  BatchEvaluator<float> bf;
+  BatchEvaluator<double> bd;
+  FloatErrorBound fb;
+  for (const Expr& e : models) {
+    TapePtr tape = Tape::compile(e, 3);
+    ASSERT_TRUE(FloatErrorBound::supports(*tape)) << toString(e);
+    bf.reserve(*tape), bd.reserve(*tape);
+    int finite = 0, useful = 0;
+    for (int box = 0; box < 200; ++box) {
+      Interval iv[3];
+      const double side = std::pow(10.0, -4 * w(rng));  // 1e-4 to 1
+      for (int k = 0; k < 3; ++k) iv[k] = {c(rng), 0.0}, iv[k].hi = iv[k].lo + side;
+      const double B = fb.bound(*tape, iv);
+      const size_t n = BatchEvaluator<double>::kBatch;
+      for (int k = 0; k < 3; ++k)
+        for (size_t i = 0; i < n; ++i) {
+          bd.in(uint32_t(k))[i] = iv[k].lo + (iv[k].hi - iv[k].lo) * t(rng);
+          bf.in(uint32_t(k))[i] = float(bd.in(uint32_t(k))[i]);
+        }
+      const float* ff = bf.eval(*tape, n);
+      const double* fd = bd.eval(*tape, n);
+      if (!std::isfinite(B)) continue;
+      ++finite;
+      size_t below = 0;
+      for (size_t i = 0; i < n; ++i) {
+        ASSERT_LE(std::fabs(double(ff[i]) - fd[i]), B) << toString(e) << " at " << bd.in(0)[i] << ", " << bd.in(1)[i];
+        below += std::fabs(fd[i]) > 100 * B;
+      }
+      useful += below > n / 2;
+    }
+    EXPECT_GT(finite, 150) << toString(e);
+    EXPECT_GT(useful, 100) << toString(e);
+  }
 }

@@ -46,12 +46,52 @@ bool supported(Op op, double imm) {
       return true;
     case Op::PowI:
       return imm == 2.0;
+    case Op::Div:
+      return true;
+    case Op::RAnd:
+    case Op::ROr:
+      return imm > -1 && imm < 1;  // the R-functions' parameter range (expr.h)
     default:
       return false;
   }
 }
 
-inline bool binary(Op op) { return op == Op::Add || op == Op::Sub || op == Op::Mul || op == Op::Min || op == Op::Max; }
+inline bool binary(Op op) {
+  return op == Op::Add || op == Op::Sub || op == Op::Mul || op == Op::Min || op == Op::Max || op == Op::Div ||
+         op == Op::RAnd || op == Op::ROr;
+}
+
+// The R-function parameter (DenseTape has no R-functions: never read there).
+inline double rParam(const Instr& ins) { return ins.imm; }
+inline double rParam(const DenseInstr&) { return 0.0; }
+
+// (x + y + sg sqrt(x^2 + y^2 - 2 al x y)) / (1 + al) in double, as the enclosure's end points
+// (R-functions are increasing in both arguments, expr.h); widened outwards by `side`.
+inline double rValue(double x, double y, double al, double sg, double side) {
+  const double q = std::max(0.0, x * x + y * y - 2 * al * x * y);
+  const double v = (x + y + sg * std::sqrt(q)) / (1 + al);
+  return v + side * (std::fabs(v) * 0x1p-48 + (std::fabs(x) + std::fabs(y)) * 0x1p-48 + 0x1p-1000);
+}
+
+// Rounding error of the batch evaluator's R-function (eval_batch.cpp: s = a a + b b - (2 al) a
+// b, root = sqrt(max(s, 0)), (a + b + sg root) / (1 + al); no division when al = 0) at inputs
+// of magnitudes at most ma, mb, with unit roundoff u, underflow term tiny and the precision's
+// parameter off from al by at most dal. The sum of squares and products has a relative error
+// of at most theta against Q = a^2 + b^2 - 2 al a b >= (1 - |al|)(a^2 + b^2) (Higham eq. 2.4
+// per op), so its square root one of theta plus sqrt(tiny terms); the sum, the final addition
+// and the division add theirs.
+inline double rRounding(double ma, double mb, double al, double u, double tiny, double dal) {
+  const double aa = std::fabs(al), m = ma + mb;
+  const double theta = (u * 8 * (1 + aa) + 2 * dal) / (1 - aa);
+  const double rmax = std::sqrt(1 + aa) * m;  // sqrt(Q) <= sqrt(1 + |al|) (|a| + |b|)
+  const double root = rmax * (theta + 2 * u) + 4 * std::sqrt(6 * tiny) + 2 * tiny;
+  const double num = m + rmax, eNum = u * m + root + 2 * u * num + 4 * tiny;
+  if (al == 0) return eNum;
+  // 1 + al rounded: off from the exact 1 + al by dD; dividing by it
+  const double d = 1 + al, dD = dal + 2 * u * (1 + aa), dmin = d - dD;
+  if (!(dmin > 0)) return kInf;
+  return (eNum + num * dD / d) / dmin + 2 * u * (num + eNum) / dmin + 2 * tiny;
+}
 
 }  // namespace
 
@@ -146,6 +186,28 @@ double FloatErrorBound::propagate(const I* code, size_t size, uint32_t result) {
           return o.lo > 0 ? std::min(s, e / o.lo) : s;
         };
         rounded(prop(a.ef), prop(a.ed));
+        break;
+      }
+      case Op::Div: {
+        // a / b with b away from 0 in both precisions: |a'/b' - a/b| <= (|b| ea + |a| eb) / (|b'| |b|)
+        const double bmin = b.lo > 0 ? b.lo : b.hi < 0 ? -b.hi : 0.0;
+        if (!(bmin > 0) || !(bmin - b.ef > 0) || !(bmin - b.ed > 0)) return kInf;
+        const double p[4] = {a.lo / b.lo, a.lo / b.hi, a.hi / b.lo, a.hi / b.hi};
+        o.lo = dn(*std::min_element(p, p + 4)), o.hi = up(*std::max_element(p, p + 4));
+        rounded(up((mb * a.ef + ma * b.ef) / (dn(bmin - b.ef) * bmin)),
+                up((mb * a.ed + ma * b.ed) / (dn(bmin - b.ed) * bmin)));
+        break;
+      }
+      case Op::RAnd:
+      case Op::ROr: {
+        // Inputs off by ea, eb move the exact value by at most L (ea + eb): sqrt(Q) is the norm
+        // of M^(1/2) (a, b), M's eigenvalues 1 -+ al, so it is sqrt(1 + |al|)-Lipschitz.
+        const double al = rParam(ins), sg = ins.op == Op::ROr ? 1.0 : -1.0;
+        const double L = (1 + std::sqrt(1 + std::fabs(al))) / (1 + al) * (1 + 0x1p-40);
+        o.lo = rValue(a.lo, b.lo, al, sg, -1.0), o.hi = rValue(a.hi, b.hi, al, sg, 1.0);
+        const double dalF = std::fabs(double(float(al)) - al);  // the float lanes' parameter
+        o.ef = upErr(L * (a.ef + b.ef) + rRounding(ma + a.ef, mb + b.ef, al, kUf, kTinyF, dalF)) * 1.0625;
+        o.ed = upErr(L * (a.ed + b.ed) + rRounding(ma + a.ed, mb + b.ed, al, kUd, kTinyD, 0.0)) * 1.0625;
         break;
       }
       case Op::Neg:

@@ -14,8 +14,9 @@ namespace frep {
 
 class FloatErrorBound {
  public:
-  // Whether the bound covers every op of the tape: + - * neg abs min max sqrt square copy (the
-  // correctly rounded ones). Other tapes get +inf from bound().
+  // Whether the bound covers every op of the tape: + - * / neg abs min max sqrt square copy (the
+  // correctly rounded ones) and the R-functions (RAnd, ROr; parameter in (-1, 1)). Other tapes
+  // get +inf from bound(); a division by an enclosure that may reach 0 too.
   static bool supports(const Tape& tape);
   // B >= |f_float(x) - f_double(x)| for every x in the box (box[i]: var i, the coordinates as
   // the caller passes them in double; the float lanes get them rounded to float). +inf when the
