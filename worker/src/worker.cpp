@@ -302,6 +302,9 @@ int runWorker(const WorkerOptions& opt) {
       }
       auto now = Clock::now();
       if (gTerminate) {
+        // Never welcomed and holding nothing (e.g. still connecting when a small job ended):
+        // nobody to tell, so no wait for frames to leave.
+        if (!welcomed && compute.holding().empty()) std::_Exit(kWorkerOk);
         // Hand every unfinished brick back, say bye, leave.
         for (const Task& t : compute.unfinished()) {
           Envelope f;
