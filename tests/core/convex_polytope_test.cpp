@@ -198,9 +198,53 @@ TEST(PolytopeUnion, UnboundedEmptyCurvedAndOversizedFormsAreRefused) {
   EXPECT_EQ(two->pieces, 2u);
 }
 
+// The L-slab read from inside: its complement is the outside of block 1 (six half-spaces) and
+// block 2, and the distance to them is exact inside the slab, including near the notch's inner
+// edge, where the nearest point of the complement is block 2's edge, not a plane.
+TEST(PolytopeUnion, ComplementFormIsTheExactDistanceInside) {
+  const double lo1[3] = {-1, -1, -0.25}, hi1[3] = {1, 1, 0.25};
+  const double lo2[3] = {-0.2, -0.2, -1}, hi2[3] = {1.3, 1.3, 1};
+  const Expr slab = min(block(lo1, hi1), -block(lo2, hi2));
+  auto c = minkowski::polytopeComplementOf(slab);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_TRUE(c->exactInside);
+  EXPECT_EQ(c->pieces, 7u);
+  EXPECT_EQ(c->boxes, 7u);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coord(-1.2, 1.2);
+  int inside = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const double p[3] = {coord(rng), coord(rng), coord(rng)};
+    const double f = eval(c->field, p[0], p[1], p[2]), original = eval(slab, p[0], p[1], p[2]);
+    if (std::abs(original) > 1e-9) EXPECT_EQ(f > 0, original > 0) << p[0] << " " << p[1] << " " << p[2];
+    if (!(original > 0)) continue;
+    ++inside;
+    double d = boxOutsideDistance(p, lo2, hi2);
+    for (int a = 0; a < 3; ++a) d = std::min({d, p[a] - lo1[a], hi1[a] - p[a]});
+    EXPECT_NEAR(f, d, 1e-12) << p[0] << " " << p[1] << " " << p[2];
+  }
+  EXPECT_GT(inside, 300);
+  EXPECT_NEAR(eval(c->field, -0.3, -0.3, 0), std::sqrt(0.02), 1e-12);  // the notch's edge
+  // General planes: a tetrahedron's complement is four half-spaces, each clipped far away; the
+  // distance inside is its nearest face's, as the polytope's own exact distance says.
+  auto t = minkowski::polytopeComplementOf(tetrahedron(0.5));
+  auto own = minkowski::convexPolytopeOf(tetrahedron(0.5));
+  ASSERT_TRUE(t.has_value() && own.has_value());
+  EXPECT_EQ(t->pieces, 4u);
+  EXPECT_EQ(t->boxes, 0u);
+  std::uniform_real_distribution<double> small(-0.4, 0.4);
+  for (int i = 0; i < 500; ++i) {
+    const double x = small(rng), y = small(rng), z = small(rng);
+    const double want = eval(own->field, x, y, z);
+    if (want > 0) EXPECT_NEAR(eval(t->field, x, y, z), want, 1e-9) << x << " " << y << " " << z;
+  }
+  // A solid that is all of space has an empty complement: refused.
+  EXPECT_FALSE(minkowski::polytopeComplementOf(Expr(1.0) + 0.0 * X()).has_value());
+}
+
 // L-slab ⊕ ball: the offset of the union's distance (Roerdink eq. 1: the sum distributes over
-// the union), reported as such; its erosion by the ball is not taken (not exact inside).
-TEST(PolytopeUnion, SumWithABallTakesTheOffsetPathErosionDoesNot) {
+// the union); L-slab ⊖ ball: the inward offset of its complement's distance; reported as such.
+TEST(PolytopeUnion, SumAndErosionWithABallTakeTheOffsetPath) {
   const double lo1[3] = {-1, -1, -0.25}, hi1[3] = {1, 1, 0.25};
   const double lo2[3] = {-0.2, -0.2, -1}, hi2[3] = {1.3, 1.3, 1};
   const Expr slab = min(block(lo1, hi1), -block(lo2, hi2));
@@ -222,5 +266,10 @@ TEST(PolytopeUnion, SumWithABallTakesTheOffsetPathErosionDoesNot) {
   ASSERT_FALSE(described.empty());
   EXPECT_NE(described[0].find("union of 2 convex pieces"), std::string::npos) << described[0];
   Expr eroded;
-  EXPECT_FALSE(minkowski::distanceBallDifference(slab, ball, 3, &eroded));
+  ASSERT_TRUE(minkowski::distanceBallDifference(slab, ball, 3, &eroded));
+  EXPECT_NEAR(eval(eroded, -0.6, 0.5, 0), 0.25 - r, 1e-12);              // the slab's faces z = +-0.25
+  EXPECT_NEAR(eval(eroded, -0.3, -0.3, 0), std::sqrt(0.02) - r, 1e-12);  // the notch's edge
+  const auto erodedText = minkowski::describeExact(eroded);
+  ASSERT_FALSE(erodedText.empty());
+  EXPECT_NE(erodedText[0].find("complement of a union of 7 convex pieces"), std::string::npos) << erodedText[0];
 }

@@ -230,21 +230,32 @@ bool axisAligned(const Term& t) {
   return true;
 }
 
-// The exact signed distance of the box (positive inside): with q = |X - c| - h per axis,
-// -(|max(q, 0)| + min(max_i q_i, 0)).
-Expr boxDistance(const Point& lo, const Point& hi) {
-  Expr q[3], outside2;
+// The exact signed distance of the box [lo, hi] (positive inside), some bounds possibly
+// infinite (an unbounded box: a half-space, a quadrant, a slab): with q_a the signed distance
+// outside the interval of axis a (|x - c| - h when both bounds are finite), -(|max(q, 0)| +
+// min(max_a q_a, 0)) over the bounded axes. Nothing when no axis is bounded (the whole space).
+std::optional<Expr> boxDistance(const Point& lo, const Point& hi) {
+  std::vector<Expr> q;
   for (int a = 0; a < 3; ++a) {
-    const double c = 0.5 * (lo[size_t(a)] + hi[size_t(a)]), h = 0.5 * (hi[size_t(a)] - lo[size_t(a)]);
-    q[a] = abs(Expr::x(uint32_t(a)) - Expr(c)) - Expr(h);
-    const Expr o = square(max(q[a], Expr(0.0)));
-    outside2 = a == 0 ? o : outside2 + o;
+    const Expr x = Expr::x(uint32_t(a));
+    const double l = lo[size_t(a)], h = hi[size_t(a)];
+    if (std::isfinite(l) && std::isfinite(h)) q.push_back(abs(x - Expr(0.5 * (l + h))) - Expr(0.5 * (h - l)));
+    else if (std::isfinite(l)) q.push_back(Expr(l) - x);
+    else if (std::isfinite(h)) q.push_back(x - Expr(h));
   }
-  return -(sqrt(outside2) + min(max(q[0], max(q[1], q[2])), Expr(0.0)));
+  if (q.empty()) return std::nullopt;
+  Expr outside2 = square(max(q[0], Expr(0.0))), deepest = q[0];
+  for (size_t a = 1; a < q.size(); ++a) {
+    outside2 = outside2 + square(max(q[a], Expr(0.0)));
+    deepest = a == 1 ? max(q[0], q[1]) : max(q[0], max(q[1], q[2]));
+  }
+  return -(sqrt(outside2) + min(deepest, Expr(0.0)));
 }
 
-// A general term: bounded when no vertex of it clipped by a far box lies on that box.
-Extent polytopeOfTerm(const Term& t, std::optional<ConvexPolytope>& out) {
+// A general term as a polytope. Bounded when no vertex of it clipped by a far box lies on that
+// box; an unbounded one is kept clipped when `clip` (the far box, 10^6 times the planes'
+// offsets away, is never the nearest feature to a point of the model's region).
+Extent polytopeOfTerm(const Term& t, bool clip, std::optional<ConvexPolytope>& out) {
   const double tol = toleranceOf(t);
   const double far = 1e6 * (tol / 1e-9);
   Term clipped = t;
@@ -255,11 +266,39 @@ Extent polytopeOfTerm(const Term& t, std::optional<ConvexPolytope>& out) {
       clipped.push_back(p);
     }
   const std::vector<Point> verts = verticesOf(clipped, tol);
+  bool bounded = true;
   for (const Point& v : verts)
-    for (double c : v)
-      if (std::abs(c) >= far * (1 - 1e-9)) return Extent::Unbounded;
-  out = meshOf(t, verts, tol);
-  return out ? Extent::Bounded : Extent::Empty;
+    for (double c : v) bounded = bounded && std::abs(c) < far * (1 - 1e-9);
+  if (!bounded && !clip) return Extent::Unbounded;
+  out = meshOf(bounded ? t : clipped, verts, tol);
+  return out ? (bounded ? Extent::Bounded : Extent::Unbounded) : Extent::Empty;
+}
+
+// The union of the normal form's terms as one field: max of their exact signed distances.
+// `clip`: unbounded terms are kept (clipped far away) instead of refusing the form.
+std::optional<PolytopeUnion> unionOfTerms(const std::vector<Term>& terms, bool clip) {
+  PolytopeUnion u;
+  for (const Term& t : terms) {
+    std::optional<Expr> piece;
+    if (axisAligned(t)) {
+      Point lo, hi;
+      const Extent x = boxOf(t, lo, hi);
+      if (x == Extent::Unbounded && !clip) return std::nullopt;
+      if (x == Extent::Empty) continue;
+      piece = boxDistance(lo, hi);
+      if (!piece) return std::nullopt;  // the whole space
+      ++u.boxes;
+    } else {
+      std::optional<ConvexPolytope> p;
+      const Extent x = polytopeOfTerm(t, clip, p);
+      if (x == Extent::Unbounded && !clip) return std::nullopt;
+      if (x == Extent::Empty) continue;
+      piece = p->field;
+    }
+    u.field = u.pieces++ == 0 ? *piece : max(u.field, *piece);
+  }
+  if (u.pieces == 0) return std::nullopt;
+  return u;
 }
 
 }  // namespace
@@ -272,32 +311,23 @@ std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e) {
 }
 
 std::string PolytopeUnion::describe() const {
-  return "union of " + std::to_string(pieces) + " convex pieces (" + std::to_string(boxes) + " of them boxes)";
+  const std::string what = std::to_string(pieces) + " convex pieces (" + std::to_string(boxes) + " of them boxes)";
+  return exactInside ? "complement of a union of " + what : "union of " + what;
 }
 
 std::optional<PolytopeUnion> polytopeUnionOf(const Expr& e) {
   std::vector<Term> terms;
   if (!normalForm(minMaxForm(e), false, terms)) return std::nullopt;
-  PolytopeUnion u;
-  for (const Term& t : terms) {
-    Expr piece;
-    if (axisAligned(t)) {
-      Point lo, hi;
-      const Extent x = boxOf(t, lo, hi);
-      if (x == Extent::Unbounded) return std::nullopt;
-      if (x == Extent::Empty) continue;
-      piece = boxDistance(lo, hi);
-      ++u.boxes;
-    } else {
-      std::optional<ConvexPolytope> p;
-      const Extent x = polytopeOfTerm(t, p);
-      if (x == Extent::Unbounded) return std::nullopt;
-      if (x == Extent::Empty) continue;
-      piece = p->field;
-    }
-    u.field = u.pieces++ == 0 ? piece : max(u.field, piece);
-  }
-  if (u.pieces == 0) return std::nullopt;
+  return unionOfTerms(terms, false);
+}
+
+std::optional<PolytopeUnion> polytopeComplementOf(const Expr& e) {
+  std::vector<Term> terms;  // -e's normal form: the complement of e's set
+  if (!normalForm(minMaxForm(e), true, terms)) return std::nullopt;
+  std::optional<PolytopeUnion> u = unionOfTerms(terms, true);
+  if (!u) return std::nullopt;
+  u->field = -u->field;
+  u->exactInside = true;
   return u;
 }
 

@@ -87,8 +87,9 @@ Expr offsetField(const Expr& f, const Ball& b, bool erosion, ExactTerm t) {
 
 // An operand that is not an exact distance but has a registered distance twin (hfCylinder,
 // hfTorus), or is an intersection of half-spaces, is replaced by that exact signed distance,
-// a union of such intersections by one exact outside (same set: the sum's is unchanged).
-Expr exactOperand(const Expr& field, Exactness& x) {
+// a union of such intersections by one exact outside (a sum) or inside (an erosion): the same
+// set, so the result's is unchanged.
+Expr exactOperand(const Expr& field, bool erosion, Exactness& x) {
   if (std::optional<ExactTerm> t = lookupExact(field); t && t->kind == ExactTerm::Kind::Distance) {
     x = {true, true, t->operand};
     return t->twin;  // the same set, read as its exact distance
@@ -99,9 +100,10 @@ Expr exactOperand(const Expr& field, Exactness& x) {
     x = exactnessOf(p->field);
     return p->field;
   }
-  // A union of polytopes (a difference of blocks, say): exact outside only, enough for a sum.
-  if (std::optional<PolytopeUnion> u = polytopeUnionOf(field)) {
-    x = {true, false, u->describe()};
+  // A union of polytopes (a difference of blocks, say) is exact outside as such, and inside
+  // through its complement: the side the operation needs.
+  if (std::optional<PolytopeUnion> u = erosion ? polytopeComplementOf(field) : polytopeUnionOf(field)) {
+    x = {!erosion, erosion, u->describe()};
     return u->field;
   }
   return field;
@@ -115,7 +117,7 @@ bool distanceBallSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
     std::optional<Ball> ball = ballOf(k == 0 ? b : a);
     if (!ball) continue;
     Exactness x;
-    const Expr field = exactOperand(k == 0 ? a : b, x);
+    const Expr field = exactOperand(k == 0 ? a : b, false, x);
     if (!x.outside) continue;
     ExactTerm t;
     t.operand = x.what + " + " + ballText(*ball);
@@ -132,7 +134,7 @@ bool distanceBallDifference(const Expr& a0, const Expr& b, uint32_t dims, Expr* 
   std::optional<Ball> ball = ballOf(b);
   if (!ball) return false;
   Exactness x;
-  const Expr a = exactOperand(a0, x);
+  const Expr a = exactOperand(a0, true, x);
   if (!x.inside) return false;
   ExactTerm t;
   t.operand = x.what + " - " + ballText(*ball);

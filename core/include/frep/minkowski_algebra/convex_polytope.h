@@ -38,11 +38,20 @@ std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e);
 struct PolytopeUnion {
   Expr field;
   size_t pieces = 0, boxes = 0;  // boxes: the pieces written in closed form
+  bool exactInside = false;      // polytopeComplementOf's (else exact outside)
   std::string describe() const;  // "union of 2 convex pieces (2 of them boxes)"
 };
 
 // Nothing when e is not such a form, needs more than 64 terms or 64 planes in one, or is
 // unbounded or empty.
 std::optional<PolytopeUnion> polytopeUnionOf(const Expr& e);
+
+// The same forms read from inside, for erosions: the complement of e's set is the union of the
+// terms of -e's normal form (often unbounded: a half-space, a wedge, the outside of a block),
+// and the distance to a union is the least of the distances to its pieces, so field = -(max_i
+// of those pieces' exact signed distances) is exact inside e's set (an unbounded general piece
+// is clipped by a box 10^6 times the planes' offsets away). Nothing when e is not such a form,
+// outgrows the limits, or its complement is empty or everything.
+std::optional<PolytopeUnion> polytopeComplementOf(const Expr& e);
 
 }  // namespace frep::minkowski
