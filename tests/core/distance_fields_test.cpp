@@ -400,6 +400,37 @@ TEST(MeshField, AnswersDoNotDependOnTheOrderOfQueriesOrTheCells) {
   }
 }
 
+// A mesh of at most 16 triangles is scanned whole, this thread's last nearest triangle first:
+// on the lattice points around a cube (12 triangles; ties between faces, edges and corners) the
+// value and gradient (the closest point chosen among ties) are bit for bit the same in order,
+// shuffled and interleaved with the torus's queries, and the distance is the brute force's.
+TEST(MeshField, SmallMeshAnswersDoNotDependOnTheOrderOfQueries) {
+  std::mt19937 rng(23);
+  const Soup cubeSoup = cube(0.5), torusSoup = torus(0.8, 0.3, 40, 24);
+  MeshField c(cubeSoup.xyz, cubeSoup.tris, "cube"), t(torusSoup.xyz, torusSoup.tris, "torus");
+  std::vector<std::array<double, 3>> pts;
+  for (int i = -8; i <= 8; ++i)
+    for (int j = -8; j <= 8; ++j)
+      for (int k = -8; k <= 8; ++k) pts.push_back({0.125 * i, 0.125 * j, 0.125 * k});
+  auto ask = [](const MeshField& m, const std::array<double, 3>& p) {
+    std::array<double, 4> a;
+    a[0] = m.gradient(p.data(), a.data() + 1);
+    return a;
+  };
+  std::vector<std::array<double, 4>> ref;
+  for (const auto& p : pts) ref.push_back(ask(c, p));
+  std::vector<size_t> order(pts.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  for (int round = 0; round < 2; ++round) {
+    std::shuffle(order.begin(), order.end(), rng);
+    for (size_t i : order) {
+      ASSERT_TRUE(std::memcmp(ask(c, pts[i]).data(), ref[i].data(), sizeof ref[i]) == 0) << "cube point " << i;
+      if (round == 1) ask(t, pts[order[(i * 7) % order.size()]]);  // another field's queries between
+    }
+  }
+  for (size_t i = 0; i < pts.size(); ++i) ASSERT_NEAR(std::fabs(ref[i][0]), bruteDist3D(cubeSoup, pts[i].data()), 1e-12);
+}
+
 TEST(MeshField, SignMatchesWindingNumberOnVertexRaysAndEdgeLines) {
   std::mt19937 rng(13);
   for (const Soup& s : {cube(0.5), torus(0.8, 0.3, 24, 16), starPrism()}) {

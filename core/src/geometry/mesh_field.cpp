@@ -311,7 +311,13 @@ int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, 
   uint32_t count = 0;
   const uint32_t* cands = nullptr;
   if (nt <= 16) {  // a few triangles: all of them, no hierarchy
-    for (uint32_t slot = 0; slot < nt; ++slot) offer(p, slot, n);
+    // This thread's last nearest first: its distance lets the plane test skip most of the
+    // others (a convex polytope's facets). The answer is canonical, so the order is free.
+    const uint32_t warm = tWarm.field == id_ && tWarm.slot < nt ? tWarm.slot : 0;
+    offer(p, warm, n);
+    for (uint32_t slot = 0; slot < nt; ++slot)
+      if (slot != warm) offer(p, slot, n);
+    if (n.found) tWarm = {id_, n.slot};
   } else if (gCandidateCells.load(std::memory_order_relaxed) && (cands = cellCandidates(p, count))) {
     for (uint32_t i = 0; i < count; ++i) offer(p, cands[i], n);
   } else {
