@@ -57,7 +57,7 @@ void addFarmOptions(CLI::App* sub, FarmRequest& f) {
   sub->add_flag("--strict", f.strict,
                 "Fail (exit 8, no output) when an extremum search stops before certifying its tolerance "
                 "(default: a warning with the widest gap reached, also in the report)");
-  sub->add_option("--workers", f.workers, "Local worker processes (default: one per core; 0 computes in-process)");
+  sub->add_option("--workers", f.workers, "Local worker processes (default: one per core; a grid of at most 64^3 points in-process; 0 computes in-process)");
   sub->add_option("--listen", f.listen,
                   "Cluster mode: bind here (e.g. tcp://*:5555), start no workers; they connect with "
                   "frep-worker --connect");
