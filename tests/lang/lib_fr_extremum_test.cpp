@@ -241,6 +241,24 @@ TEST(FrExtremum, SweepKeysAlongAnLIsTheUnionOfTwoCapsules) {
   for (const auto& p : pts) EXPECT_NEAR(at(s, p), at(m, p), 1e-3);
 }
 
+// The same path swept by HyperFun's own ball (hfSphere, a recognised ball), translation only:
+// a union of capsules, no search (path_sweep.h), the exact values; with angles it searches.
+TEST(FrExtremum, SweepKeysOfARecognisedBallIsAUnionOfCapsules) {
+  const std::string ball = "ball(x[3], a[1]) { array c[3]; c = [0.1, 0, 0]; ball = hfSphere(x, c, 0.3); }\n";
+  Model m = compileOk(ball +
+                      "my_model(x[3], a[1]) { array ts[3], ps[9]; ts = [0, 1, 3]; "
+                      "ps = [0, 0, 0,  2, 0, 0,  2, 1.5, 0]; my_model = frSweepKeys(x, ball, ts, ps); }");
+  EXPECT_FALSE(Tape::compile(m.field, 3)->hasExtrema());
+  const std::vector<std::array<double, 3>> path = {{0.1, 0, 0}, {2.1, 0, 0}, {2.1, 1.5, 0}};
+  for (const auto& p : std::vector<std::vector<double>>{
+           {1, 0.1, 0}, {1, 0.29, 0}, {1, 0.31, 0}, {-0.2, 0.2, 0}, {2.25, -0.2, 0}, {2.1, 0.7, 0.2}, {3, 3, 3}})
+    EXPECT_NEAR(at(m, p), 0.3 - polylineDistance(path, p), 1e-12) << p[0] << "," << p[1];
+  Model turned = compileOk(ball +
+                           "my_model(x[3], a[1]) { array ts[2], ps[6], an[6]; ts = [0, 1]; ps = [0, 0, 0, 1, 0, 0]; "
+                           "an = [0, 0, 0, 0, 0, 1]; my_model = frSweepKeys(x, ball, ts, ps, an); }");
+  EXPECT_TRUE(Tape::compile(turned.field, 3)->hasExtrema());
+}
+
 // Rotation keyframes: a 2D bar turned a quarter turn about the origin through a keyframe at
 // half way (0 -> pi/4 -> pi/2) equals the expression form; its translation keyframes move it.
 TEST(FrExtremum, SweepKeysWithAngles) {

@@ -161,6 +161,7 @@ std::optional<ConvexPolytope> meshOf(const std::vector<Affine>& planes, const st
   out.planes = planes.size();
   out.facets = facets;
   out.vertices = verts.size();
+  out.corners = verts;
   return out;
 }
 
@@ -288,12 +289,18 @@ std::optional<PolytopeUnion> unionOfTerms(const std::vector<Term>& terms, bool c
       piece = boxDistance(lo, hi);
       if (!piece) return std::nullopt;  // the whole space
       ++u.boxes;
+      if (x == Extent::Bounded) {
+        u.corners.emplace_back();
+        for (int k = 0; k < 8; ++k)
+          u.corners.back().push_back({k & 4 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 1 ? hi[2] : lo[2]});
+      }
     } else {
       std::optional<ConvexPolytope> p;
       const Extent x = polytopeOfTerm(t, clip, p);
       if (x == Extent::Unbounded && !clip) return std::nullopt;
       if (x == Extent::Empty) continue;
       piece = p->field;
+      if (x == Extent::Bounded) u.corners.push_back(p->corners);
     }
     u.field = u.pieces++ == 0 ? *piece : max(u.field, *piece);
   }

@@ -12,15 +12,7 @@
 #include "frep/minkowski_algebra/registry.h"
 
 namespace frep::minkowski {
-namespace {
 
-struct Ball {
-  Vec3 centre{0, 0, 0};
-  double radius = 0;
-  Sum sum;
-};
-
-// A registered basic-set sum with no block edges and no discs: a ball (radius 0: a point).
 std::optional<Ball> ballOf(const Expr& e) {
   std::optional<ExactTerm> t = lookupExact(e);
   if (!t || t->kind != ExactTerm::Kind::Sum) return std::nullopt;
@@ -29,6 +21,8 @@ std::optional<Ball> ballOf(const Expr& e) {
     if (s.lengths[i] != 0 || s.disc[i] != 0) return std::nullopt;
   return Ball{s.offset, s.ball, s};
 }
+
+namespace {
 
 // x_i, x_i + k or x_i - k (k constant): a translation keeps a distance exact.
 bool translatedCoordinate(const Expr& e, uint32_t i) {

@@ -11,8 +11,10 @@
 // has no closed form from its planes (min_i of the plane distances is exact inside only).
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "frep/expressions/expr.h"
 
@@ -21,6 +23,7 @@ namespace frep::minkowski {
 struct ConvexPolytope {
   Expr field;  // the exact signed distance (positive inside) of the polytope
   size_t planes = 0, facets = 0, vertices = 0;
+  std::vector<std::array<double, 3>> corners;  // its vertices
 };
 
 // The polytope of `e` over x[0..2], or nothing when e is not (sign-exactly) a min of affine
@@ -37,9 +40,10 @@ std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e);
 // Minkowski sums with a ball distribute over the union (Roerdink eq. 1) and take the offset path.
 struct PolytopeUnion {
   Expr field;
-  size_t pieces = 0, boxes = 0;  // boxes: the pieces written in closed form
-  bool exactInside = false;      // polytopeComplementOf's (else exact outside)
-  std::string describe() const;  // "union of 2 convex pieces (2 of them boxes)"
+  size_t pieces = 0, boxes = 0;                             // boxes: the pieces written in closed form
+  bool exactInside = false;                                 // polytopeComplementOf's (else exact outside)
+  std::vector<std::vector<std::array<double, 3>>> corners;  // each bounded piece's vertices
+  std::string describe() const;                             // "union of 2 convex pieces (2 of them boxes)"
 };
 
 // Nothing when e is not such a form, needs more than 64 terms or 64 planes in one, or is

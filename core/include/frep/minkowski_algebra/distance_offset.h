@@ -18,10 +18,22 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 
 #include "frep/expressions/expr.h"
+#include "frep/minkowski_algebra/basic_set.h"
 
 namespace frep::minkowski {
+
+struct Ball {
+  Vec3 centre{0, 0, 0};
+  double radius = 0;
+  Sum sum;
+};
+
+// A registered basic-set sum with no block edges and no discs (frBall, hfSphere): a ball
+// (radius 0: a point).
+std::optional<Ball> ballOf(const Expr& e);
 
 // A ⊕ B over x[0..3) when one operand is a ball and the other exact outside; registers the
 // result (describeExact: "exact Minkowski sum ..., error bound 0").
