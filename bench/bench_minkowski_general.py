@@ -20,7 +20,8 @@ the box for the morph; polyhedral sums (bunny (+) tool / block) are exact in bot
 volume is the reference; bunny (+) ball has no closed form: the reference is frep at --ref-res
 (the exact offset path, so only meshing error; printed).
 
-For each case: frep mesh at several resolutions (2 local workers, the README's main job form),
+For each case: frep mesh at several resolutions (its default: 2 local workers, or in-process for a
+grid of at most 64^3 points, docs/cli.md; the run's line says which),
 OpenSCAD minkowski() (sphere $fn from --fn) and manifold-3d minkowskiSum (node; the whole
 process and the operation alone). Equal accuracy: for each peer run, the coarsest frep run whose
 |volume error| is at most the peer's; the ratio peer / frep of wall times is printed. Also the
@@ -400,7 +401,7 @@ def main():
     if args.only:
         keep = set(args.only.split(","))
         cases = [c for c in cases if c["name"] in keep or c["name"] in BASELINES.values()]
-    print("Minkowski sums of any operands: frep mesh (2 local workers) vs OpenSCAD %s and manifold-3d %s" %
+    print("Minkowski sums of any operands: frep mesh (default workers) vs OpenSCAD %s and manifold-3d %s" %
           ("(found)" if have_scad else "(not installed)", "(found)" if have_manifold else "(not installed)"))
     print("%d cores, load average %.2f; work in %s" % (os.cpu_count(), os.getloadavg()[0], work))
     base = {}
@@ -417,8 +418,11 @@ def main():
                 print("  frep --res %d failed: %s" % (res, err.strip()))
                 continue
             tris = read_stl(stl)
-            path = "search" if b"searches\": 0" not in open(stl + ".report.json", "rb").read() else "exact"
-            frep_runs.append(dict(res=res, wall=dt, tris=len(tris), vol=volume(tris), open=unpaired_edges(tris), path=path))
+            report = open(stl + ".report.json", "rb").read()
+            path = "search" if b"searches\": 0" not in report else "exact"
+            where = "in-process" if b"\"in_process_rule\": \"" in report else "farm"
+            frep_runs.append(dict(res=res, wall=dt, tris=len(tris), vol=volume(tris), open=unpaired_edges(tris), path=path,
+                                  where=where))
         peers = []
         r = sphere_radius(case)
         for fn in (fns if r else [0]):
@@ -461,8 +465,8 @@ def main():
         def err_of(v):
             return (v - exact) / exact if exact else float("nan")
         for fr in frep_runs:
-            print("  %-30s %8.2f %9s %10d %+9.4f%% %6d  (%s path)" % ("frep --res %d" % fr["res"], fr["wall"], "", fr["tris"],
-                                                                    100 * err_of(fr["vol"]), fr["open"], fr["path"]))
+            print("  %-30s %8.2f %9s %10d %+9.4f%% %6d  (%s path, %s)" % ("frep --res %d" % fr["res"], fr["wall"], "", fr["tris"],
+                                                                        100 * err_of(fr["vol"]), fr["open"], fr["path"], fr["where"]))
             if name in BASELINES.values():
                 base[(case["form"], fr["res"])] = fr["wall"]
         for pp in peers:
