@@ -114,4 +114,14 @@ bool translationSweep(const Expr& a, const std::vector<Vec3>& path, Expr* out) {
   return true;
 }
 
+bool keyframeSweep(const Expr& a, const std::vector<Expr>& positions, Expr* out) {
+  if (positions.empty() || positions.size() % 3 != 0) return false;
+  std::vector<Vec3> path(positions.size() / 3);
+  for (size_t j = 0; j < positions.size(); ++j) {
+    if (!positions[j].isConst()) return false;
+    path[j / 3][j % 3] = positions[j].constValue();
+  }
+  return translationSweep(a, path, out);
+}
+
 }  // namespace frep::minkowski

@@ -610,16 +610,9 @@ Expr frSweepKeys(std::vector<Arg>& a) {
   if (o.hasBox) throw LibraryError("frSweepKeys: the options take no box", optionsAt);
   // A ball or polytope(s) moved by translation only sweeps a union of capsules or convex hulls
   // (minkowski_algebra/path_sweep.h): no search, the options do not apply.
-  if (n == 3 && !timeVarying && anglesAt < 0 && numParams(A.value) == 0 && A.objectDims == 3) {
-    std::vector<minkowski::Vec3> path(k);
-    bool constant = true;
-    for (size_t j = 0; j < k * n; ++j) {
-      constant = constant && ps[j].isConst();
-      if (constant) path[j / n][j % n] = ps[j].constValue();
-    }
-    Expr r;
-    if (constant && minkowski::translationSweep(A.value, path, &r)) return through(r, xs, n);
-  }
+  Expr exact;
+  if (n == 3 && !timeVarying && anglesAt < 0 && numParams(A.value) == 0 && minkowski::keyframeSweep(A.value, ps, &exact))
+    return through(exact, xs, n);
   Expr r = guarded(fn, -1, [&] { return sweep(A.value, static_cast<uint32_t>(n), m, ts.front(), ts.back(), o.search); });
   return through(r, xs, n);
 }

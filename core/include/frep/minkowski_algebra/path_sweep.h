@@ -22,5 +22,8 @@ namespace frep::minkowski {
 // hfSphere), a convex polytope or a union of polytopes, with at most 256 pieces (segments x
 // the operand's pieces). Registers the result ("exact Minkowski sum sweep of ...").
 bool translationSweep(const Expr& a, const std::vector<Vec3>& path, Expr* out);
+// The same with the path given as keyframe positions x, y, z one after the other (frSweepKeys),
+// when they are constants.
+bool keyframeSweep(const Expr& a, const std::vector<Expr>& positions, Expr* out);
 
 }  // namespace frep::minkowski
