@@ -40,6 +40,22 @@ double windingNumber(const std::vector<Vec3>& v, const std::vector<Tri>& t, cons
   return w / (4 * M_PI);
 }
 
+struct Box {
+  Vec3 lo, hi;
+  bool touches(const Box& o, double tol) const {
+    for (size_t a = 0; a < 3; ++a)
+      if (o.lo[a] > hi[a] + tol || o.hi[a] < lo[a] - tol) return false;
+    return true;
+  }
+};
+
+Box boxOf(const std::vector<Vec3>& pts) {
+  Box b{pts.at(0), pts.at(0)};
+  for (const Vec3& p : pts)
+    for (size_t a = 0; a < 3; ++a) b.lo[a] = std::min(b.lo[a], p[a]), b.hi[a] = std::max(b.hi[a], p[a]);
+  return b;
+}
+
 double volumeOf(const PieceMesh& m) {
   double vol = 0;
   for (const Tri& f : m.t) vol += dot(m.v[f[0]], cross(m.v[f[1]], m.v[f[2]])) / 6;
@@ -448,9 +464,13 @@ std::optional<std::vector<PieceMesh>> convexCover(const std::vector<Vec3>& v, co
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
       return norm(sub(cells[a].centroid, cells[s].centroid)) < norm(sub(cells[b].centroid, cells[s].centroid));
     });
-    for (int pass = 0; pass < 2; ++pass)
+    // Only cells touching the piece's box (a far one joins after those between).
+    Box box = boxOf(g.mesh.v);
+    bool grew = true;
+    for (int pass = 0; pass < 2 && grew; ++pass) {
+      grew = false;
       for (size_t j : order) {
-        if (g.has[j]) continue;
+        if (g.has[j] || !box.touches(boxOf(cells[j].hull.v), tol)) continue;
         if (hullHolds(g.mesh, cells[j].hull, tol)) {
           g.has[j] = true;
           continue;
@@ -461,7 +481,10 @@ std::optional<std::vector<PieceMesh>> convexCover(const std::vector<Vec3>& v, co
         if (!h || !convexInsideMesh(*h, v, t, tol)) continue;
         g.mesh = std::move(*h);
         g.has[j] = true;
+        box = boxOf(g.mesh.v);
+        grew = true;
       }
+    }
     g.volume = volumeOf(g.mesh);
     for (size_t j = 0; j < n; ++j) taken[j] = taken[j] || g.has[j];
     grown.push_back(std::move(g));
