@@ -4,14 +4,14 @@
 // the pieces need only cover P, so they can be much fuller than a partition (an L prism is two
 // overlapping boxes, not ten pyramids from a kernel point).
 //
-// Cells: the tool's bounding box cut (a binary space partition) by the planes of the faces at
-// its reflex edges while such a plane crosses the cell's part of the tool. A cell that no such
-// plane crosses holds no reflex edge inside, so its part of the tool is locally convex, hence
-// convex in each connected component (Tietze-Nakajima); the part is taken as the hull of its
-// vertices and kept when that hull lies in the tool (split in half otherwise). Then from each
-// cell a piece is grown by taking in the other cells while the hull stays in the tool, and a
-// greedy set cover of the cells picks the pieces. No kernel point is needed, so tools that are
-// not star-shaped are covered too.
+// Cells: the tool's bounding box cut (a binary space partition) by the face planes of the
+// reflex edges that meet a cell. A cell with no reflex edge inside holds a locally convex, hence
+// convex (Tietze-Nakajima), part of the tool in each component: with one component, the cell
+// cut by the tool faces reaching into it. It is kept when that lies in the tool (else halved),
+// and the kept parts must add up to the tool's volume. Then from each cell a piece is grown by
+// taking in touching cells while the hull stays in the tool, and a greedy set cover of the
+// cells picks the pieces. No kernel point is needed, so tools that are not star-shaped (a U, a
+// comb) are covered too.
 #pragma once
 
 #include <array>
@@ -37,8 +37,8 @@ bool convexInsideMesh(const PieceMesh& k, const std::vector<Vec3>& v, const std:
                       double tol);
 
 // Convex pieces covering the solid of the closed, outward, connected mesh (v, t), or nothing
-// when the mesh is convex, not connected, larger than 2048 triangles, or would need more than
-// maxCells cells or maxPieces pieces.
+// when the mesh is convex, not connected, larger than 2048 triangles, would need more than
+// maxCells cells or maxPieces pieces, or its cells' parts miss 10^-7 of its volume.
 std::optional<std::vector<PieceMesh>> convexCover(const std::vector<Vec3>& v,
                                                   const std::vector<std::array<uint32_t, 3>>& t, size_t maxPieces,
                                                   size_t maxCells = 128);

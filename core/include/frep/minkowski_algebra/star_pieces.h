@@ -4,7 +4,7 @@
 // union of the pyramids from c over its faces; coplanar neighbouring triangles are merged while
 // their union stays a convex polygon, so a box-like tool gives one pyramid per face, and the
 // pyramids are convex (c is inside each base's half-space). By Roerdink-Minkowski eq. 1,
-// A ⊕ ∪_i P_i = ∪_i (A ⊕ P_i).
+// A ⊕ ∪_i P_i = ∪_i (A ⊕ P_i). The fallback of convex_cover.h (fewer, fuller pieces).
 #pragma once
 
 #include <array>
