@@ -214,6 +214,53 @@ TEST(MeshConvexSum, NonConvexMeshGrownByABoxIsTheUnionOfTheGrownBlocks) {
   EXPECT_NEAR(mc::enclosedVolume(m.positions, m.triangles), volume, 0.003 * volume);
 }
 
+// The same L written as a block minus a block (a union of polytopes, convex_polytope.h) is its
+// own cover: a box ⊕ it is the union of the grown blocks, a big box ⊖ it the intersection of
+// the shrunk boxes (A ⊖ (K1 ∪ K2) = (A ⊖ K1) ∩ (A ⊖ K2)), each exact on its side.
+TEST(MeshConvexSum, ToolWrittenAsABlockDifferenceIsCoveredByItsBoxes) {
+  const double h = 0.4;
+  const Expr ell = min(axisBox({0, 0, 0}, {2, 2, h}), -axisBox({1, 1, -1}, {3, 3, 1}));
+  const V3 clo{-0.1, -0.2, -0.15}, chi{0.3, 0.05, 0.1};
+  Expr sum;
+  ASSERT_TRUE(minkowski::meshConvexSum(axisBox(clo, chi), ell, 3, &sum));
+  const auto described = minkowski::describeExact(sum);
+  ASSERT_FALSE(described.empty());
+  EXPECT_NE(described[0].find("union of 2 convex pieces"), std::string::npos) << described[0];
+  const V3 lo1{clo[0], clo[1], clo[2]}, hi1{2 + chi[0], 1 + chi[1], h + chi[2]};
+  const V3 lo2{clo[0], clo[1], clo[2]}, hi2{1 + chi[0], 2 + chi[1], h + chi[2]};
+  std::mt19937 rng(15);
+  std::uniform_real_distribution<double> u(-0.8, 2.8);
+  int outside = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const V3 p{u(rng), u(rng), 0.5 * u(rng)};
+    const double exact = std::max(boxDistance(p, lo1, hi1), boxDistance(p, lo2, hi2)), f = eval(sum, p);
+    if (std::abs(exact) < 1e-9) continue;
+    ASSERT_EQ(f >= 0, exact > 0) << p[0] << " " << p[1] << " " << p[2];
+    if (exact < 0) {
+      ++outside;
+      EXPECT_NEAR(f, exact, 1e-9) << p[0] << " " << p[1] << " " << p[2];
+    }
+  }
+  EXPECT_GT(outside, 1000);
+  const V3 alo{-1, -1, -1}, ahi{3, 3, 1.5};
+  Expr diff;
+  ASSERT_TRUE(minkowski::meshConvexDifference(axisBox(alo, ahi), ell, 3, &diff));
+  // A ⊖ [0,1]x[0,2]x[0,h] and A ⊖ [0,2]x[0,1]x[0,h]: [alo, ahi - hi_k].
+  const V3 s1{ahi[0] - 1, ahi[1] - 2, ahi[2] - h}, s2{ahi[0] - 2, ahi[1] - 1, ahi[2] - h};
+  int inside = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const V3 p{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 1};
+    const double exact = std::min(boxDistance(p, alo, s1), boxDistance(p, alo, s2)), f = eval(diff, p);
+    if (std::abs(exact) < 1e-9) continue;
+    ASSERT_EQ(f >= 0, exact > 0) << p[0] << " " << p[1] << " " << p[2];
+    if (exact > 0) {
+      ++inside;
+      EXPECT_NEAR(f, exact, 1e-9) << p[0] << " " << p[1] << " " << p[2];
+    }
+  }
+  EXPECT_GT(inside, 300);
+}
+
 TEST(MeshConvexSum, TetrahedronErodedByABoxIsTheShrunkTetrahedron) {
   // T = {x, y, z >= -0.3, x + y + z <= 0.6}; T ⊖ C = {x : x + C ⊆ T} moves each plane by C's
   // support: x >= -0.3 - min_C x, ..., x + y + z <= 0.6 - max_C (x + y + z).

@@ -537,15 +537,29 @@ bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, E
            double scaleB = 1) {
   bool aPoly = false, bPoly = false;
   std::optional<Mesh> b = closedMeshOf(bExpr, &bPoly);
+  // A union of polytopes (a difference of blocks, say) is its own cover (convex_polytope.h).
+  std::optional<PolytopeUnion> bUnion;
+  if (!b && pieces && scaleB == 1 && (bUnion = polytopeUnionOf(bExpr)) && bUnion->corners.size() == bUnion->pieces &&
+      bUnion->pieces <= kMaxPieces)
+    b = Mesh{};
   if (!b) return false;
   std::optional<Mesh> a = closedMeshOf(aExpr, &aPoly);
   if (!a) return false;
   scaleMesh(*a, scaleA);
   scaleMesh(*b, scaleB);
+  if (bUnion)
+    for (const auto& c : bUnion->corners) b->v.insert(b->v.end(), c.begin(), c.end());  // for the scale
   const double scale = std::max(extentOf(a->v), extentOf(b->v));
   std::vector<Convex> bs;
-  std::string bWhat = b->what;
-  if (std::optional<Convex> cb = convexOf(*b, scale)) {
+  std::string bWhat = bUnion ? bUnion->describe() : b->what;
+  if (bUnion) {
+    for (const auto& c : bUnion->corners) {
+      std::optional<PieceMesh> hull = convexHullMesh(c, 1e-9 * scale);
+      std::optional<Convex> k = hull ? convexOf(Mesh{hull->v, hull->t, ""}, scale) : std::nullopt;
+      if (!k) return false;
+      bs.push_back(std::move(*k));
+    }
+  } else if (std::optional<Convex> cb = convexOf(*b, scale)) {
     if (pieces) return false;  // the convex form was tried first
     bs.push_back(std::move(*cb));
   } else {
