@@ -14,6 +14,7 @@
 #include "core/mesh_checks.h"
 #include "core/mesh_models.h"
 #include "frep/evaluators/eval.h"
+#include "frep/evaluators/float_error.h"
 #include "frep/meshing/mesh.h"
 #include "frep/meshing/mesh_simplify.h"
 #include "frep/primitives/ops.h"
@@ -321,6 +322,33 @@ TEST(MeshSimplify, SameResultForAnyThreadCount) {
   EXPECT_EQ(a.triangles, b.triangles);
   EXPECT_EQ(sa.collapses, sb.collapses);
   EXPECT_EQ(sa.modelEvals, sb.modelEvals);
+}
+
+// The error check's signs in float with the certified double fallback give the double path's
+// mesh: R-function blocks joined by a blended union (the division of hfBlendUni), as
+// examples/chair.hf is built, and the split tests' model (min, max, square roots).
+TEST(MeshSimplify, FloatSignsGiveTheDoubleMesh) {
+  Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  auto block = [&](double cx, double cy, double cz, double hx, double hy, double hz) {
+    return rIntersection(rIntersection(hx - abs(x - cx), hy - abs(y - cy)), hz - abs(z - cz));
+  };
+  const Expr seat = block(0.0, 0.0, 0.1, 0.6, 0.6, 0.08), leg = block(0.3, 0.3, -0.3, 0.08, 0.08, 0.35);
+  const Expr chairLike = rUnion(seat, leg) + 0.02 / (1.0 + square(seat / 0.1) + square(leg / 0.1));
+  for (const Expr& m : {chairLike, torusAndNotchedBlock()}) {
+    TapePtr tape = Tape::compile(m, 3);
+    ASSERT_TRUE(FloatErrorBound::supports(*tape));
+    GridSpec g = cubeGrid(1.0, 80);
+    Mesh a = meshGrid(tape, g), b = a;
+    SimplifyOptions flt, dbl;
+    flt.tolerance = dbl.tolerance = 0.1;
+    dbl.floatSigns = false;
+    const SimplifyStats sa = simplifyMesh(a, tape, g, flt), sb = simplifyMesh(b, tape, g, dbl);
+    EXPECT_GT(sa.collapses, 1000u);
+    EXPECT_EQ(sa.collapses, sb.collapses);
+    EXPECT_EQ(sa.modelEvals, sb.modelEvals);
+    EXPECT_EQ(sa.errorBound, sb.errorBound);
+    expectSameMesh(a, b);
+  }
 }
 
 TEST(MeshSimplify, WithoutSharpFeaturesEveryVertexStaysAMesherVertex) {

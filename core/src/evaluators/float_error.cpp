@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
+#include <utility>
 
 namespace frep {
 namespace {
@@ -76,23 +78,49 @@ inline double rValue(double x, double y, double al, double sg, double side) {
 // Rounding error of the batch evaluator's R-function (eval_batch.cpp: s = a a + b b - (2 al) a
 // b, root = sqrt(max(s, 0)), (a + b + sg root) / (1 + al); no division when al = 0) at inputs
 // of magnitudes at most ma, mb, with unit roundoff u, underflow term tiny and the precision's
-// parameter off from al by at most dal. The sum of squares and products has a relative error
-// of at most theta against Q = a^2 + b^2 - 2 al a b >= (1 - |al|)(a^2 + b^2) (Higham eq. 2.4
-// per op), so its square root one of theta plus sqrt(tiny terms); the sum, the final addition
-// and the division add theirs.
-inline double rRounding(double ma, double mb, double al, double u, double tiny, double dal) {
+// parameter off from al by at most dal; mr bounds the result's magnitude. The squares and
+// products have a relative error of at most theta against Q = a^2 + b^2 - 2 al a b >= (1 -
+// |al|)(a^2 + b^2) (Higham eq. 2.4 per op), so the root one of theta / 2 + u (plus the root of
+// the tiny terms), the sum and the final addition u of their magnitudes; al != 0 adds the
+// division by the rounded 1 + al.
+inline double rRounding(double ma, double mb, double mr, double al, double u, double tiny, double dal) {
   const double aa = std::fabs(al), m = ma + mb;
+  const double rmax = std::sqrt(1 + aa) * std::sqrt(ma * ma + mb * mb);  // sqrt(Q) <= sqrt(1 + |al|) |(a, b)|
+  if (al == 0) {
+    const double root = rmax * (2 * u * (1 + 2 * u)) + 2 * std::sqrt(4 * tiny) + tiny;  // (1 -+ u)^2 around 1
+    return u * m + root + u * (mr + u * (m + 3 * rmax)) + 4 * tiny;
+  }
   const double theta = (u * 8 * (1 + aa) + 2 * dal) / (1 - aa);
-  const double rmax = std::sqrt(1 + aa) * m;  // sqrt(Q) <= sqrt(1 + |al|) (|a| + |b|)
   const double root = rmax * (theta + 2 * u) + 4 * std::sqrt(6 * tiny) + 2 * tiny;
   const double num = m + rmax, eNum = u * m + root + 2 * u * num + 4 * tiny;
-  if (al == 0) return eNum;
   // 1 + al rounded: off from the exact 1 + al by dD; dividing by it
   const double d = 1 + al, dD = dal + 2 * u * (1 + aa), dmin = d - dD;
   if (!(dmin > 0)) return kInf;
   return (eNum + num * dD / d) / dmin + 2 * u * (num + eNum) / dmin + 2 * tiny;
 }
 
+// Bounds on |dR/da| and |dR/db| of an R-function with al = 0, R = a + b + sg sqrt(a^2 + b^2),
+// over the box [alo, ahi] x [blo, bhi]: dR/da = 1 + sg h(a, b), h = a / sqrt(a^2 + b^2), which
+// increases with a and is monotone in b^2 for each sign of a, so its extremes lie at the corners
+// (a, b^2). A box holding (0, 0) gets the global bound 2 (the root is 1-Lipschitz).
+inline std::pair<double, double> rSlopes(double alo, double ahi, double blo, double bhi, double sg) {
+  auto range = [](double lo, double hi, double olo, double ohi) {  // h over [lo, hi] x [olo, ohi]
+    const double t0 = olo <= 0 && ohi >= 0 ? 0.0 : std::min(olo * olo, ohi * ohi), t1 = std::max(olo * olo, ohi * ohi);
+    if (lo <= 0 && hi >= 0 && t0 == 0) return std::pair<double, double>{-1.0, 1.0};
+    double mn = 1, mx = -1;
+    for (double x : {lo, hi})
+      for (double t : {t0, t1}) {
+        const double h = x == 0 ? 0.0 : t == 0 ? (x > 0 ? 1.0 : -1.0) : x / std::sqrt(x * x + t);
+        mn = std::min(mn, h), mx = std::max(mx, h);
+      }
+    return std::pair<double, double>{mn, mx};
+  };
+  const auto [ha0, ha1] = range(alo, ahi, blo, bhi);
+  const auto [hb0, hb1] = range(blo, bhi, alo, ahi);
+  // |1 + sg h| over [h0, h1] (within [0, 2]), plus a margin for h's own rounding
+  const double da = sg > 0 ? 1 + ha1 : 1 - ha0, db = sg > 0 ? 1 + hb1 : 1 - hb0;
+  return {std::min(2.0, da + 1e-9), std::min(2.0, db + 1e-9)};
+}
 }  // namespace
 
 bool FloatErrorBound::supports(const Tape& tape) {
@@ -200,14 +228,17 @@ double FloatErrorBound::propagate(const I* code, size_t size, uint32_t result) {
       }
       case Op::RAnd:
       case Op::ROr: {
-        // Inputs off by ea, eb move the exact value by at most L (ea + eb): sqrt(Q) is the norm
-        // of M^(1/2) (a, b), M's eigenvalues 1 -+ al, so it is sqrt(1 + |al|)-Lipschitz.
+        // Inputs off by ea, eb move the exact value by at most La ea + Lb eb (mean value theorem
+        // over the box widened by the errors; al != 0: sqrt(Q) is the norm of M^(1/2) (a, b), M's
+        // eigenvalues 1 -+ al, so it is sqrt(1 + |al|)-Lipschitz).
         const double al = rParam(ins), sg = ins.op == Op::ROr ? 1.0 : -1.0;
-        const double L = (1 + std::sqrt(1 + std::fabs(al))) / (1 + al) * (1 + 0x1p-40);
         o.lo = rValue(a.lo, b.lo, al, sg, -1.0), o.hi = rValue(a.hi, b.hi, al, sg, 1.0);
+        double La = (1 + std::sqrt(1 + std::fabs(al))) / (1 + al) * (1 + 0x1p-40), Lb = La;
+        if (al == 0) std::tie(La, Lb) = rSlopes(a.lo - a.ef, a.hi + a.ef, b.lo - b.ef, b.hi + b.ef, sg);
+        const double pf = La * a.ef + Lb * b.ef, pd = La * a.ed + Lb * b.ed, mr = mag(o.lo, o.hi);
         const double dalF = std::fabs(double(float(al)) - al);  // the float lanes' parameter
-        o.ef = upErr(L * (a.ef + b.ef) + rRounding(ma + a.ef, mb + b.ef, al, kUf, kTinyF, dalF)) * 1.0625;
-        o.ed = upErr(L * (a.ed + b.ed) + rRounding(ma + a.ed, mb + b.ed, al, kUd, kTinyD, 0.0)) * 1.0625;
+        o.ef = upErr(pf + rRounding(ma + a.ef, mb + b.ef, mr + pf, al, kUf, kTinyF, dalF)) * 1.0625;
+        o.ed = upErr(pd + rRounding(ma + a.ed, mb + b.ed, mr + pd, al, kUd, kTinyD, 0.0)) * 1.0625;
         break;
       }
       case Op::Neg:

@@ -25,6 +25,7 @@ Simplifier::Simplifier(Work&& work, const TapePtr& tape, const GridSpec& grid, c
     throw std::invalid_argument("simplifyMesh: the model has " + std::to_string(tape_->numVars()) +
                                 " coordinates; give values for x[4..] (fixedCoords)");
   batch_.setFieldSignsOnly(true);  // crossed() reads the class of each value alone
+  floatSigns_ = opt_.floatSigns && FloatErrorBound::supports(*tape_);
 }
 
 // Collapses until no candidate is left; then work(), vertexAlive() and triangleAlive() hold

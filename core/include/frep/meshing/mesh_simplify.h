@@ -55,6 +55,10 @@ struct SimplifyOptions {
   std::vector<double> fixedCoords;  // x[3], x[4], ... for models of dimension > 3
   double minQuality = 0.02;  // 4 sqrt(3) area / sum of squared edges (1: equilateral)
   int threads = 0;           // the block passes' independent blocks; 0: all cores (same result)
+  // The error check's signs in float where a certified bound decides them, in double for the
+  // rest (frep/evaluators/float_error.h; tapes it does not cover: double throughout). Never
+  // changes the result; false: double throughout (for tests).
+  bool floatSigns = true;
   // The mesh's bricks of this many cells (from index 0) went through simplifyRegion already:
   // their blocks are not done again. 0: none.
   int bricksSimplified = 0;
