@@ -80,7 +80,11 @@ FarmOutcome Master::run() {
   if (!opt_.journalPath.empty()) {
     // Replayed without handing slabs to the merge thread: a record may be revoked further on.
     replaying_ = true;
-    journal_ = std::make_unique<Journal>(opt_.journalPath, jobId_, opt_.resume, [&](uint64_t id, const std::string& payload) {
+    // The journal's id binds the brick edge too: a record is a brick's payload by its index in
+    // the plan, so a journal of another edge (another --brick, or --workers, which chooses it)
+    // would merge its bricks as other regions. It is refused as another job's.
+    const uint64_t journalId = jobId_ ^ (0x9e3779b97f4a7c15ull * uint64_t(opt_.brickVoxels));
+    journal_ = std::make_unique<Journal>(opt_.journalPath, journalId, opt_.resume, [&](uint64_t id, const std::string& payload) {
       if ((id == kJournalVerifySeed || id == kJournalRevoke) && payload.size() == 8) {
         uint64_t v = 0;
         std::memcpy(&v, payload.data(), 8);

@@ -124,6 +124,25 @@ TEST_F(MeshFarmCli, PoisonedBrickExitsFiveAndIsNamed) {
   EXPECT_TRUE(fileExists(path("out.ply.report.json")));
 }
 
+// A journal binds the brick edge: resumed without the first run's --workers/--brick (here the
+// small-job default, in-process on bricks of 64) it is refused as another job's, instead of its
+// bricks of 32 being merged as bricks of 64 (an open mesh); with them the job completes.
+TEST_F(MeshFarmCli, ResumeWithAnotherBrickEdgeIsRefused) {
+  ASSERT_EQ(run(meshArgs("ref.ply") + " --workers 0").code, 0);
+  std::string full = "cd '" + dir_ + "' && FREP_TEST_CRASH_BRICK=5 '" FREP_BINARY "' " + meshArgs("out.ply") +
+                     " --workers 2 --brick 32 >/dev/null 2>&1";
+  int status = std::system(full.c_str());
+  ASSERT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 5);
+  ASSERT_TRUE(fileExists(path("out.ply.journal")));
+  RunResult other = run(meshArgs("out.ply") + " --resume");
+  EXPECT_EQ(other.code, 7) << other.err;
+  EXPECT_NE(other.err.find("belongs to another job"), std::string::npos) << other.err;
+  EXPECT_FALSE(fileExists(path("out.ply")));
+  RunResult same = run(meshArgs("out.ply") + " --resume --workers 2 --brick 32");
+  ASSERT_EQ(same.code, 0) << same.err;
+  EXPECT_TRUE(readText(path("out.ply")) == readText(path("ref.ply"))) << "output bytes differ";
+}
+
 TEST_F(MeshFarmCli, JsonProgressEventsForBatchSystems) {
   RunResult r = run(meshArgs("j.ply") + " --workers 2 --brick 32 --json");
   ASSERT_EQ(r.code, 0) << r.err;
