@@ -58,14 +58,35 @@ void Master::verifyArrivals(zmq::socket_t& router) {
       const uint32_t crc = a.result.payload_crc32();
       a.ok = crc32Of(data, size) == crc && verifyPayload(data, size, bricks_[a.brick], a.out, a.kept, &a.error);
       a.journaled = a.journaled && a.ok;
-      if (a.journaled) keep(a);
+      if (a.journaled && !journal_) keep(a);  // into the arena; with a journal, below
       // Not held: freed now, the next message's buffer reuses its memory.
-      if (!a.ok || a.journaled) a.payload = zmq::message_t();
+      if (!a.ok || (a.journaled && !journal_)) a.payload = zmq::message_t();
     });
   });
+  if (journal_) journalArrivals();
   for (Arrival& a : arrivals_) judge(router, a);
   arrivals_.clear();
   arrivalBytes_ = 0;
+}
+
+// The batch's verified first copies, journaled together (Journal::addAll: one system call where
+// each took one) before any of them is judged, and kept for the merge as keep() keeps one.
+void Master::journalArrivals() {
+  std::vector<Journal::Record> records;
+  for (const Arrival& a : arrivals_)
+    if (a.journaled) records.push_back({a.brick, a.payload.data(), a.payload.size(), a.result.payload_crc32(), 0});
+  if (records.empty()) return;
+  journal_->addAll(records.data(), records.size());
+  size_t r = 0;
+  for (Arrival& a : arrivals_) {
+    if (!a.journaled) continue;
+    const Journal::Record& rec = records[r++];
+    if (op_ == Operation::Sample) {
+      a.kept.inJournal = true, a.kept.journalAt = rec.at, a.kept.size = rec.size, a.kept.crc = rec.crc;
+      a.kept.received = HeldPayload::take(a.payload, heldBytes_, opt_.heldPayloadBytes);
+    }
+    a.payload = zmq::message_t();  // not held: freed now, the next message's buffer reuses its memory
+  }
 }
 
 // A copy journaled (verifyArrivals) that is not merged: void in the journal, so that a resume

@@ -218,6 +218,7 @@ class Master {
   std::map<std::string, Clock::time_point> lastResultAt_;
 
   void verifyArrivals(zmq::socket_t& router);
+  void journalArrivals();
 
   // Journals a verified payload and keeps it for the merge ("sample": the message itself while
   // the held bytes allow, with a journal; a copy in the arena without one).
@@ -278,7 +279,17 @@ class Master {
 
   bool sendTask(zmq::socket_t& router, const std::string& rid, uint64_t id, uint32_t attempt);
 
-  std::string_view keptPayload(const KeptBrick& k, size_t brick, std::string& buffer);
+  // A buffer for a payload read back from the journal, reused from slab to slab: not zeroed
+  // when it grows (std::string's resize wrote each 150 kB once more) and not faulted in anew.
+  struct ReadBack {
+    std::unique_ptr<char[]> bytes;
+    size_t capacity = 0;
+    char* room(size_t size) {
+      if (size > capacity) bytes.reset(new char[capacity = size + size / 8]);
+      return bytes.get();
+    }
+  };
+  std::string_view keptPayload(const KeptBrick& k, size_t brick, ReadBack& buffer);
 
   // ---- the merge of a sample ----------------------------------------------------------------
   // The bricks' leaves sorted by origin (as sample() sorts them) and their tiles, one slab of
@@ -289,9 +300,9 @@ class Master {
   // slab's payloads are then released, so the master holds the payloads or the output, not both.
 
   void slabRecords(size_t first, size_t last, tbb::task_arena& threads, std::vector<LeafRecord>& sorted,
-                   std::vector<std::string>& readBack, std::vector<Tile>& tiles);
+                   std::vector<ReadBack>& readBack, std::vector<Tile>& tiles);
 
-  void releaseSlab(size_t first, size_t last, std::vector<std::string>& readBack);
+  void releaseSlab(size_t first, size_t last);
 
   void queueCompleteSlabs();
 

@@ -17,22 +17,22 @@ namespace frep::farm::detail {
 // A kept payload's bytes: as received, in the arena, or read back from the journal into
 // `buffer` and checked against the CRC-32 it was verified with (the file is the master's own,
 // but what it merges must be exactly what it verified).
-std::string_view Master::keptPayload(const KeptBrick& k, size_t brick, std::string& buffer) {
+std::string_view Master::keptPayload(const KeptBrick& k, size_t brick, ReadBack& buffer) {
   if (k.received.held()) return k.received.bytes();
   if (!k.inJournal) return {k.payload.data(), k.payload.size()};
-  buffer.resize(k.size);
-  journal_->read(k.journalAt, buffer.data(), k.size);
-  if (crc32Of(buffer.data(), buffer.size()) != k.crc)
+  char* bytes = buffer.room(k.size);
+  journal_->read(k.journalAt, bytes, k.size);
+  if (crc32Of(bytes, k.size) != k.crc)
     throw JournalIoError("journal " + journal_->path() + ": the record of brick " + std::to_string(brick) +
                          " changed after it was written (its CRC-32 no longer matches)");
-  return buffer;
+  return {bytes, k.size};
 }
 
 // The leaf records of the slab of bricks [first, last), sorted by origin, and its tiles
-// (appended to `tiles`). Payloads read back from the journal are kept in readBack (one string
-// a brick) while the records point into them. Runs on `threads`.
+// (appended to `tiles`). Payloads read back from the journal are kept in readBack (a buffer per
+// brick of the slab, reused by the next slab) while the records point into them. Runs on `threads`.
 void Master::slabRecords(size_t first, size_t last, tbb::task_arena& threads, std::vector<LeafRecord>& sorted,
-                 std::vector<std::string>& readBack, std::vector<Tile>& tiles) {
+                 std::vector<ReadBack>& readBack, std::vector<Tile>& tiles) {
   std::vector<std::array<int32_t, 3>> origins;  // the slab's, brick by brick
   std::vector<size_t> start(1, 0), rank;         // rank[start[brick] + leaf]: the leaf's place in the slab
   for (size_t i = first; i < last; ++i) {
@@ -57,10 +57,10 @@ void Master::slabRecords(size_t first, size_t last, tbb::task_arena& threads, st
   });
 }
 
-// After a slab's records were decoded: its payloads go (the arena unmaps emptied chunks).
-void Master::releaseSlab(size_t first, size_t last, std::vector<std::string>& readBack) {
+// After a slab's records were decoded: its payloads go (the arena unmaps emptied chunks); the
+// read-back buffers stay for the next slab.
+void Master::releaseSlab(size_t first, size_t last) {
   for (size_t i = first; i < last; ++i) kept_[i] = KeptBrick{};
-  readBack.clear();
 }
 
 // Streaming (FarmOptions::sampleSink): the loop hands the merge thread every slab whose bricks
@@ -88,7 +88,7 @@ void Master::mergeSlabs() {
       size_t(std::max({1, mergers_.max_concurrency(), allCores_.max_concurrency()})));
   for (auto& p : pieces) p.reserve(kSinkPieceLeaves);
   std::vector<LeafRecord> sorted;
-  std::vector<std::string> readBack;
+  std::vector<ReadBack> readBack;
   std::vector<Tile> tiles;
   try {
     for (size_t next = 0;; ++next) {
@@ -119,7 +119,7 @@ void Master::mergeSlabs() {
         else threads.execute([&] { tbb::parallel_for(size_t(0), count, decodePiece); });
         for (size_t p = 0; p < count; ++p) sink.leaves(pieces[p]);
       }
-      releaseSlab(first, last, readBack);
+      releaseSlab(first, last);
       streamedTiles_.insert(streamedTiles_.end(), tiles.begin(), tiles.end());
       std::lock_guard<std::mutex> lock(mergeMutex_);
       slabsStreamed_ = next + 1;
@@ -167,7 +167,7 @@ void Master::mergeLeaves(SampleResult& result) {
   adviseHugePages(result.leaves.data(), leaves * sizeof(LeafBlock));
   std::vector<Tile> tiles;
   std::vector<LeafRecord> sorted;
-  std::vector<std::string> readBack;
+  std::vector<ReadBack> readBack;
   for (size_t first = firstKept; first < kept_.size(); first += perSlab_) {
     const size_t last = std::min(kept_.size(), first + perSlab_), at = result.leaves.size();
     slabRecords(first, last, decoders_, sorted, readBack, tiles);
@@ -177,7 +177,7 @@ void Master::mergeLeaves(SampleResult& result) {
         decodeLeafRecords(sorted.data() + r.begin(), r.size(), result.leaves.data() + at + r.begin());
       });
     });
-    releaseSlab(first, last, readBack);
+    releaseSlab(first, last);
   }
   std::vector<LeafBlock> noLeaves;
   sortByOrigin(noLeaves, tiles);

@@ -48,6 +48,18 @@ class Journal {
   // takes its own stretch of the file (their order in it does not matter); they write in turn.
   // Returns where the payload starts in the file (for read).
   uint64_t add(uint64_t brick, const void* payload, size_t size, uint32_t crc);
+  // A record for addAll: what add takes; `at` is set to where its payload starts in the file.
+  struct Record {
+    uint64_t brick = 0;
+    const void* payload = nullptr;
+    size_t size = 0;
+    uint32_t crc = 0;
+    uint64_t at = 0;
+  };
+  // Appends `n` records as add does, one after another in one stretch of the file and with as
+  // few system calls as the kernel allows (one pwritev of up to 512 records): what the master
+  // received in one loop turn. Each record is complete in the kernel when this returns.
+  void addAll(Record* records, size_t n);
   uint64_t append(uint64_t brick, const std::string& payload);  // add, computing the CRC
   // Reads back `size` bytes at `offset` (a payload add placed there): the master keeps a merged
   // brick's payload here, in the page cache, rather than a second copy in its own memory.
