@@ -319,8 +319,10 @@ class Simplifier {
   bool floatSigns_ = false;
   BatchEvaluator<float> fbatch_;
   FloatErrorBound fbound_;
-  std::vector<Interval> box_;  // the box bound_ holds for, then the last lanes' box
-  double bound_ = -1;          // < 0: none yet
+  std::vector<float*> finputs_;      // its input lanes, written with inputs_ (levels)
+  std::array<double, 3> laneLo_{}, laneHi_{};  // a box holding the lanes written (spatial coordinates)
+  std::vector<Interval> box_;        // the box bound_ holds for
+  double bound_ = -1;                // < 0: none yet
   std::vector<uint32_t> redo_;
   std::array<char, 2 * kPairsPerCall> inside_{};
   int maxLevel_ = 0;  // the last error level

@@ -77,6 +77,11 @@ bool Simplifier::levels(std::vector<LevelQuery>& qs, int maxK, bool stopAbove, b
   batch_.reserve(*tape_);
   inputs_.resize(nvars);
   for (uint32_t k = 0; k < nvars; ++k) inputs_[k] = batch_.in(k);
+  if (floatSigns_) {
+    fbatch_.reserve(*tape_);
+    finputs_.resize(nvars);
+    for (uint32_t k = 0; k < nvars; ++k) finputs_[k] = fbatch_.in(k);
+  }
   const uint32_t spatial = std::min(nvars, 3u);  // a 2D model (a prism) has no x[3]
   for (;;) {
     bool any = false;
@@ -94,6 +99,7 @@ bool Simplifier::levels(std::vector<LevelQuery>& qs, int maxK, bool stopAbove, b
       for (size_t k = from; k < to && !failed_[i];) {
         const size_t n = std::min(to - k, kPairsPerCall - lanes_);
         double* const* in = inputs_.data();
+        if (floatSigns_ && lanes_ == 0) laneLo_ = {INFINITY, INFINITY, INFINITY}, laneHi_ = {-INFINITY, -INFINITY, -INFINITY};
         for (size_t j = 0; j < n; ++j, ++k) {
           const double s = cells[k][0] + 1.0 / 3, t = cells[k][1] + 1.0 / 3;
           const size_t lane = 2 * (lanes_ + j);
@@ -101,6 +107,12 @@ bool Simplifier::levels(std::vector<LevelQuery>& qs, int maxK, bool stopAbove, b
             const double pc = q.a[c] + (u[c] * s + v[c] * t);  // a + s u + t v
             in[c][lane] = pc - de[c], in[c][lane + 1] = pc + de[c];
           }
+          if (floatSigns_)  // the float lanes and the box of the lanes (classify)
+            for (uint32_t c = 0; c < spatial; ++c) {
+              const double lo = std::min(in[c][lane], in[c][lane + 1]), hi = std::max(in[c][lane], in[c][lane + 1]);
+              laneLo_[c] = lo < laneLo_[c] ? lo : laneLo_[c], laneHi_[c] = hi > laneHi_[c] ? hi : laneHi_[c];
+              finputs_[c][lane] = float(in[c][lane]), finputs_[c][lane + 1] = float(in[c][lane + 1]);
+            }
           laneQuery_[lanes_ + j] = i;
         }
         lanes_ += n;
@@ -161,41 +173,29 @@ bool Simplifier::crossed() {
 // Each lane's value depends on its point alone (no extremum or field in a covered tape), so the
 // double lanes give the same bits packed to the front.
 void Simplifier::classify(size_t n) {
-  const uint32_t nvars = tape_->numVars();
+  const uint32_t nvars = tape_->numVars(), spatial = std::min(nvars, 3u);
   if (floatSigns_) {
-    // The bound of a box holding the lanes: the last one computed when it holds them (the
-    // rounds of one check sample the same triangles), else one for the lanes' box 3 voxels
-    // wider. A tight box keeps the bound tight (the R-functions' slopes are taken over it); the
-    // hull of all lanes so far left 80% of them to double on examples/chair.hf; chair 128^3,
-    // one thread: pad 0.5 / 1.5 / 4 / 8 voxels 1.21 / 1.16 / 1.13 / 1.35 CPU-s.
+    // The bound of a box holding the lanes (laneLo_, laneHi_ and the fixed coordinates): the
+    // last one computed when it holds them (the rounds of one check sample the same triangles),
+    // else one for the lanes' box 3 voxels wider. A tight box keeps the bound tight (the
+    // R-functions' slopes are taken over it); the hull of all lanes so far left 80% of them to
+    // double on examples/chair.hf; chair 128^3, one thread: pad 0.5 / 1.5 / 4 / 8 voxels
+    // 1.21 / 1.16 / 1.13 / 1.35 CPU-s.
     bool held = bound_ >= 0;
-    box_.resize(2 * size_t(nvars));
+    box_.resize(nvars);
     for (uint32_t k = 0; k < nvars; ++k) {
-      const double* in = inputs_[k];
-      double lo[4] = {in[0], in[0], in[0], in[0]}, hi[4] = {in[0], in[0], in[0], in[0]};
-      size_t i = 0;
-      for (; i + 4 <= n; i += 4)  // four independent chains
-        for (int j = 0; j < 4; ++j) lo[j] = in[i + j] < lo[j] ? in[i + j] : lo[j], hi[j] = in[i + j] > hi[j] ? in[i + j] : hi[j];
-      for (; i < n; ++i) lo[0] = in[i] < lo[0] ? in[i] : lo[0], hi[0] = in[i] > hi[0] ? in[i] : hi[0];
-      const Interval b{std::min(std::min(lo[0], lo[1]), std::min(lo[2], lo[3])),
-                       std::max(std::max(hi[0], hi[1]), std::max(hi[2], hi[3]))};
-      held = held && b.lo >= box_[k].lo && b.hi <= box_[k].hi;
-      box_[nvars + k] = b;
+      const double lo = k < spatial ? laneLo_[k] : opt_.fixedCoords[k - 3], hi = k < spatial ? laneHi_[k] : lo;
+      held = held && lo >= box_[k].lo && hi <= box_[k].hi;
     }
     if (!held) {
       for (uint32_t k = 0; k < nvars; ++k) {
-        const double pad = k < 3 ? 3 * grid_.voxel : 0.0;
-        box_[k] = {box_[nvars + k].lo - pad, box_[nvars + k].hi + pad};
+        const double pad = k < spatial ? 3 * grid_.voxel : 0.0;
+        box_[k] = k < spatial ? Interval{laneLo_[k] - pad, laneHi_[k] + pad} : Interval{opt_.fixedCoords[k - 3]};
       }
       bound_ = fbound_.bound(*tape_, box_.data());
     }
     if (bound_ < std::numeric_limits<double>::infinity()) {
-      fbatch_.reserve(*tape_);
-      for (uint32_t k = 0; k < nvars; ++k) {
-        float* out = fbatch_.in(k);
-        const double* in = inputs_[k];
-        for (size_t i = 0; i < n; ++i) out[i] = float(in[i]);
-      }
+      for (uint32_t k = spatial; k < nvars; ++k) std::fill_n(finputs_[k], n, float(opt_.fixedCoords[k - 3]));
       const float* f = fbatch_.eval(*tape_, n);
       const float bound = float(bound_) * (1 + 0x1p-20f);  // rounded up: |f| > it exceeds bound_
       redo_.clear();
