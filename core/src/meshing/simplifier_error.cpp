@@ -41,6 +41,12 @@ const std::vector<std::array<int32_t, 2>>& errorSampleCells(int m) {
 
 namespace simplify_detail {
 
+namespace {
+// double -> float without the undefined conversion of values beyond float's range (those lanes
+// never pass the bound: it is infinite for such boxes).
+inline float narrow(double x) { return std::fabs(x) <= 3.0e38 ? float(x) : float(std::copysign(INFINITY, x)); }
+}  // namespace
+
 // Answers every query. A level is checked in full only once its probes (kProbes points spread
 // over the triangle, where a chord is deepest) pass, and a failing level moves on to the next
 // one's probes: the answer is the same as checking every level in full, for far fewer
@@ -111,7 +117,7 @@ bool Simplifier::levels(std::vector<LevelQuery>& qs, int maxK, bool stopAbove, b
             for (uint32_t c = 0; c < spatial; ++c) {
               const double lo = std::min(in[c][lane], in[c][lane + 1]), hi = std::max(in[c][lane], in[c][lane + 1]);
               laneLo_[c] = lo < laneLo_[c] ? lo : laneLo_[c], laneHi_[c] = hi > laneHi_[c] ? hi : laneHi_[c];
-              finputs_[c][lane] = float(in[c][lane]), finputs_[c][lane + 1] = float(in[c][lane + 1]);
+              finputs_[c][lane] = narrow(in[c][lane]), finputs_[c][lane + 1] = narrow(in[c][lane + 1]);
             }
           laneQuery_[lanes_ + j] = i;
         }
@@ -195,9 +201,9 @@ void Simplifier::classify(size_t n) {
       bound_ = fbound_.bound(*tape_, box_.data());
     }
     if (bound_ < std::numeric_limits<double>::infinity()) {
-      for (uint32_t k = spatial; k < nvars; ++k) std::fill_n(finputs_[k], n, float(opt_.fixedCoords[k - 3]));
+      for (uint32_t k = spatial; k < nvars; ++k) std::fill_n(finputs_[k], n, narrow(opt_.fixedCoords[k - 3]));
       const float* f = fbatch_.eval(*tape_, n);
-      const float bound = float(bound_) * (1 + 0x1p-20f);  // rounded up: |f| > it exceeds bound_
+      const float bound = narrow(bound_) * (1 + 0x1p-20f);  // rounded up: |f| > it exceeds bound_
       redo_.clear();
       for (size_t i = 0; i < n; ++i) {
         if (std::fabs(f[i]) > bound) inside_[i] = f[i] >= 0;
