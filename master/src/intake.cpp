@@ -50,35 +50,48 @@ void Master::verifyArrivals(zmq::socket_t& router) {
   // only once another worker agrees) are journaled by the judge if it merges them.
   std::set<uint64_t> first;
   for (Arrival& a : arrivals_) a.journaled = !a.check && first.insert(a.brick).second;
+  // Groups of consecutive arrivals up to kJournalGroupBytes, each checked then journaled in one
+  // call while its payloads are still in the core's cache: journaling the whole batch after
+  // checking it all made the kernel's copy into the page cache read them from memory again.
+  std::vector<size_t> groups(1, 0);
+  for (size_t i = 0, bytes = 0; i < arrivals_.size(); ++i) {
+    bytes += arrivals_[i].payload.size();
+    if (bytes >= kJournalGroupBytes || i + 1 == arrivals_.size()) groups.push_back(i + 1), bytes = 0;
+  }
   decoders_.execute([&] {
-    tbb::parallel_for(size_t(0), arrivals_.size(), [&](size_t i) {
-      Arrival& a = arrivals_[i];
-      const void* data = a.payload.data();
-      const size_t size = a.payload.size();
-      const uint32_t crc = a.result.payload_crc32();
-      a.ok = crc32Of(data, size) == crc && verifyPayload(data, size, bricks_[a.brick], a.out, a.kept, &a.error);
-      a.journaled = a.journaled && a.ok;
-      if (a.journaled && !journal_) keep(a);  // into the arena; with a journal, below
-      // Not held: freed now, the next message's buffer reuses its memory.
-      if (!a.ok || (a.journaled && !journal_)) a.payload = zmq::message_t();
+    tbb::parallel_for(size_t(0), groups.size() - 1, [&](size_t g) {
+      for (size_t i = groups[g]; i < groups[g + 1]; ++i) {
+        Arrival& a = arrivals_[i];
+        const void* data = a.payload.data();
+        const size_t size = a.payload.size();
+        const uint32_t crc = a.result.payload_crc32();
+        a.ok = crc32Of(data, size) == crc && verifyPayload(data, size, bricks_[a.brick], a.out, a.kept, &a.error);
+        a.journaled = a.journaled && a.ok;
+        if (a.journaled && !journal_) keep(a);  // into the arena; with a journal, below
+        // Not held: freed now, the next message's buffer reuses its memory.
+        if (!a.ok || (a.journaled && !journal_)) a.payload = zmq::message_t();
+      }
+      if (journal_) journalArrivals(groups[g], groups[g + 1]);
     });
   });
-  if (journal_) journalArrivals();
   for (Arrival& a : arrivals_) judge(router, a);
   arrivals_.clear();
   arrivalBytes_ = 0;
 }
 
-// The batch's verified first copies, journaled together (Journal::addAll: one system call where
-// each took one) before any of them is judged, and kept for the merge as keep() keeps one.
-void Master::journalArrivals() {
+// Arrivals [from, to)'s verified first copies, journaled together (Journal::addAll: one system
+// call where each took one) before any of them is judged, and kept for the merge as keep()
+// keeps one. Safe on the decode threads at once (other ranges).
+void Master::journalArrivals(size_t from, size_t to) {
   std::vector<Journal::Record> records;
-  for (const Arrival& a : arrivals_)
-    if (a.journaled) records.push_back({a.brick, a.payload.data(), a.payload.size(), a.result.payload_crc32(), 0});
+  for (size_t i = from; i < to; ++i)
+    if (const Arrival& a = arrivals_[i]; a.journaled)
+      records.push_back({a.brick, a.payload.data(), a.payload.size(), a.result.payload_crc32(), 0});
   if (records.empty()) return;
   journal_->addAll(records.data(), records.size());
   size_t r = 0;
-  for (Arrival& a : arrivals_) {
+  for (size_t i = from; i < to; ++i) {
+    Arrival& a = arrivals_[i];
     if (!a.journaled) continue;
     const Journal::Record& rec = records[r++];
     if (op_ == Operation::Sample) {
