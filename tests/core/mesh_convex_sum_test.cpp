@@ -259,6 +259,20 @@ TEST(MeshConvexSum, ToolWrittenAsABlockDifferenceIsCoveredByItsBoxes) {
     }
   }
   EXPECT_GT(inside, 300);
+  // Two boxes apart (a bar minus a slab across it): one translate A + b0 cannot stand for both,
+  // so this form is refused (the search takes it), never answered wrong: (1.35, 0.5, 0.5) lies
+  // in A ⊕ B for A = [0, 1]^3 (a point of A deep inside, plus one of the second box), but
+  // neither in A plus a point of the first box nor near A's boundary plus either box.
+  const Expr apart = min(axisBox({0, 0, 0}, {0.6, 0.1, 0.1}), max(0.1 - X(), X() - 0.5));
+  const auto two = minkowski::polytopeUnionOf(apart);
+  ASSERT_TRUE(two.has_value());
+  EXPECT_EQ(two->pieces, 2u);
+  EXPECT_FALSE(two->connected());
+  EXPECT_TRUE(minkowski::polytopeUnionOf(ell)->connected());
+  Expr wrong;
+  if (minkowski::meshConvexSum(axisBox({0, 0, 0}, {1, 1, 1}), apart, 3, &wrong)) {
+    EXPECT_GE(eval(wrong, {1.35, 0.5, 0.5}), 0);
+  }
 }
 
 TEST(MeshConvexSum, TetrahedronErodedByABoxIsTheShrunkTetrahedron) {

@@ -290,6 +290,7 @@ std::optional<PolytopeUnion> unionOfTerms(const std::vector<Term>& terms, bool c
       if (!piece) return std::nullopt;  // the whole space
       ++u.boxes;
       if (x == Extent::Bounded) {
+        u.halfSpaces.push_back(t);
         u.corners.emplace_back();
         for (int k = 0; k < 8; ++k)
           u.corners.back().push_back({k & 4 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 1 ? hi[2] : lo[2]});
@@ -300,7 +301,10 @@ std::optional<PolytopeUnion> unionOfTerms(const std::vector<Term>& terms, bool c
       if (x == Extent::Unbounded && !clip) return std::nullopt;
       if (x == Extent::Empty) continue;
       piece = p->field;
-      if (x == Extent::Bounded) u.corners.push_back(p->corners);
+      if (x == Extent::Bounded) {
+        u.halfSpaces.push_back(t);
+        u.corners.push_back(p->corners);
+      }
     }
     u.field = u.pieces++ == 0 ? *piece : max(u.field, *piece);
   }
@@ -320,6 +324,31 @@ std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e) {
 std::string PolytopeUnion::describe() const {
   const std::string what = std::to_string(pieces) + " convex pieces (" + std::to_string(boxes) + " of them boxes)";
   return exactInside ? "complement of a union of " + what : "union of " + what;
+}
+
+bool PolytopeUnion::connected() const {
+  const size_t n = halfSpaces.size();
+  if (n != pieces) return false;
+  // Two convex pieces meet iff their half-spaces together have a feasible vertex (both are
+  // bounded, so a non-empty intersection has one); the pieces are connected when the graph of
+  // meeting pairs is.
+  std::vector<size_t> root(n);
+  for (size_t i = 0; i < n; ++i) root[i] = i;
+  auto find = [&](size_t i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  size_t components = n;
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 1; j < n; ++j) {
+      if (find(i) == find(j)) continue;
+      Term both = halfSpaces[i];
+      both.insert(both.end(), halfSpaces[j].begin(), halfSpaces[j].end());
+      if (verticesOf(both, toleranceOf(both)).empty()) continue;
+      root[find(i)] = find(j);
+      --components;
+    }
+  return components == 1;
 }
 
 std::optional<PolytopeUnion> polytopeUnionOf(const Expr& e) {

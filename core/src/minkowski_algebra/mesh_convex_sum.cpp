@@ -537,11 +537,13 @@ bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, E
            double scaleB = 1) {
   bool aPoly = false, bPoly = false;
   std::optional<Mesh> b = closedMeshOf(bExpr, &bPoly);
-  // A union of polytopes (a difference of blocks, say) is its own cover (convex_polytope.h).
+  // A union of polytopes (a difference of blocks, say) is its own cover (convex_polytope.h);
+  // the construction's one translate A + b0 needs the tool connected.
   std::optional<PolytopeUnion> bUnion;
   if (!b && pieces && scaleB == 1 && (bUnion = polytopeUnionOf(bExpr)) && bUnion->corners.size() == bUnion->pieces &&
-      bUnion->pieces <= kMaxPieces)
+      bUnion->pieces <= kMaxPieces && bUnion->connected())
     b = Mesh{};
+  else bUnion.reset();
   if (!b) return false;
   std::optional<Mesh> a = closedMeshOf(aExpr, &aPoly);
   if (!a) return false;

@@ -40,10 +40,13 @@ std::optional<ConvexPolytope> convexPolytopeOf(const Expr& e);
 // Minkowski sums with a ball distribute over the union (Roerdink eq. 1) and take the offset path.
 struct PolytopeUnion {
   Expr field;
-  size_t pieces = 0, boxes = 0;                             // boxes: the pieces written in closed form
-  bool exactInside = false;                                 // polytopeComplementOf's (else exact outside)
-  std::vector<std::vector<std::array<double, 3>>> corners;  // each bounded piece's vertices
-  std::string describe() const;                             // "union of 2 convex pieces (2 of them boxes)"
+  size_t pieces = 0, boxes = 0;                                // boxes: the pieces written in closed form
+  bool exactInside = false;                                    // polytopeComplementOf's (else exact outside)
+  std::vector<std::vector<std::array<double, 3>>> corners;     // each bounded piece's vertices
+  std::vector<std::vector<std::array<double, 4>>> halfSpaces;  // and its n . X + d >= 0 (unit n)
+  // Whether the pieces form one connected set (each meets another, transitively).
+  bool connected() const;
+  std::string describe() const;  // "union of 2 convex pieces (2 of them boxes)"
 };
 
 // Nothing when e is not such a form, needs more than 64 terms or 64 planes in one, or is
