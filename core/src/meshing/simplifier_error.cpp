@@ -104,23 +104,30 @@ bool Simplifier::levels(std::vector<LevelQuery>& qs, int maxK, bool stopAbove, b
       // query that already failed this round stops.
       for (size_t k = from; k < to && !failed_[i];) {
         const size_t n = std::min(to - k, kPairsPerCall - lanes_);
-        double* const* in = inputs_.data();
         if (floatSigns_ && lanes_ == 0) laneLo_ = {INFINITY, INFINITY, INFINITY}, laneHi_ = {-INFINITY, -INFINITY, -INFINITY};
-        for (size_t j = 0; j < n; ++j, ++k) {
-          const double s = cells[k][0] + 1.0 / 3, t = cells[k][1] + 1.0 / 3;
-          const size_t lane = 2 * (lanes_ + j);
-          for (uint32_t c = 0; c < spatial; ++c) {
-            const double pc = q.a[c] + (u[c] * s + v[c] * t);  // a + s u + t v
-            in[c][lane] = pc - de[c], in[c][lane + 1] = pc + de[c];
+        const size_t lane0 = 2 * lanes_;
+        for (uint32_t c = 0; c < spatial; ++c) {  // coordinate by coordinate: the box in registers
+          double* const out = inputs_[c] + lane0;
+          const double ac = q.a[c], uc = u[c], vc = v[c], dc = de[c];
+          double lo = INFINITY, hi = -INFINITY;
+          for (size_t j = 0; j < n; ++j) {
+            const double s = cells[k + j][0] + 1.0 / 3, t = cells[k + j][1] + 1.0 / 3;
+            const double pc = ac + (uc * s + vc * t);  // a + s u + t v
+            out[2 * j] = pc - dc, out[2 * j + 1] = pc + dc;
+            lo = pc < lo ? pc : lo, hi = pc > hi ? pc : hi;
           }
-          if (floatSigns_)  // the float lanes and the box of the lanes (classify)
-            for (uint32_t c = 0; c < spatial; ++c) {
-              const double lo = std::min(in[c][lane], in[c][lane + 1]), hi = std::max(in[c][lane], in[c][lane + 1]);
-              laneLo_[c] = lo < laneLo_[c] ? lo : laneLo_[c], laneHi_[c] = hi > laneHi_[c] ? hi : laneHi_[c];
-              finputs_[c][lane] = narrow(in[c][lane]), finputs_[c][lane + 1] = narrow(in[c][lane + 1]);
-            }
-          laneQuery_[lanes_ + j] = i;
+          if (floatSigns_) {  // the float lanes and their box (classify); rounding is monotone, so
+            // fl(lo - |dc|) and fl(hi + |dc|) hold every fl(pc -+ dc)
+            float* const fout = finputs_[c] + lane0;
+            if (lo - std::fabs(dc) >= -3.0e38 && hi + std::fabs(dc) <= 3.0e38)
+              for (size_t j = 0; j < 2 * n; ++j) fout[j] = float(out[j]);  // in range: vectorised
+            else
+              for (size_t j = 0; j < 2 * n; ++j) fout[j] = narrow(out[j]);
+            laneLo_[c] = std::min(laneLo_[c], lo - std::fabs(dc)), laneHi_[c] = std::max(laneHi_[c], hi + std::fabs(dc));
+          }
         }
+        for (size_t j = 0; j < n; ++j) laneQuery_[lanes_ + j] = i;
+        k += n;
         lanes_ += n;
         if (lanes_ == kPairsPerCall && crossed() && stopAbove && endsAbove(qs, maxK)) return false;
       }
