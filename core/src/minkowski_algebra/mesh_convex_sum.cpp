@@ -7,8 +7,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -533,8 +535,8 @@ constexpr size_t kMaxPieces = 64;
 
 // pieces: a B that is not convex may be covered by convex pieces (convex_cover.h), each of which
 // adds a copy of A's cells, so the callers try the convex forms first.
-bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, Expr* out, double scaleA = 1,
-           double scaleB = 1) {
+bool construct(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, Expr* out, double scaleA,
+               double scaleB) {
   bool aPoly = false, bPoly = false;
   std::optional<Mesh> b = closedMeshOf(bExpr, &bPoly);
   // A union of polytopes (a difference of blocks, say) is its own cover (convex_polytope.h);
@@ -604,6 +606,49 @@ bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, E
   t.errorBound = field->setErrorBound();
   registerExact(*out, t);
   return true;
+}
+
+// A process compiles one model several times (the CLI for its bounds and its report, an
+// in-process run for itself), and constructing the field (cells, lattice lists, pruned pieces)
+// costs seconds for a large mesh: the results, failures too, are kept for the last few operand
+// pairs. Operands are hash-consed (a mesh read again is the same node while one is alive), and
+// an entry holds its operands, so the same model finds its entry.
+struct BuildKey {
+  const Node *a, *b;
+  bool difference, pieces;
+  double scaleA, scaleB;
+  bool operator==(const BuildKey& o) const {
+    return a == o.a && b == o.b && difference == o.difference && pieces == o.pieces && scaleA == o.scaleA &&
+           scaleB == o.scaleB;
+  }
+};
+struct BuildEntry {
+  BuildKey key;
+  Expr a, b;  // keep the operands' nodes alive (and so the key's pointers unique)
+  std::optional<Expr> result;
+};
+std::mutex gBuildMutex;
+std::deque<BuildEntry> gBuilt;  // most recent first
+constexpr size_t kBuildsKept = 8;
+
+bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, Expr* out, double scaleA = 1,
+           double scaleB = 1) {
+  const BuildKey key{&aExpr.node(), &bExpr.node(), difference, pieces, scaleA, scaleB};
+  {
+    std::lock_guard<std::mutex> lock(gBuildMutex);
+    for (const BuildEntry& e : gBuilt)
+      if (e.key == key) {
+        if (e.result) *out = *e.result;
+        return e.result.has_value();
+      }
+  }
+  Expr r;
+  const bool ok = construct(aExpr, bExpr, difference, pieces, &r, scaleA, scaleB);
+  std::lock_guard<std::mutex> lock(gBuildMutex);
+  gBuilt.push_front(BuildEntry{key, aExpr, bExpr, ok ? std::optional<Expr>(r) : std::nullopt});
+  if (gBuilt.size() > kBuildsKept) gBuilt.pop_back();
+  if (ok) *out = r;
+  return ok;
 }
 
 }  // namespace
