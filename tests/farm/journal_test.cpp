@@ -227,7 +227,8 @@ TEST(Journal, RecordsAddedInABatchAreTheRecordsAddedOneByOne) {
     payloads.push_back(i % 97 == 5 ? std::string() : std::string(100 + (i * 37) % 3000, char('a' + i % 26)));
   std::vector<Journal::Record> records;
   for (size_t i = 0; i < payloads.size(); ++i)
-    records.push_back({i, payloads[i].data(), payloads[i].size(), frep::farm::crc32Of(payloads[i].data(), payloads[i].size()), 0});
+    records.push_back(
+        {i, payloads[i].data(), payloads[i].size(), frep::farm::crc32Of(payloads[i].data(), payloads[i].size()), 0});
   {
     Journal one(single, 42, false, nullptr);
     for (size_t i = 0; i < payloads.size(); ++i) one.append(i, payloads[i]);
@@ -243,7 +244,8 @@ TEST(Journal, RecordsAddedInABatchAreTheRecordsAddedOneByOne) {
   EXPECT_TRUE(readAll(single) == readAll(batched));
   {
     Journal j(batched, 42, true, [](uint64_t, const std::string&) {});
-    Journal::Record more[2] = {{5000, "x", 1, frep::farm::crc32Of("x", 1), 0}, {5001, "yz", 2, frep::farm::crc32Of("yz", 2), 0}};
+    Journal::Record more[2] = {{5000, "x", 1, frep::farm::crc32Of("x", 1), 0},
+                               {5001, "yz", 2, frep::farm::crc32Of("yz", 2), 0}};
     j.addAll(more, 2);
   }
   size_t n = 0;
