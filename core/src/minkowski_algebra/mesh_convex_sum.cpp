@@ -628,7 +628,8 @@ struct BuildEntry {
   std::optional<Expr> result;
 };
 std::mutex gBuildMutex;
-std::deque<BuildEntry> gBuilt;  // most recent first
+// Most recent first; never destroyed (its nodes outliving the intern table at exit would crash).
+std::deque<BuildEntry>& gBuilt = *new std::deque<BuildEntry>;
 constexpr size_t kBuildsKept = 8;
 
 bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, Expr* out, double scaleA = 1,

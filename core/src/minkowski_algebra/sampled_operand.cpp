@@ -2,6 +2,8 @@
 #include "frep/minkowski_algebra/sampled_operand.h"
 
 #include <algorithm>
+#include <deque>
+#include <mutex>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -12,8 +14,9 @@
 
 namespace frep::minkowski {
 
-std::optional<SampledOperand> sampleOperand(const Expr& a, const Bounds& box, int res, const std::string& name) {
-  if (res < 8 || res > 1024) throw std::invalid_argument("the sampling grid must have 8 to 1024 points a side");
+namespace {
+
+std::optional<SampledOperand> sample(const Expr& a, const Bounds& box, int res, const std::string& name) {
   if (box.lo.size() < 3 || box.hi.size() < 3) return std::nullopt;
   std::array<double, 3> lo, hi;
   double extent = 0;
@@ -42,13 +45,45 @@ std::optional<SampledOperand> sampleOperand(const Expr& a, const Bounds& box, in
   tris.reserve(3 * m.triangles.size());
   for (const auto& t : m.triangles) tris.insert(tris.end(), t.begin(), t.end());
   char what[200];
-  std::snprintf(what, sizeof what, "%s sampled on %d^3 points (%zu triangles, within %.3g of its surface)", name.c_str(),
-                res, out.triangles, out.errorBound);
+  std::snprintf(what, sizeof what, "%s sampled on %d^3 points (%zu triangles, within %.3g of its surface)",
+                name.c_str(), res, out.triangles, out.errorBound);
   auto field = std::make_shared<MeshField>(std::move(xyz), std::move(tris), what);
   if (!field->check().closed()) return std::nullopt;
   field->setSetErrorBound(out.errorBound);
   out.field = fieldExpr(field, Expr::x(0), Expr::x(1), Expr::x(2));
   return out;
+}
+
+// A process compiles one model several times (the CLI, the report, an in-process run), and
+// meshing the operand is the costly part: the last few results are kept, each with its operand
+// (hash-consed: the same model's operand is the same node while it lives).
+struct Sampled {
+  Expr a;
+  std::vector<double> lo, hi;
+  int res;
+  std::string name;
+  std::optional<SampledOperand> result;
+};
+std::mutex gMutex;
+// Most recent first; never destroyed (its nodes outliving the intern table at exit would crash).
+std::deque<Sampled>& gSampled = *new std::deque<Sampled>;
+constexpr size_t kKept = 4;
+
+}  // namespace
+
+std::optional<SampledOperand> sampleOperand(const Expr& a, const Bounds& box, int res, const std::string& name) {
+  if (res < 8 || res > 1024) throw std::invalid_argument("the sampling grid must have 8 to 1024 points a side");
+  {
+    std::lock_guard<std::mutex> lock(gMutex);
+    for (const Sampled& s : gSampled)
+      if (&s.a.node() == &a.node() && s.lo == box.lo && s.hi == box.hi && s.res == res && s.name == name)
+        return s.result;
+  }
+  std::optional<SampledOperand> r = sample(a, box, res, name);
+  std::lock_guard<std::mutex> lock(gMutex);
+  gSampled.push_front(Sampled{a, box.lo, box.hi, res, name, r});
+  if (gSampled.size() > kKept) gSampled.pop_back();
+  return r;
 }
 
 }  // namespace frep::minkowski
