@@ -114,6 +114,9 @@ void LeaseTable::drop(const std::string& rid, Departure how, LeaseTime now) {
 }
 
 size_t LeaseTable::expire(LeaseTime now) {
+  // After a stall, a hello sent during it may be read only now (ZeroMQ's I/O thread was stopped
+  // too) and adopted with a fresh window while its worker, given up on that connection, sleeps.
+  if (now <= stallGraceUntil_) return 0;
   std::vector<std::string> dead;
   for (auto& [rid, p] : peers_)
     if (now > p.expiry) dead.push_back(rid);
@@ -136,7 +139,8 @@ LeaseClock::duration LeaseTable::turn(LeaseTime last, LeaseTime now) {
   // A worker's backoff after a silence of `gap` is at most gap + the first one (the earlier ones
   // and their windows add up to the current one minus the first), capped.
   const LeaseClock::duration sleep = std::min<LeaseClock::duration>(gap + kReconnectFirstBackoff, kReconnectMaxBackoff);
-  for (auto& [rid, p] : peers_) p.expiry = std::max(p.expiry, now + sleep + policy_.liveWindow);
+  stallGraceUntil_ = std::max(stallGraceUntil_, now + sleep + policy_.liveWindow);
+  for (auto& [rid, p] : peers_) p.expiry = std::max(p.expiry, stallGraceUntil_);
   for (uint64_t id : leased_) bricks_[id].firstLease += gap;
   return gap;
 }

@@ -158,6 +158,25 @@ TEST(LeaseTable, HeardPeersStayAliveAndAStalledMasterCountsNoOneDead) {
   EXPECT_EQ(f.table.expire(f.now), 1u);
 }
 
+// A hello sent while the master was stopped is read only after the stall is seen (ZeroMQ's I/O
+// thread was stopped too): its peer, joined with a fresh window, may be asleep in its backoff
+// (the worker gave up on that connection), so it too has the stall's grace.
+TEST(LeaseTable, APeerThatJoinsJustAfterAStallHasItsGrace) {
+  LeasePolicy policy;
+  policy.liveWindow = milliseconds(1000);
+  Fixture f(2, policy);
+  f.join("a");
+  const LeaseTime last = f.now;
+  f.now += seconds(3);
+  EXPECT_EQ(f.table.turn(last, f.now), seconds(3));
+  f.now += milliseconds(4);
+  f.join("stale");              // window until now + 1 s
+  f.now += milliseconds(2000);  // silent past its own window: its worker sleeps 2 s
+  EXPECT_EQ(f.table.expire(f.now), 0u);
+  f.now += milliseconds(3000);  // past the grace: 3 s + the first backoff + a window after the wake
+  EXPECT_EQ(f.table.expire(f.now), 2u);
+}
+
 TEST(LeaseTable, ASuspectGoesAloneToAFreshPeerAndFreshKillersPoisonIt) {
   LeasePolicy policy;
   policy.maxAttempts = 3;

@@ -129,9 +129,10 @@ class LeaseTable {
   // Drops the peers silent past their window (counted dead); returns how many.
   size_t expire(LeaseTime now);
   // The loop's turn at `now` after the one at `last`: a gap longer than the live window is the
-  // master's own stall, not its peers' silence: every lease timer moves on by it, and every peer
-  // has until the end of the reconnect backoff it may be sleeping in (as long as the gap, up to
-  // kReconnectMaxBackoff) plus a window. Returns the gap if so (counted), else zero.
+  // master's own stall, not its peers' silence: every lease timer moves on by it, and no peer,
+  // nor one that comes back in the meantime, is counted dead until the end of the reconnect
+  // backoff it may be sleeping in (as long as the gap, up to kReconnectMaxBackoff) plus a
+  // window. Returns the gap if so (counted), else zero.
   LeaseClock::duration turn(LeaseTime last, LeaseTime now);
 
   // ---- leases ----
@@ -194,6 +195,9 @@ class LeaseTable {
   size_t medianOf_ = 0;
   size_t done_ = 0, poisoned_ = 0;
   std::optional<LeaseTime> firstJoin_;
+  // After the master's own stall, nobody is counted dead before this (turn): a worker's stale
+  // hello may be read only after the stall is seen, then the worker sleeps its backoff.
+  LeaseTime stallGraceUntil_{};
   LeaseStats stats_;
 };
 
