@@ -140,7 +140,6 @@ LeaseClock::duration LeaseTable::turn(LeaseTime last, LeaseTime now) {
   // and their windows add up to the current one minus the first), capped.
   const LeaseClock::duration sleep = std::min<LeaseClock::duration>(gap + kReconnectFirstBackoff, kReconnectMaxBackoff);
   stallGraceUntil_ = std::max(stallGraceUntil_, now + sleep + policy_.liveWindow);
-  for (auto& [rid, p] : peers_) p.expiry = std::max(p.expiry, stallGraceUntil_);
   for (uint64_t id : leased_) bricks_[id].firstLease += gap;
   return gap;
 }
