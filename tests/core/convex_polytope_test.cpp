@@ -37,6 +37,19 @@ double eval(const Expr& e, double x, double y, double z) {
   return pe.eval(*t, p);
 }
 
+// A ball of radius r at the origin, registered as the basic-set sphere frBall / hfSphere make.
+Expr registeredBall(double r) {
+  minkowski::Shape s;
+  s.kind = minkowski::ShapeKind::Sphere;
+  s.size[0] = r;
+  const Expr ball = r * r - X() * X() - Y() * Y() - Z() * Z();
+  minkowski::ExactTerm t;
+  t.sum = minkowski::sumOf(s);
+  t.pieces = 1;
+  minkowski::registerExact(ball, t);
+  return ball;
+}
+
 }  // namespace
 
 TEST(ConvexPolytope, TetrahedronIsRecognisedWithItsExactDistance) {
@@ -85,14 +98,7 @@ TEST(ConvexPolytope, SumWithABallIsTheOffsetOfTheExactDistance) {
   // tetrahedron ⊕ ball r: r - dist(X, T), exact at a point beyond a vertex (where the min of
   // the plane distances would be wrong: it is the largest plane distance, not the vertex's).
   const double h = 0.5, r = 0.2;
-  minkowski::Shape s;
-  s.kind = minkowski::ShapeKind::Sphere;
-  s.size[0] = r;
-  const Expr ball = r * r - X() * X() - Y() * Y() - Z() * Z();
-  minkowski::ExactTerm t;
-  t.sum = minkowski::sumOf(s);
-  t.pieces = 1;
-  minkowski::registerExact(ball, t);
+  const Expr ball = registeredBall(r);
   Expr sum;
   ASSERT_TRUE(minkowski::distanceBallSum(tetrahedron(h), ball, 3, &sum));
   const double far = 0.25;  // beyond the vertex (-h, -h, -h) by `far` along each axis
@@ -249,14 +255,7 @@ TEST(PolytopeUnion, SumAndErosionWithABallTakeTheOffsetPath) {
   const double lo2[3] = {-0.2, -0.2, -1}, hi2[3] = {1.3, 1.3, 1};
   const Expr slab = min(block(lo1, hi1), -block(lo2, hi2));
   const double r = 0.3;
-  minkowski::Shape s;
-  s.kind = minkowski::ShapeKind::Sphere;
-  s.size[0] = r;
-  const Expr ball = r * r - X() * X() - Y() * Y() - Z() * Z();
-  minkowski::ExactTerm t;
-  t.sum = minkowski::sumOf(s);
-  t.pieces = 1;
-  minkowski::registerExact(ball, t);
+  const Expr ball = registeredBall(r);
   Expr sum;
   ASSERT_TRUE(minkowski::distanceBallSum(slab, ball, 3, &sum));
   EXPECT_NEAR(eval(sum, 0.3, 0.4, 0), r - 0.5, 1e-12);  // in the notch, 0.5 from its face x = -0.2
