@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <cstring>
 #include <deque>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -21,6 +20,7 @@
 #include "frep/minkowski_algebra/convex_polytope.h"
 #include "frep/minkowski_algebra/registry.h"
 #include "frep/minkowski_algebra/star_pieces.h"
+#include "convolution_pieces.h"
 #include "mesh_operands.h"
 
 namespace frep::minkowski {
@@ -28,36 +28,6 @@ namespace {
 
 using namespace vec3;
 using namespace mesh_operands;
-
-// The convex hull of points on a plane with unit normal u, fanned into triangles (emit(p, q, r));
-// nothing when they span no area (the face of a sum in a direction that is not a facet's).
-template <typename Emit>
-void facetTriangles(const V3& u, const std::vector<V3>& pts, double tol, Emit&& emit) {
-  if (pts.size() < 3) return;
-  const V3 e1 = std::abs(u[0]) < 0.9 ? cross(u, V3{1, 0, 0}) : cross(u, V3{0, 1, 0});
-  const double l1 = norm(e1);
-  const V3 a{e1[0] / l1, e1[1] / l1, e1[2] / l1}, b = cross(u, a);
-  std::vector<std::pair<std::array<double, 2>, size_t>> q;
-  for (size_t i = 0; i < pts.size(); ++i) q.push_back({{dot(a, pts[i]), dot(b, pts[i])}, i});
-  std::sort(q.begin(), q.end());
-  auto turn = [](const std::array<double, 2>& o, const std::array<double, 2>& p, const std::array<double, 2>& r) {
-    return (p[0] - o[0]) * (r[1] - o[1]) - (p[1] - o[1]) * (r[0] - o[0]);
-  };
-  // Andrew's monotone chain; turns within tol * extent count as straight.
-  std::vector<size_t> hull(2 * q.size());
-  size_t k = 0;
-  const double eps = tol * std::max(1.0, std::abs(q.back().first[0] - q.front().first[0]));
-  for (size_t i = 0; i < q.size(); ++i) {
-    while (k >= 2 && turn(q[hull[k - 2]].first, q[hull[k - 1]].first, q[i].first) <= eps) --k;
-    hull[k++] = i;
-  }
-  for (size_t i = q.size() - 1, lower = k + 1; i-- > 0;) {
-    while (k >= lower && turn(q[hull[k - 2]].first, q[hull[k - 1]].first, q[i].first) <= eps) --k;
-    hull[k++] = i;
-  }
-  if (k < 4) return;  // fewer than three distinct corners (the chain repeats the first)
-  for (size_t i = 1; i + 2 < k; ++i) emit(pts[q[hull[0]].second], pts[q[hull[i]].second], pts[q[hull[i + 1]].second]);
-}
 
 // See mesh_convex_sum.h. complement: the field of A^c ⊕ B (for the difference, B = -B).
 class MeshConvexSumField : public DistanceField {
@@ -104,7 +74,7 @@ class MeshConvexSumField : public DistanceField {
     lattice_ = CellLattice::over(lo, hi, 128, 0);
     cellBoxes_ = std::move(boxes);
     cellClasses_ = lattice_.size * std::sqrt(3.0) < 1.9 * memoRadius_;
-    for (size_t i = 0; i < bs.size(); ++i) convolutionPieces(a, bs[i], pieceDirs[i], tol, tri);
+    for (size_t i = 0; i < bs.size(); ++i) convolutionPieces(a, bs[i], pieceDirs[i], complement_, tol, tri);
     pruneInterior(soup, soupTris, tol);
     pieces_ = soupTris.size() / 3;
     soup_ = std::make_shared<MeshField>(std::move(soup), std::move(soupTris), "boundary pieces");
@@ -153,20 +123,28 @@ class MeshConvexSumField : public DistanceField {
       for (const V3& k : bNormals) known = known || dot(k, n) > 1 - 1e-12;
       if (!known) bNormals.push_back(n);
     }
+    // A B with no facets is a segment or a point (a path's piece); one with facets has volume.
+    const bool flatB = bNormals.empty();
     std::vector<V3> normals;
     for (const auto& t : a.t) {
       const V3 tv[3] = {a.v[t[0]], a.v[t[1]], a.v[t[2]]};
-      // The candidate facet normals of T ⊕ B, each once.
+      // The candidate facet normals of T ⊕ B, each once: two within 1e-12 are one (rounding), but
+      // not two that are merely close, such as the facets of a prism T ⊕ d a hair off T's plane
+      // and ±n_T (merged, the thin slanted prism would read as the flat box over its shadow).
       normals.clear();
       auto candidate = [&](V3 u) {
         const double l = norm(u);
         if (!(l > 0)) return;
         for (double& x : u) x /= l;
         for (const V3& k : normals)
-          if (dot(k, u) > 1 - 1e-12) return;
+          if (dot(sub(k, u), sub(k, u)) < 1e-24) return;
         normals.push_back(u);
       };
       const V3 n = cross(sub(tv[1], tv[0]), sub(tv[2], tv[0]));
+      const double ln = norm(n);
+      // A flat B (a segment of a path, path_sweep.h): a T of no area adds no cell (its points lie
+      // on its neighbours, and no finite set of planes bounds a segment ⊕ segment's points).
+      if (flatB && !(ln > 0)) continue;
       candidate(n);
       candidate({-n[0], -n[1], -n[2]});
       for (const V3& u : bNormals) candidate(u);
@@ -178,6 +156,22 @@ class MeshConvexSumField : public DistanceField {
           candidate(u);
           candidate({-u[0], -u[1], -u[2]});
         }
+      }
+      // A flat B parallel to T's plane makes T ⊕ B flat too, a polygon whose edges are T's and B's:
+      // its planes are ±n_T and the in-plane normals n_T × e of those edges, which the products
+      // above miss (there they are ±n_T). Supporting planes are exact wherever they point, so they
+      // are added whenever B lies within 1e-5 of T's plane (a prism that thin has them all,
+      // redundant or not), so no B in T's plane up to rounding goes without them.
+      bool parallel = flatB;
+      for (const V3& d : bDirs) parallel = parallel && std::abs(dot(n, d)) < 1e-5 * ln;
+      if (parallel) {
+        auto inPlane = [&](const V3& e) {
+          const V3 u = cross(n, e);
+          candidate(u);
+          candidate({-u[0], -u[1], -u[2]});
+        };
+        for (int k = 0; k < 3; ++k) inPlane(sub(tv[(k + 1) % 3], tv[k]));
+        for (const V3& d : bDirs) inPlane(d);
       }
       const uint32_t first = uint32_t(planes_.size());
       for (const V3& u : normals) {
@@ -255,97 +249,6 @@ class MeshConvexSumField : public DistanceField {
   std::shared_ptr<const MeshField> soup_;
   size_t pieces_ = 0;
   uint64_t hash_ = 0;
-
-  // The pieces a + b of ∂A ⊕ ∂B with a common outward normal u (the convolution of the two
-  // boundaries), which cover the boundary of A ⊕ B: a boundary point x = a + b has x − B outside
-  // A touching it at a, so b ∈ F_B(u) for an outward normal u of A at a. On a face's interior u is
-  // its normal: T + F_B(n_T). On a convex edge u runs over the arc between its faces' normals: the
-  // parallelograms e ⊕ e_B of the B edges whose normal arcs meet it. A reflex edge or vertex adds
-  // nothing (x − B lies in the convex outer wedge, so b ∈ F_B of each incident face: the face pieces
-  // hold x). A convex vertex: v + the B facets whose normals lie in its normal cone; a saddle
-  // vertex: v + every B facet (a superset, as every piece lies in A ⊕ B).
-  template <typename Tri>
-  void convolutionPieces(const Mesh& a, const Convex& b, const std::vector<V3>& bDirs, double tol, Tri&& tri) const {
-    const double sigma = complement_ ? -1 : 1;  // A^c's outward normals are A's reversed
-    std::vector<V3> N(a.t.size());
-    for (size_t i = 0; i < a.t.size(); ++i) {
-      const auto& t = a.t[i];
-      V3 n = cross(sub(a.v[t[1]], a.v[t[0]]), sub(a.v[t[2]], a.v[t[0]]));
-      const double l = norm(n);
-      N[i] = l > 0 ? V3{sigma * n[0] / l, sigma * n[1] / l, sigma * n[2] / l} : V3{0, 0, 0};
-    }
-    auto supportFace = [&](const V3& u, std::vector<V3>& out) {
-      out.clear();
-      const double h = b.support(u);
-      for (const V3& q : b.v)
-        if (dot(u, q) >= h - tol) out.push_back(q);
-    };
-    std::vector<V3> fb, pts;
-    for (size_t i = 0; i < a.t.size(); ++i) {  // faces: T + F_B(N_T)
-      if (N[i] == V3{0, 0, 0}) continue;
-      supportFace(N[i], fb);
-      pts.clear();
-      for (uint32_t k : a.t[i])
-        for (const V3& q : fb) pts.push_back(add(a.v[k], q));
-      facetTriangles(N[i], pts, tol, tri);
-    }
-    // Edges: the two triangles of each (closed, consistently oriented mesh) and their far vertices.
-    std::map<std::pair<uint32_t, uint32_t>, std::pair<size_t, uint32_t>> firstSide;
-    std::vector<std::vector<uint32_t>> neighbours(a.v.size()), incident(a.v.size());
-    for (size_t i = 0; i < a.t.size(); ++i) {
-      const auto& t = a.t[i];
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t p = t[size_t(k)], q = t[size_t((k + 1) % 3)], far = t[size_t((k + 2) % 3)];
-        incident[p].push_back(uint32_t(i));
-        neighbours[p].push_back(q);
-        auto key = std::make_pair(std::min(p, q), std::max(p, q));
-        auto it = firstSide.find(key);
-        if (it == firstSide.end()) {
-          firstSide.emplace(key, std::make_pair(i, far));
-          continue;
-        }
-        const size_t j = it->second.first;
-        const V3 &P = a.v[p], &Q = a.v[q], &w1 = a.v[it->second.second], &w2 = a.v[far];
-        if (dot(N[j], sub(w2, P)) > tol) continue;  // reflex: the face pieces cover it
-        const V3 e = sub(Q, P);
-        for (const V3& d : bDirs) {
-          V3 u = cross(e, d);
-          const double l = norm(u);
-          if (!(l > 1e-12 * norm(e))) continue;
-          for (double sgn : {1.0, -1.0}) {
-            const V3 us{sgn * u[0] / l, sgn * u[1] / l, sgn * u[2] / l};
-            if (dot(us, sub(w1, P)) > tol || dot(us, sub(w2, P)) > tol) continue;  // not in the edge's arc
-            const double hb = b.support(us);
-            for (const auto& eb : b.edges) {
-              const V3 &q0 = b.v[eb[0]], &q1 = b.v[eb[1]];
-              if (dot(us, q0) < hb - tol || dot(us, q1) < hb - tol) continue;
-              tri(add(P, q0), add(Q, q0), add(Q, q1));
-              tri(add(P, q0), add(Q, q1), add(P, q1));
-            }
-          }
-        }
-      }
-    }
-    // Vertices.
-    for (size_t v = 0; v < a.v.size(); ++v) {
-      if (incident[v].empty()) continue;
-      bool convex = true, concave = true;
-      for (uint32_t f : incident[v])
-        for (uint32_t w : neighbours[v]) {
-          const double h = dot(N[f], sub(a.v[w], a.v[v]));
-          convex = convex && h <= tol;
-          concave = concave && h >= -tol;
-        }
-      if (concave && !convex) continue;
-      for (size_t f = 0; f < b.faces.size(); ++f) {
-        const V3& u = b.faceN[f];
-        bool inCone = true;
-        if (convex)
-          for (uint32_t w : neighbours[v]) inCone = inCone && dot(u, sub(a.v[w], a.v[v])) <= tol;
-        if (inCone) tri(add(a.v[v], b.faces[f][0]), add(a.v[v], b.faces[f][1]), add(a.v[v], b.faces[f][2]));
-      }
-    }
-  }
 
   // Drops the pieces that lie in the interior of one convex T ⊕ B (all three corners strictly
   // inside it) or of A + b0 (a ball about the centroid holding the triangle inside A): they hold
@@ -530,8 +433,34 @@ thread_local MeshConvexSumField::SignMemo MeshConvexSumField::tSignMemo[MeshConv
 thread_local int MeshConvexSumField::tSignMemoNext = 0;
 thread_local MeshConvexSumField::ClassOfCell MeshConvexSumField::tClassOfCell[4096] = {};
 
-// A tool cut into more pieces than this is left to the search: each piece adds a copy of A's cells.
+// A tool cut into more pieces than this is left to the search: each piece adds a copy of A's
+// cells; so is a path of more segments.
 constexpr size_t kMaxPieces = 64;
+
+// The field of A ⊕ B (difference: of A^c ⊕ B, the pieces of B already negated) for the closed
+// mesh a read from aExpr (scaled by scaleA) and B the union of the convex pieces bs, registered:
+// "<name> as the union of the mesh's translate and N boundary pieces of triangle ⊕ <kind> sums".
+Expr assemble(const Mesh& a, const Expr& aExpr, double scaleA, const std::vector<Convex>& bs, bool difference,
+              const std::string& name, const char* kind) {
+  std::vector<double> xyz;
+  for (const V3& p : a.v) xyz.insert(xyz.end(), p.begin(), p.end());
+  std::vector<uint32_t> tris;
+  for (const auto& t : a.t) tris.insert(tris.end(), t.begin(), t.end());
+  auto aField = std::make_shared<MeshField>(std::move(xyz), std::move(tris), a.what);
+  if (aExpr.op() == Op::Field) aField->setSetErrorBound(aExpr.node().fn->setErrorBound() * scaleA);
+  auto field = std::make_shared<MeshConvexSumField>(a, aField, bs, difference, name);
+  Expr out = fieldExpr(field, Expr::x(0), Expr::x(1), Expr::x(2));
+  ExactTerm t;
+  t.kind = ExactTerm::Kind::MeshPolytope;
+  t.operand = name + " as the union of the mesh's translate and " + std::to_string(field->pieces()) +
+              " boundary pieces of triangle ⊕ " + kind + " sums";
+  t.erosion = difference;
+  t.exactOutside = !difference;
+  t.exactInside = difference;
+  t.errorBound = field->setErrorBound();
+  registerExact(out, t);
+  return out;
+}
 
 // pieces: a B that is not convex may be covered by convex pieces (convex_cover.h), each of which
 // adds a copy of A's cells, so the callers try the convex forms first.
@@ -587,39 +516,49 @@ bool construct(const Expr& aExpr, const Expr& bExpr, bool difference, bool piece
         for (V3& p : f) p = {-p[0], -p[1], -p[2]};
       for (V3& n : cb.faceN) n = {-n[0], -n[1], -n[2]};
     }
-  std::vector<double> xyz;
-  for (const V3& p : a->v) xyz.insert(xyz.end(), p.begin(), p.end());
-  std::vector<uint32_t> tris;
-  for (const auto& t : a->t) tris.insert(tris.end(), t.begin(), t.end());
-  auto aField = std::make_shared<MeshField>(std::move(xyz), std::move(tris), a->what);
-  if (aExpr.op() == Op::Field) aField->setSetErrorBound(aExpr.node().fn->setErrorBound() * scaleA);
-  const std::string name = a->what + (difference ? " ⊖ " : " ⊕ ") + bWhat;
-  auto field = std::make_shared<MeshConvexSumField>(*a, aField, bs, difference, name);
-  *out = fieldExpr(field, Expr::x(0), Expr::x(1), Expr::x(2));
-  ExactTerm t;
-  t.kind = ExactTerm::Kind::MeshPolytope;
-  t.operand = name + " as the union of the mesh's translate and " + std::to_string(field->pieces()) +
-              " boundary pieces of triangle ⊕ polytope sums";
-  t.erosion = difference;
-  t.exactOutside = !difference;
-  t.exactInside = difference;
-  t.errorBound = field->setErrorBound();
-  registerExact(*out, t);
+  *out = assemble(*a, aExpr, scaleA, bs, difference, a->what + (difference ? " ⊖ " : " ⊕ ") + bWhat, "polytope");
+  return true;
+}
+
+// A ⊕ P for the polyline P through path: P is connected and the union of its segments, each a
+// convex piece with no facets (support max(u · p, u · q), one edge), so the construction above
+// applies as it is, the flat cells aside (addCells). Repeated points are dropped; a single point
+// is the segment [p, p] (A moved there).
+bool constructPath(const Expr& aExpr, const std::vector<V3>& path, Expr* out) {
+  bool aPoly = false;
+  std::optional<Mesh> a = closedMeshOf(aExpr, &aPoly);
+  if (!a || path.empty()) return false;
+  std::vector<V3> pts;
+  for (const V3& p : path)
+    if (pts.empty() || p != pts.back()) pts.push_back(p);
+  if (pts.size() == 1) pts.push_back(pts[0]);
+  if (pts.size() - 1 > kMaxPieces) return false;
+  std::vector<Convex> bs;
+  for (size_t i = 0; i + 1 < pts.size(); ++i) {
+    Convex c;
+    c.v = {pts[i], pts[i + 1]};
+    if (pts[i] != pts[i + 1]) c.edges.push_back({0, 1});
+    bs.push_back(std::move(c));
+  }
+  const std::string name = "sweep of " + a->what + " along a path of " + std::to_string(path.size()) + " points (" +
+                           std::to_string(bs.size()) + (bs.size() == 1 ? " segment)" : " segments)");
+  *out = assemble(*a, aExpr, 1, bs, false, name, "segment");
   return true;
 }
 
 // A process compiles one model several times (the CLI for its bounds and its report, an
 // in-process run for itself), and constructing the field (cells, lattice lists, pruned pieces)
 // costs seconds for a large mesh: the results, failures too, are kept for the last few operand
-// pairs. Operands are hash-consed (a mesh read again is the same node while one is alive), and
-// an entry holds its operands, so the same model finds its entry.
+// pairs (or operand and path). Operands are hash-consed (a mesh read again is the same node while
+// one is alive), and an entry holds its operands, so the same model finds its entry.
 struct BuildKey {
-  const Node *a, *b;
+  const Node *a, *b;  // b: none for a path
   bool difference, pieces;
   double scaleA, scaleB;
+  std::vector<V3> path;
   bool operator==(const BuildKey& o) const {
     return a == o.a && b == o.b && difference == o.difference && pieces == o.pieces && scaleA == o.scaleA &&
-           scaleB == o.scaleB;
+           scaleB == o.scaleB && path == o.path;
   }
 };
 struct BuildEntry {
@@ -632,9 +571,8 @@ std::mutex gBuildMutex;
 std::deque<BuildEntry>& gBuilt = *new std::deque<BuildEntry>;
 constexpr size_t kBuildsKept = 8;
 
-bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, Expr* out, double scaleA = 1,
-           double scaleB = 1) {
-  const BuildKey key{&aExpr.node(), &bExpr.node(), difference, pieces, scaleA, scaleB};
+template <typename Construct>
+bool cached(const BuildKey& key, const Expr& aExpr, const Expr& bExpr, Construct&& construct, Expr* out) {
   {
     std::lock_guard<std::mutex> lock(gBuildMutex);
     for (const BuildEntry& e : gBuilt)
@@ -644,12 +582,19 @@ bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, E
       }
   }
   Expr r;
-  const bool ok = construct(aExpr, bExpr, difference, pieces, &r, scaleA, scaleB);
+  const bool ok = construct(&r);
   std::lock_guard<std::mutex> lock(gBuildMutex);
   gBuilt.push_front(BuildEntry{key, aExpr, bExpr, ok ? std::optional<Expr>(r) : std::nullopt});
   if (gBuilt.size() > kBuildsKept) gBuilt.pop_back();
   if (ok) *out = r;
   return ok;
+}
+
+bool build(const Expr& aExpr, const Expr& bExpr, bool difference, bool pieces, Expr* out, double scaleA = 1,
+           double scaleB = 1) {
+  const BuildKey key{&aExpr.node(), &bExpr.node(), difference, pieces, scaleA, scaleB, {}};
+  return cached(
+      key, aExpr, bExpr, [&](Expr* r) { return construct(aExpr, bExpr, difference, pieces, r, scaleA, scaleB); }, out);
 }
 
 }  // namespace
@@ -671,6 +616,12 @@ bool meshConvexMorph(const Expr& a, const Expr& b, double t, Expr* out) {
 bool meshConvexDifference(const Expr& a, const Expr& b, uint32_t dims, Expr* out) {
   if (dims != 3) return false;
   return build(a, b, true, false, out) || build(a, b, true, true, out);
+}
+
+bool meshPathSum(const Expr& a, const std::vector<Vec3>& path, Expr* out) {
+  const BuildKey key{&a.node(), nullptr, false, false, 1, 1, path};
+  return cached(
+      key, a, Expr(), [&](Expr* r) { return constructPath(a, path, r); }, out);
 }
 
 }  // namespace frep::minkowski

@@ -13,6 +13,7 @@
 #include "frep/minkowski_algebra/convex_cover.h"
 #include "frep/minkowski_algebra/convex_polytope.h"
 #include "frep/minkowski_algebra/distance_offset.h"
+#include "frep/minkowski_algebra/mesh_convex_sum.h"
 #include "frep/minkowski_algebra/registry.h"
 
 namespace frep::minkowski {
@@ -94,7 +95,9 @@ bool translationSweep(const Expr& a, const std::vector<Vec3>& path, Expr* out) {
       corners = u->corners;
       what = u->describe();
     } else {
-      return false;
+      // A closed mesh (an STL part, a non-convex tool): the sum with the path's segments
+      // (mesh_convex_sum.h), registered there.
+      return meshPathSum(a, path, out);
     }
     if (segments.size() * corners.size() > kMaxPieces) return false;
     for (const auto& [p, q] : segments)

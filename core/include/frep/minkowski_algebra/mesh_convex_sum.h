@@ -25,9 +25,17 @@
 //
 // The difference with frMinkowskiDiff's convention, A ⊖ B = { x : x + B ⊆ A }, is the
 // complement of A^c ⊕ (−B): the same construction on the flipped mesh, negated (exact inside).
+//
+// B may also be flat: a segment [p, q], support h_B(u) = max(u · p, u · q), no facets, one edge
+// direction d. Then T ⊕ B is the prism of T along d (facet normals ±n_T and the edges' e × d),
+// or, when d lies in T's plane, the flat polygon of T at both ends, bounded within the plane by
+// the in-plane normals n_T × e and n_T × d. A path P = p_0 ... p_k is the connected union of such
+// segments, so a sweep by translation A ⊕ P = ∪_t (A + p(t)) is the same construction.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <vector>
 
 #include "frep/expressions/expr.h"
 
@@ -42,5 +50,9 @@ bool meshConvexSum(const Expr& a, const Expr& b, uint32_t dims, Expr* out);
 bool meshConvexMorph(const Expr& a, const Expr& b, double t, Expr* out);
 // A ⊖ B when A is a closed mesh (or a polytope) and B a convex polytope.
 bool meshConvexDifference(const Expr& a, const Expr& b, uint32_t dims, Expr* out);
+// A ⊕ P, the sweep of a closed mesh A (or a polytope) by translation along the polyline P through
+// path (at least one point, at most 64 segments): path_sweep.h's form for meshes. Registers the
+// result ("sweep of bunny.stl (3674 triangles) along a path of 4 points (3 segments) ...").
+bool meshPathSum(const Expr& a, const std::vector<std::array<double, 3>>& path, Expr* out);
 
 }  // namespace frep::minkowski

@@ -8,7 +8,9 @@
 // convex sets is convex, and its vertices are sums of vertices), a closed mesh with an exact
 // signed distance; a union of polytopes (convex_polytope.h) sweeps piece by piece. The field
 // is the max over the pieces: sign-exact, the exact signed distance outside the sweep, a lower
-// bound of the depth inside.
+// bound of the depth inside. A closed triangle mesh (an frMesh part, a non-convex tool) sweeps
+// as the sum of the mesh and the path (mesh_convex_sum.h with segments for B): its translate
+// united with the prisms T ⊕ [p_i, p_{i+1}] of its triangles, the same guarantees.
 #pragma once
 
 #include <vector>
@@ -20,7 +22,8 @@ namespace frep::minkowski {
 
 // The sweep of a over x[0..3) along path (at least one point), when a is a ball (frBall,
 // hfSphere), a convex polytope or a union of polytopes, with at most 256 pieces (segments x
-// the operand's pieces). Registers the result ("exact Minkowski sum sweep of ...").
+// the operand's pieces), or a closed mesh with at most 64 segments. Registers the result
+// ("exact Minkowski sum sweep of ...").
 bool translationSweep(const Expr& a, const std::vector<Vec3>& path, Expr* out);
 // The same with the path given as keyframe positions x, y, z one after the other (frSweepKeys),
 // when they are constants.
