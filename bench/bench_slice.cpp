@@ -5,6 +5,9 @@
 // for bit; then sign images in double and in float with the certified double fallback
 // (PlaneOptions::floatSigns), whose signs must all be the baseline's; each by the general path and
 // by dense tapes (PlaneOptions::denseTapes). Usage: bench_slice [model.hf] [side]
+// With --mask-runs N first: the dense float sign image (`frep slice --mask`) alone, N runs at
+// one thread and N at two, alternated, their median and best CPU and wall times, and that every
+// run's signs are the double sign path's.
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -73,7 +76,52 @@ std::vector<double> bruteForce(const TapePtr& tape, const PlaneLattice& l) {
 
 }  // namespace
 
+// Medians and minima of n samples.
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? NAN : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+int signClass(double f) { return std::isnan(f) ? 2 : f >= 0 ? 1 : 0; }
+
+// --mask-runs: the float sign image, runs alternated between one and two threads.
+int maskRuns(const TapePtr& tape, const PlaneLattice& l, int runs) {
+  PlaneOptions dbl;
+  dbl.signOnly = true;
+  dbl.threads = 1;
+  const std::vector<double> ref = evaluatePlane(tape, l, dbl);
+  std::vector<double> cpu[3], wall[3];
+  size_t wrong = 0;
+  PlaneStats st;
+  for (int i = 0; i < runs; ++i)
+    for (int threads : {1, 2}) {
+      PlaneOptions o;
+      o.signOnly = o.floatSigns = true;
+      o.threads = threads;
+      std::vector<double> got;
+      st = PlaneStats();
+      const Timing t = best(1, [&] { got = evaluatePlane(tape, l, o, &st); });
+      cpu[threads].push_back(t.cpuMs);
+      wall[threads].push_back(t.wallMs);
+      for (size_t k = 0; k < ref.size(); ++k) wrong += signClass(ref[k]) != signClass(got[k]);
+    }
+  for (int threads : {1, 2})
+    std::printf("float mask, dense, %d thr, %d runs: CPU ms median %.2f best %.2f; wall ms median %.2f best %.2f\n",
+                threads, runs, median(cpu[threads]), *std::min_element(cpu[threads].begin(), cpu[threads].end()),
+                median(wall[threads]), *std::min_element(wall[threads].begin(), wall[threads].end()));
+  std::printf("%.2fM interval instructions, %.2fM batch instructions in %llu batches, %llu pixels in double, "
+              "%llu in float; pixels of another sign than the double path's: %zu\n",
+              1e-6 * double(st.intervalInstrs), 1e-6 * double(st.tapeInstrs), (unsigned long long)st.tapeBatches,
+              (unsigned long long)st.doublePixels, (unsigned long long)st.floatPixels, wrong);
+  return wrong ? 1 : 0;
+}
+
 int main(int argc, char** argv) {
+  int maskRunCount = 0;
+  if (argc > 2 && std::strcmp(argv[1], "--mask-runs") == 0) {
+    maskRunCount = std::max(1, std::atoi(argv[2]));
+    argc -= 2, argv += 2;
+  }
   const std::string path = argc > 1 ? argv[1] : FREP_SHARED_DIR "/corpus/fidget/prospero.hf";
   const int side = argc > 2 ? std::atoi(argv[2]) : 1024;
   std::ifstream in(path);
@@ -94,6 +142,7 @@ int main(int argc, char** argv) {
   l.origin[0] = l.origin[1] = -1.0;
   l.step = 2.0 / double(side - 1);
   l.width = l.height = side;
+  if (maskRunCount) return maskRuns(tape, l, maskRunCount);
 
   std::vector<double> ref, fast, mask, fmask;
   const Timing tb = best(3, [&] { ref = bruteForce(tape, l); });
@@ -148,7 +197,7 @@ int main(int argc, char** argv) {
               (unsigned long long)floatStats.floatPixels, (unsigned long long)floatStats.doublePixels,
               (unsigned long long)floatStats.decidedPixels);
   // Sign classes of the image: NaN, f >= 0, f < 0.
-  auto cls = [](double f) { return std::isnan(f) ? 2 : f >= 0 ? 1 : 0; };
+  auto cls = signClass;
   size_t differ = 0, signs = 0, floatSigns = 0;
   for (size_t i = 0; i < ref.size(); ++i) {
     if (std::memcmp(&ref[i], &fast[i], sizeof(double)) != 0) ++differ;
