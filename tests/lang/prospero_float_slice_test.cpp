@@ -1,9 +1,11 @@
 // Prospero (Fidget's 7,866-op challenge, ../shared/corpus/fidget/prospero.hf) sliced at 1024^2 in
 // float with the certified double fallback (PlaneOptions::floatSigns): every pixel's sign class
-// is that of the double values, with one and two threads, and most pixels are certified in float.
+// is that of the double values, with one, two and TBB's default threads (the same bytes each
+// time), and most pixels are certified in float.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -38,7 +40,8 @@ TEST(ProsperoFloatSlice, SignImageIsTheDoublePathsAt1024) {
   l.step = 2.0 / 1023.0;
   l.width = l.height = 1024;
   const std::vector<double> values = evaluatePlane(tape, l);  // double, every evaluated pixel exact
-  for (int threads : {1, 2}) {
+  std::vector<double> first;  // the one-thread image, which every thread count must give byte for byte
+  for (int threads : {1, 2, 0}) {
     PlaneOptions o;
     o.signOnly = o.floatSigns = true;
     o.threads = threads;
@@ -49,6 +52,8 @@ TEST(ProsperoFloatSlice, SignImageIsTheDoublePathsAt1024) {
     EXPECT_EQ(wrong, 0u) << threads << " thread(s)";
     EXPECT_GT(st.floatPixels, 100 * st.doublePixels);  // the fallback stays rare
     EXPECT_EQ(st.floatPixels + st.doublePixels + st.decidedPixels, values.size());
+    if (first.empty()) first = f;
+    else EXPECT_EQ(std::memcmp(first.data(), f.data(), f.size() * sizeof(double)), 0) << threads << " thread(s)";
   }
 }
 

@@ -1,14 +1,16 @@
 // evaluatePlane on a DenseTape (plane_dense.h), in Fidget's shape: the image split in four by
-// four-box interval passes down to top tiles (the parallel grain, planned on one thread), each
-// tile's tape simplified from its parent's in one backward pass (DenseSimplifier) into a
-// per-depth buffer of its thread (no allocation once warm), split in four down to leaf tiles
-// of one batch, whose pixels are evaluated with the
+// four-box interval passes, each tile's tape simplified from its parent's in one backward pass
+// (DenseSimplifier); tiles above kTaskTile split in tasks (any thread, work stealing), smaller
+// ones on one thread into per-depth buffers of its worker (no allocation once warm), down to
+// leaf tiles of one batch, whose pixels are evaluated with the
 // leaf's short, densely numbered tape. Float leaves (signOnly + floatSigns) keep a pixel's float
 // value where it exceeds the certified bound over the leaf's box (FloatErrorBound) and recompute
 // the others in double on the same tape, so every sign is the double path's.
 #include "sampling/plane_dense.h"
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cmath>
@@ -17,22 +19,22 @@
 #include "frep/evaluators/dense_eval.h"
 #include "frep/evaluators/float_error.h"
 #include "frep/expressions/dense_tape.h"
-#include "sampling/parallel_chunks.h"
+#include "frep/interrupt/interrupter.h"
 
 namespace frep {
 namespace {
 
-// Top tiles (the parallel grain): the passes over the whole tape are per 256 x 256 pixels.
-constexpr int kTopTile = 256;
+// Tiles of at most kTaskTile x kTaskTile pixels are split on one thread (in its per-depth
+// buffers); larger ones split in tasks, each quadrant simplifying its own tape from its parent's
+// (Prospero 1024^2 on two threads: 16 tasks of 256^2 were up to 4x apart in time, 64 of 128^2
+// share the work evenly, and the root's and 512^2 tiles' simplifications run in parallel too).
+constexpr int kTaskTile = 128;
 // Leaves of at most 16 x 16 pixels, one batch (Prospero 1024^2, float signs: 8 x 8 and 32 x 32
 // measured slower, by more interval passes and simplifications or by longer batch tapes).
 constexpr int kLeafTile = 16;
 // Buffers per depth: the top tile's, then one per halving down to the leaves.
 constexpr int kMaxDepth = 16;
-static_assert((kTopTile >> (kMaxDepth - 2)) <= kLeafTile, "a depth's buffers for every halving");
-// The planner's deepest split: at most 4^6 tasks, each then up to 1/64 of the image's side (a
-// lattice would need sides of millions of pixels to outgrow the tasks' kMaxDepth buffers).
-constexpr int kPlanDepth = 6;
+static_assert((kTaskTile >> (kMaxDepth - 2)) <= kLeafTile, "a depth's buffers for every halving");
 
 struct Worker {
   DenseIntervalEvaluator interval;
@@ -84,37 +86,50 @@ class DensePlane {
   struct Rect {
     int c0, c1, r0, r1;  // pixels [c0, c1) x [r0, r1)
   };
-  // A tile of at most kTopTile (or a part the planner stopped at) with its simplified tape
-  // (the root's: rootTape).
-  struct Task {
-    Rect t;
-    DenseTape tape;
-    bool rootTape = false;
-  };
 
-  // The serial part, on one worker: the image split in four by four-box interval passes down
-  // to top tiles, each tile's tape simplified from its parent's, not from the root's (on
-  // Prospero 1024^2, one pass over the root and four over 512^2 tapes instead of sixteen
-  // single-box passes and simplifications of the root).
-  void plan(Worker& w, std::vector<Task>& tasks) {
-    const Rect all{0, l_.width, 0, l_.height};
-    if (isTop(all)) tasks.push_back(Task{all, DenseTape(), true});
-    else spread(w, all, root_, 0, tasks);
-  }
-  // A task, on any worker.
-  void run(Worker& w, const Task& task) {
-    const DenseTape& tape = task.rootTape ? root_ : task.tape;
-    if (isLeaf(task.t)) {
-      Interval* box = w.boxes[0].data();
-      setBox(box, task.t);
-      leaf(w, task.t.c0, task.t.c1, task.t.r0, task.t.r1, tape, box);
-    } else {
-      group(w, task.t, tape, 0);
+  // Tile p with its tape: split on this thread when it is at most a task tile, else its
+  // quadrants classified in one pass and each undecided one run as a task (through `spawn`)
+  // that simplifies its own tape from this one, then recurses.
+  template <typename Spawn>
+  void descend(Worker& w, const Rect& p, const DenseTape& tape, Spawn&& spawn) {
+    if (isTask(p)) {
+      if (isLeaf(p)) {
+        Interval* box = w.boxes[0].data();
+        setBox(box, p);
+        leaf(w, p.c0, p.c1, p.r0, p.r1, tape, box);
+      } else {
+        group(w, p, tape, 0);
+      }
+      return;
     }
+    Rect kids[4];
+    uint32_t decided[4];
+    Interval iv[4];
+    const int n = quadrants(w, p, tape, 0, kids, decided, iv);
+    // The choices outlive this worker's buffers: the tasks may run after it took other work.
+    const std::vector<uint8_t> choices(w.choices[1].begin(), w.choices[1].begin() + long(4 * tape.size()));
+    spawn([&](auto&& fork) {
+      for (int j = 0; j < n; ++j) {
+        if (decide(w, kids[j], iv[j], tape.size())) continue;
+        const Rect t = kids[j];
+        const bool simplify = decided[j] != 0;
+        fork([this, t, simplify, j, &tape, &choices, &spawn](Worker& own) {
+          if (!simplify) return descend(own, t, tape, spawn);
+          DenseTape sub;
+          own.simplifier.simplify(tape, choices.data() + j, sub, 4);
+          descend(own, t, sub, spawn);
+        });
+      }
+    });
+  }
+  // The whole image from the root's tape.
+  template <typename Spawn>
+  void run(Worker& w, Spawn&& spawn) {
+    descend(w, Rect{0, l_.width, 0, l_.height}, root_, spawn);
   }
 
  private:
-  bool isTop(const Rect& t) const { return t.c1 - t.c0 <= kTopTile && t.r1 - t.r0 <= kTopTile; }
+  bool isTask(const Rect& t) const { return t.c1 - t.c0 <= kTaskTile && t.r1 - t.r0 <= kTaskTile; }
   bool isLeaf(const Rect& t) const { return t.c1 - t.c0 <= leafSide_ && t.r1 - t.r0 <= leafSide_; }
   void setBox(Interval* b, const Rect& t) const {
     if (l_.u < root_.numVars) b[l_.u] = Interval(l_.colCoord(t.c0), l_.colCoord(t.c1 - 1));
@@ -165,20 +180,6 @@ class DensePlane {
     if (!decided) return &tape;
     w.simplifier.simplify(tape, w.choices[size_t(depth + 1)].data() + j, w.tapes[size_t(depth + 1)], 4);
     return &w.tapes[size_t(depth + 1)];
-  }
-
-  // plan's recursion: the quadrants of p that are top tiles (or at the depth limit) become tasks.
-  void spread(Worker& w, const Rect& p, const DenseTape& tape, int depth, std::vector<Task>& tasks) {
-    Rect kids[4];
-    uint32_t decided[4];
-    Interval iv[4];
-    const int n = quadrants(w, p, tape, depth, kids, decided, iv);
-    for (int j = 0; j < n; ++j) {
-      if (decide(w, kids[j], iv[j], tape.size())) continue;
-      const DenseTape* own = simplified(w, tape, depth, j, decided[j]);
-      if (isTop(kids[j]) || depth + 1 >= kPlanDepth) tasks.push_back(Task{kids[j], *own, false});
-      else spread(w, kids[j], *own, depth + 1, tasks);
-    }
   }
 
   // Each quadrant of tile p is filled (signOnly, decided), evaluated as a leaf, or split in
@@ -296,15 +297,41 @@ void evaluatePlaneDense(const TapePtr& tape, const PlaneLattice& l, const PlaneO
                         PlaneStats& stats) {
   DensePlane plane(tape, l, opt, out);
   tbb::enumerable_thread_specific<Worker> workers;
-  std::vector<DensePlane::Task> tasks;
-  Worker& planner = workers.local();
-  plane.prepare(planner);
-  plane.plan(planner, tasks);
-  parallelChunks(tasks.size(), 1, opt.threads, [&](size_t b, size_t e) {
+  const Interrupter* interrupt = currentInterrupter();
+  auto local = [&]() -> Worker& {
     Worker& w = workers.local();
     plane.prepare(w);
-    for (size_t t = b; t < e; ++t) plane.run(w, tasks[t]);
-  });
+    return w;
+  };
+  if (opt.threads == 1) {
+    // Serial: each quadrant's task runs at once, on this thread.
+    auto spawn = [&](auto&& body) {
+      body([&](auto&& task) {
+        if (interrupt) interrupt->check();
+        task(local());
+      });
+    };
+    plane.run(local(), spawn);
+  } else {
+    // A task group per split tile; a task may run on any thread, with that thread's worker.
+    auto spawn = [&](auto&& body) {
+      tbb::task_group g;
+      body([&](auto task) {
+        g.run([&, task] {
+          InterruptScope scope(interrupt);
+          if (interrupt) interrupt->check();
+          task(local());
+        });
+      });
+      g.wait();
+    };
+    if (opt.threads > 1) {
+      tbb::task_arena arena(opt.threads);
+      arena.execute([&] { plane.run(local(), spawn); });
+    } else {
+      plane.run(local(), spawn);
+    }
+  }
   for (const Worker& w : workers) {
     stats.pointEvals += w.stats.pointEvals;
     stats.intervalEvals += w.stats.intervalEvals;
