@@ -121,6 +121,74 @@ TEST(DenseTape, SimplifiedTapesGiveTheFullTapesBitsInTheirBox) {
   EXPECT_GT(decidedBoxes, 100u);
 }
 
+// simplify4 (the four boxes of one eval4 pass at once, each output in a register of its own)
+// keeps what simplify keeps, without its copies: the full tape's bits at points of each box, for
+// every subset of the boxes, and again on its own output over sub-boxes.
+TEST(DenseTape, FourBoxSimplificationsAreTheOneBoxOnes) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-2.0, 2.0), w(0.01, 0.8), t(0.0, 1.0);
+  size_t compared = 0;
+  for (int m = 0; m < 30; ++m) {
+    TapePtr tape = Tape::compile(arithmeticCsg(rng, 6), 3);
+    DenseTape root;
+    root.assign(*tape);
+    DenseIntervalEvaluator di;
+    di.bind(*tape);
+    DenseSimplifier four, one;
+    DenseBatchEvaluator<double> db;
+    db.bind(*tape);
+    BatchEvaluator<double> full;
+    full.reserve(*tape);
+    for (int k = 0; k < 10; ++k) {
+      // Four sibling boxes of a random box, then four of the first one's (its tape simplified).
+      Interval parent[3];
+      for (auto& b : parent) {
+        const double c = u(rng), h = w(rng);
+        b = Interval(c - h, c + h);
+      }
+      const DenseTape* tapeOf = &root;
+      DenseTape level[2][4];
+      for (int depth = 0; depth < 2; ++depth) {
+        Interval boxes[12];
+        for (int j = 0; j < 4; ++j) {
+          boxes[j * 3 + 0] = j & 1 ? Interval(parent[0].mid(), parent[0].hi) : Interval(parent[0].lo, parent[0].mid());
+          boxes[j * 3 + 1] = j & 2 ? Interval(parent[1].mid(), parent[1].hi) : Interval(parent[1].lo, parent[1].mid());
+          boxes[j * 3 + 2] = parent[2];
+        }
+        std::vector<uint8_t> choices(4 * tapeOf->size());
+        uint32_t decided[4];
+        Interval out[4];
+        di.eval4(*tapeOf, boxes, choices.data(), decided, out);
+        const unsigned wanted = depth == 0 ? 15u : unsigned(rng() % 16);
+        DenseTape* bufs[4] = {&level[depth][0], &level[depth][1], &level[depth][2], &level[depth][3]};
+        four.simplify4(*tapeOf, choices.data(), wanted, bufs);
+        for (int j = 0; j < 4; ++j) {
+          if (!((wanted >> j) & 1u)) continue;
+          DenseTape single;
+          one.simplify(*tapeOf, choices.data() + j, single, 4);
+          EXPECT_LE(level[depth][j].size(), single.size());
+          const size_t n = 64;
+          db.reserve(level[depth][j]);
+          for (uint32_t v = 0; v < 3; ++v)
+            for (size_t i = 0; i < n; ++i) {
+              const double p = boxes[j * 3 + v].lo + t(rng) * boxes[j * 3 + v].width();
+              db.in(v)[i] = p;
+              full.in(v)[i] = p;
+            }
+          const double* f = full.eval(*tape, n);
+          const double* g = db.eval(level[depth][j], n);
+          for (size_t i = 0; i < n; ++i)
+            ASSERT_EQ(bits(f[i]), bits(g[i])) << "model " << m << " box " << k << " depth " << depth;
+          ++compared;
+        }
+        for (int i = 0; i < 3; ++i) parent[i] = boxes[i];
+        tapeOf = &level[0][0];
+      }
+    }
+  }
+  EXPECT_GT(compared, 1000u);
+}
+
 TEST(DenseTape, SimplifiedTapeUsesFewRegisters) {
   // 64 spheres: near one of them the tape is that sphere, whatever register the root gave it.
   Expr e = Expr(1e9);

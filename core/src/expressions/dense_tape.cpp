@@ -7,6 +7,7 @@
 #include "frep/expressions/dense_tape.h"
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 
 namespace frep {
@@ -114,6 +115,91 @@ void DenseSimplifier::simplify(const DenseTape& parent, const uint8_t* choices, 
     choicesLeft += choice;
   }
   out.code.assign(dst, end);  // within its capacity once warm
+  out.numChoices = choicesLeft;
+  out.numRegs = next;
+  out.result = res;
+  out.numUniforms = parent.numUniforms;
+  out.numVars = parent.numVars;
+}
+
+// Liveness for four boxes at once, without a branch: live4_[r] holds one byte per box, 1 when a
+// later live instruction of that box reads register r (or r holds the result). Walking back, an
+// instruction is live for box j when its output's byte is; it clears that byte and sets its
+// operands' (a decided min/max only its kept operand's), and its index is appended to box j's
+// list, whose count advances by the live byte. These are the instructions simplify's backward
+// pass keeps ("not read again" drops the others), met in the same order.
+void DenseSimplifier::simplify4(const DenseTape& parent, const uint8_t* choices, unsigned wanted,
+                                DenseTape* const out[4]) {
+  const size_t size = parent.code.size();
+  if (live4_.size() < parent.numRegs) live4_.resize(parent.numRegs);
+  if (lists_.size() < 4 * size) lists_.resize(4 * size);
+  uint32_t* live = live4_.data();
+  std::fill(live + parent.firstTemp(), live + parent.numRegs, 0u);
+  uint32_t want = 0;
+  for (int j = 0; j < 4; ++j) want |= uint32_t((wanted >> j) & 1u) << (8 * j);
+  // A constant or var result reads no instruction (the bytes of constants and vars are set
+  // below too, and never read: no instruction writes them).
+  if (parent.result >= parent.firstTemp()) live[parent.result] = want;
+  uint32_t* lists[4];
+  for (size_t j = 0; j < 4; ++j) lists[j] = lists_.data() + j * size;
+  size_t n0 = 0, n1 = 0, n2 = 0, n3 = 0;
+  const DenseInstr* code = parent.code.data();
+  for (size_t i = size; i-- > 0;) {
+    const DenseInstr& ins = code[i];
+    const uint32_t l = live[ins.out];
+    live[ins.out] = 0;
+    uint32_t c;
+    std::memcpy(&c, choices + 4 * i, sizeof c);
+    const uint32_t isChoice = ins.op == Op::Min || ins.op == Op::Max ? 0x01010101u : 0u;
+    const uint32_t keepA = c & isChoice, keepB = (c >> 1) & isChoice;  // bytes of 1 (a) or 2 (b)
+    live[ins.a] |= l & ~keepB;
+    live[ins.b] |= l & ~keepA;  // (a unary op's b is its a)
+    lists[0][n0] = uint32_t(i), n0 += l & 1u;
+    lists[1][n1] = uint32_t(i), n1 += (l >> 8) & 1u;
+    lists[2][n2] = uint32_t(i), n2 += (l >> 16) & 1u;
+    lists[3][n3] = uint32_t(i), n3 += l >> 24;
+  }
+  const size_t counts[4] = {n0, n1, n2, n3};
+  for (size_t j = 0; j < 4; ++j)
+    if ((wanted >> j) & 1u) forward(parent, choices + j, lists[j], counts[j], *out[j]);
+}
+
+// The live instructions of one box in tape order (live[n - 1] first), each output in a new
+// temporary (static single assignment: no register is written twice), so a decided min/max
+// always hands its kept value's register on and no copy is ever needed, and no step waits for
+// a register allocation: every step is a select.
+void DenseSimplifier::forward(const DenseTape& parent, const uint8_t* choices, const uint32_t* live, size_t n,
+                              DenseTape& out) {
+  const uint32_t fixed = parent.firstTemp();
+  if (map_.size() < parent.numRegs) map_.resize(parent.numRegs);
+  uint32_t* map = map_.data();
+  // Constants and vars map to themselves, entered once as in simplify (a temporary's entry is
+  // always written before it is read).
+  for (uint32_t r = mapFixed_; r < fixed; ++r) map[r] = r;
+  mapFixed_ = fixed;
+  if (scratch_.size() < n + 1) scratch_.resize(n + 1);
+  DenseInstr* dst = scratch_.data();
+  uint32_t next = fixed, choicesLeft = 0;
+  const DenseInstr* code = parent.code.data();
+  for (size_t m = n; m-- > 0;) {
+    const size_t i = live[m];
+    const DenseInstr ins = code[i];
+    const uint32_t a = map[ins.a], b = map[ins.b];
+    const bool choice = ins.op == Op::Min || ins.op == Op::Max;
+    const uint8_t c = choice ? choices[4 * i] : uint8_t(0);
+    const bool decided = c != 0;
+    *dst = DenseInstr{ins.op, next, a, b};
+    dst += !decided;
+    map[ins.out] = decided ? (c == 1 ? a : b) : next;
+    next += !decided;
+    choicesLeft += choice & !decided;
+  }
+  uint32_t res = map[parent.result];
+  if (res < fixed) {  // the result always lives in a temporary
+    *dst++ = DenseInstr{Op::Copy, next, res, res};
+    res = next++;
+  }
+  out.code.assign(scratch_.data(), dst);
   out.numChoices = choicesLeft;
   out.numRegs = next;
   out.result = res;

@@ -42,8 +42,8 @@ struct Worker {
   DenseBatchEvaluator<float> fbatch;
   DenseBatchEvaluator<double> dbatch;
   FloatErrorBound error;
-  // Per depth: the tape of the tile being split, the choices and boxes of its quadrants.
-  std::vector<DenseTape> tapes = std::vector<DenseTape>(kMaxDepth);
+  // Per depth: the tapes, choices and boxes of the quadrants of the tile being split.
+  std::vector<DenseTape> tapes = std::vector<DenseTape>(4 * kMaxDepth);
   std::vector<std::vector<uint8_t>> choices = std::vector<std::vector<uint8_t>>(kMaxDepth);
   std::vector<std::vector<Interval>> boxes = std::vector<std::vector<Interval>>(kMaxDepth);
   std::vector<uint32_t> redo;
@@ -88,8 +88,8 @@ class DensePlane {
   };
 
   // Tile p with its tape: split on this thread when it is at most a task tile, else its
-  // quadrants classified in one pass and each undecided one run as a task (through `spawn`)
-  // that simplifies its own tape from this one, then recurses.
+  // quadrants classified in one pass, their tapes simplified, and each undecided one run as a
+  // task (through `spawn`) that recurses.
   template <typename Spawn>
   void descend(Worker& w, const Rect& p, const DenseTape& tape, Spawn&& spawn) {
     if (isTask(p)) {
@@ -106,19 +106,25 @@ class DensePlane {
     uint32_t decided[4];
     Interval iv[4];
     const int n = quadrants(w, p, tape, 0, kids, decided, iv);
-    // The choices outlive this worker's buffers: the tasks may run after it took other work.
-    const std::vector<uint8_t> choices(w.choices[1].begin(), w.choices[1].begin() + long(4 * tape.size()));
+    // The quadrants' tapes, simplified here in one simplify4 into tapes of this frame (the
+    // tasks may run on other threads, or on this one after it took other work).
+    DenseTape subs[4];
+    DenseTape* bufs[4] = {&subs[0], &subs[1], &subs[2], &subs[3]};
+    const DenseTape* own[4];
+    unsigned wanted = 0;
+    for (int j = 0; j < 4; ++j) {
+      own[j] = nullptr;
+      if (j >= n || decide(w, kids[j], iv[j], tape.size())) continue;
+      if (decided[j]) wanted |= 1u << j, own[j] = &subs[j];
+      else own[j] = &tape;
+    }
+    if (wanted) w.simplifier.simplify4(tape, w.choices[1].data(), wanted, bufs);
     spawn([&](auto&& fork) {
       for (int j = 0; j < n; ++j) {
-        if (decide(w, kids[j], iv[j], tape.size())) continue;
+        if (!own[j]) continue;
         const Rect t = kids[j];
-        const bool simplify = decided[j] != 0;
-        fork([this, t, simplify, j, &tape, &choices, &spawn](Worker& own) {
-          if (!simplify) return descend(own, t, tape, spawn);
-          DenseTape sub;
-          own.simplifier.simplify(tape, choices.data() + j, sub, 4);
-          descend(own, t, sub, spawn);
-        });
+        const DenseTape* sub = own[j];
+        fork([this, t, sub, &spawn](Worker& worker) { descend(worker, t, *sub, spawn); });
       }
     });
   }
@@ -174,12 +180,21 @@ class DensePlane {
     w.interval.eval4(tape, boxes, choices.data(), decided, iv);
     return n;
   }
-  // Quadrant j's tape: tape simplified by its choices into depth + 1's buffer, or tape itself
-  // when nothing was decided.
-  const DenseTape* simplified(Worker& w, const DenseTape& tape, int depth, int j, uint32_t decided) {
-    if (!decided) return &tape;
-    w.simplifier.simplify(tape, w.choices[size_t(depth + 1)].data() + j, w.tapes[size_t(depth + 1)], 4);
-    return &w.tapes[size_t(depth + 1)];
+  // The quadrants' tapes (own[j]; null for a quadrant whose sign is filled): tape simplified by
+  // each quadrant's choices into depth + 1's buffers in one simplify4, or tape itself where
+  // nothing was decided. Counts and fills the quadrants decide first.
+  void simplified(Worker& w, const DenseTape& tape, int depth, int n, const Rect* kids, const uint32_t* decided,
+                  const Interval* iv, const DenseTape** own) {
+    unsigned wanted = 0;
+    DenseTape* bufs[4];
+    for (int j = 0; j < 4; ++j) {
+      bufs[j] = &w.tapes[4 * size_t(depth + 1) + size_t(j)];
+      own[j] = nullptr;
+      if (j >= n || decide(w, kids[j], iv[j], tape.size())) continue;
+      if (decided[j]) wanted |= 1u << j, own[j] = bufs[j];
+      else own[j] = &tape;
+    }
+    if (wanted) w.simplifier.simplify4(tape, w.choices[size_t(depth + 1)].data(), wanted, bufs);
   }
 
   // Each quadrant of tile p is filled (signOnly, decided), evaluated as a leaf, or split in
@@ -190,12 +205,13 @@ class DensePlane {
     Interval iv[4];
     const int n = quadrants(w, p, tape, depth, kids, decided, iv);
     const Interval* boxes = w.boxes[size_t(depth + 1)].data();
+    const DenseTape* own[4];
+    simplified(w, tape, depth, n, kids, decided, iv, own);
     for (int j = 0; j < n; ++j) {
       const Rect& t = kids[j];
-      if (decide(w, t, iv[j], tape.size())) continue;
-      const DenseTape* own = simplified(w, tape, depth, j, decided[j]);
-      if (isLeaf(t)) leaf(w, t.c0, t.c1, t.r0, t.r1, *own, boxes + size_t(j) * nvb_);
-      else group(w, t, *own, depth + 1);
+      if (!own[j]) continue;
+      if (isLeaf(t)) leaf(w, t.c0, t.c1, t.r0, t.r1, *own[j], boxes + size_t(j) * nvb_);
+      else group(w, t, *own[j], depth + 1);
     }
   }
 

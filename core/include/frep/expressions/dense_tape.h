@@ -45,12 +45,26 @@ class DenseSimplifier {
   // The values are the parent's bit for bit: the same operations on the same operands.
   // choices[k * stride]: instruction k's (a stride of 4 reads one box of eval4's).
   void simplify(const DenseTape& parent, const uint8_t* choices, DenseTape& out, size_t stride = 1);
+  // The same for the four boxes of one eval4 pass (choices[4 k + j]: box j's choice at
+  // instruction k): *out[j] for each j set in `wanted` (bits 0-3) gets the instructions
+  // simplify(parent, choices + j, *out[j], 4) keeps, in the same order on the same operands
+  // (the same values, bit for bit), each in a register of its own and without the copies. One
+  // branch-free backward pass finds the live instructions of the four boxes at once, then one
+  // forward pass per box over them alone renames the registers, also without a branch.
+  void simplify4(const DenseTape& parent, const uint8_t* choices, unsigned wanted, DenseTape* const out[4]);
 
  private:
+  void forward(const DenseTape& parent, const uint8_t* choices, const uint32_t* live, size_t n, DenseTape& out);
   std::vector<uint32_t> bind_;  // parent register -> out register of its live value
   uint32_t boundFixed_ = 0;     // bind_[r] == r for r below it
   std::vector<uint32_t> free_;
   std::vector<DenseInstr> scratch_;  // the simplified code, written back to front
+  // simplify4: per parent register, byte j set when box j reads it later; per box, its live
+  // instructions (last first).
+  std::vector<uint32_t> live4_;
+  std::vector<uint32_t> lists_;
+  std::vector<uint32_t> map_;  // forward: parent register -> out register of its value
+  uint32_t mapFixed_ = 0;      // map_[r] == r for r below it
 };
 
 }  // namespace frep
