@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
+#include <vector>
 
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/expr.h"
@@ -271,4 +273,50 @@ TEST(PolytopeUnion, SumAndErosionWithABallTakeTheOffsetPath) {
   const auto erodedText = minkowski::describeExact(eroded);
   ASSERT_FALSE(erodedText.empty());
   EXPECT_NE(erodedText[0].find("complement of a union of 7 convex pieces"), std::string::npos) << erodedText[0];
+}
+
+// The closed-form distance (min, max, sqrt over the facets and edges) against the boundary
+// mesh's exact distance at random points inside and outside, for polytopes whose nearest
+// features are faces, edges and vertices of every kind: the tetrahedron, a box cut by a slanted
+// plane (pentagons), a thin wedge (acute facet angles: the in-facet term's factor K matters) and
+// 14 random planes tangent to an ellipsoid.
+TEST(ConvexPolytope, ClosedFormDistanceIsTheBoundaryMeshDistance) {
+  std::vector<Expr> shapes = {
+      tetrahedron(0.5),
+      min(min(min(0.5 - X(), 0.5 + X()), min(0.4 - Y(), 0.4 + Y())),
+          min(min(0.3 - Z(), 0.3 + Z()), 0.6 - X() - Y() - Z())),
+      // a wedge: facets of angle 2 atan(0.1) at the apex x = -1, closed at x = 1
+      min(min(min(Y() + 0.1 * X() + 0.1, 0.1 * X() - Y() + 0.1), 1.0 - X()), min(0.5 - Z(), 0.5 + Z()))};
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g(0, 1);
+  std::optional<Expr> random;
+  for (int i = 0; i < 14; ++i) {
+    double n[3] = {g(rng), g(rng), g(rng)};
+    const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    // tangent to the ellipsoid with semi-axes (0.8, 0.5, 0.4) along the unit normal n / l
+    const double h = std::sqrt(0.64 * n[0] * n[0] + 0.25 * n[1] * n[1] + 0.16 * n[2] * n[2]) / l;
+    const Expr plane = h - (n[0] * X() + n[1] * Y() + n[2] * Z()) / l;
+    random = random ? min(*random, plane) : plane;
+  }
+  shapes.push_back(*random);
+  std::uniform_real_distribution<double> u(-1.6, 1.6);
+  for (size_t s = 0; s < shapes.size(); ++s) {
+    auto p = minkowski::convexPolytopeOf(shapes[s]);
+    ASSERT_TRUE(p.has_value()) << s;
+    ASSERT_NE(p->field.op(), Op::Field) << s;  // the closed form, not the mesh node
+    TapePtr closed = Tape::compile(p->field, 3), mesh = Tape::compile(p->mesh, 3);
+    PointEvaluator pe;
+    int inside = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const double x[3] = {u(rng), u(rng), u(rng)};
+      const double a = pe.eval(*closed, x), b = pe.eval(*mesh, x);
+      EXPECT_NEAR(a, b, 1e-12) << s << ": " << x[0] << " " << x[1] << " " << x[2];
+      inside += b > 0;
+    }
+    EXPECT_GT(inside, 20) << s;
+    // and is registered as an exact distance
+    auto t = minkowski::lookupExact(p->field);
+    ASSERT_TRUE(t.has_value());
+    EXPECT_EQ(t->kind, minkowski::ExactTerm::Kind::Distance);
+  }
 }

@@ -5,10 +5,12 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "frep/expressions/min_max_form.h"
 #include "frep/geometry/distance_fields.h"
+#include "frep/minkowski_algebra/registry.h"
 
 namespace frep::minkowski {
 namespace {
@@ -119,7 +121,96 @@ double toleranceOf(const std::vector<Affine>& planes) {
   return 1e-9 * scale;
 }
 
-// The closed outward mesh of the polytope with these planes and vertices, as its exact signed
+// a . X + d as an expression, zero coefficients left out.
+Expr affineExpr(const Affine& a) {
+  std::optional<Expr> e;
+  for (uint32_t i = 0; i < 3; ++i) {
+    if (a[i] == 0) continue;
+    const Expr t = a[i] == 1 ? Expr::x(i) : Expr(a[i]) * Expr::x(i);
+    e = e ? *e + t : t;
+  }
+  return e ? (a[3] == 0 ? *e : *e + Expr(a[3])) : Expr(a[3]);
+}
+
+// A facet: its plane (inside n . X + d >= 0, unit n) and its vertices in order around it.
+struct Facet {
+  Affine plane;
+  std::vector<uint32_t> ring;
+};
+
+// The polytope's exact signed distance in closed form, with min, max, sqrt and arithmetic alone:
+// interval pruning then keeps a box's few nearest features and the float sign checks apply
+// (a mesh distance node allows neither). With P_f the facets' plane distances and m = min_f P_f:
+//  - inside, m is the exact distance to the boundary (the nearest facet plane's foot lies on it);
+//  - dist^2, the squared distance to the boundary on either side, is the min over candidates
+//    each at least it and equal to it for the nearest
+//    feature: for each edge its segment's squared distance, for each facet
+//    P_f^2 + K_f max(0, -inFace_f)^2, where inFace_f is the least signed distance of X's foot
+//    to the facet's edge lines (>= 0 iff the foot lies in the facet: then the term is the
+//    squared distance to the facet) and K_f = 1 / sin^2(theta_f / 2), theta_f its least
+//    interior angle, so that K_f inFace_f^2 bounds the squared in-plane distance to the facet
+//    (at a corner of angle theta the edge lines are at least sin(theta / 2) of it);
+//  - so sqrt(dist^2) is the distance to the boundary on both sides, and 2 max(m, 0) - sqrt(dist^2)
+//    the signed distance (m inside, -dist outside) with no factor that would inflate the float
+//    error bound (the sign is m's but within rounding of the boundary).
+Expr closedFormDistance(const std::vector<Facet>& facets, const std::vector<Point>& verts) {
+  auto sub3 = [](const Point& a, const Point& b) { return Point{a[0] - b[0], a[1] - b[1], a[2] - b[2]}; };
+  auto dot3 = [](const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  auto cross3 = [](const Point& a, const Point& b) {
+    return Point{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  };
+  std::optional<Expr> m, d2;
+  auto least = [](std::optional<Expr>& acc, const Expr& e) { acc = acc ? min(*acc, e) : e; };
+  std::vector<std::array<uint32_t, 2>> edges;
+  for (const Facet& f : facets) {
+    const Expr plane = affineExpr(f.plane);
+    least(m, plane);
+    const Point n{f.plane[0], f.plane[1], f.plane[2]};
+    const size_t k = f.ring.size();
+    Point c{0, 0, 0};
+    for (uint32_t v : f.ring)
+      for (int a = 0; a < 3; ++a) c[size_t(a)] += verts[v][size_t(a)] / double(k);
+    double sinHalf = 1;  // of the least interior angle
+    for (size_t j = 0; j < k; ++j) {
+      const Point& p = verts[f.ring[j]];
+      const Point u = sub3(verts[f.ring[(j + k - 1) % k]], p), w = sub3(verts[f.ring[(j + 1) % k]], p);
+      const double cosA = std::clamp(dot3(u, w) / std::sqrt(dot3(u, u) * dot3(w, w)), -1.0, 1.0);
+      sinHalf = std::min(sinHalf, std::sqrt(0.5 * (1 - cosA)));
+    }
+    const double scale = (1 + 1e-9) / sinHalf;
+    std::optional<Expr> inFace;
+    for (size_t j = 0; j < k; ++j) {
+      const uint32_t a = f.ring[j], b = f.ring[(j + 1) % k];
+      edges.push_back({std::min(a, b), std::max(a, b)});
+      Point w = cross3(n, sub3(verts[b], verts[a]));  // in the plane, across the edge
+      const double len = std::sqrt(dot3(w, w)), sign = dot3(w, sub3(c, verts[a])) < 0 ? -1 : 1;
+      for (double& x : w) x *= sign * scale / len;
+      least(inFace, affineExpr({w[0], w[1], w[2], -dot3(w, verts[a])}));
+    }
+    least(d2, square(plane) + square(max(-*inFace, Expr(0.0))));
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const auto& [a, b] : edges) {
+    const Point& p = verts[a];
+    const Point d = sub3(verts[b], p);
+    const double l2 = dot3(d, d);
+    const Expr t = min(max(affineExpr({d[0] / l2, d[1] / l2, d[2] / l2, -dot3(p, d) / l2}), Expr(0.0)), Expr(1.0));
+    Expr s2 = Expr(0.0);
+    for (uint32_t i = 0; i < 3; ++i) {
+      const Expr r = (Expr::x(i) - Expr(p[i])) - t * Expr(d[i]);
+      s2 = i == 0 ? square(r) : s2 + square(r);
+    }
+    least(d2, s2);
+  }
+  return Expr(2.0) * max(*m, Expr(0.0)) - sqrt(*d2);
+}
+
+// Polytopes with more facets keep the mesh distance as their field (the closed form grows with
+// the edges; a mesh query does not).
+constexpr size_t kClosedFormFacets = 32;
+
+// The closed outward mesh of the polytope with these planes and vertices, and its exact signed
 // distance; nothing when the facets do not close (unbounded) or enclose no volume (flat).
 std::optional<ConvexPolytope> meshOf(const std::vector<Affine>& planes, const std::vector<Point>& verts, double tol) {
   if (verts.size() < 4) return std::nullopt;
@@ -128,7 +219,7 @@ std::optional<ConvexPolytope> meshOf(const std::vector<Affine>& planes, const st
   std::vector<double> xyz;
   for (const auto& v : verts) xyz.insert(xyz.end(), v.begin(), v.end());
   std::vector<uint32_t> tris;
-  size_t facets = 0;
+  std::vector<Facet> facets;
   for (const Affine& p : planes) {
     std::vector<uint32_t> on;
     for (uint32_t v = 0; v < verts.size(); ++v)
@@ -151,15 +242,25 @@ std::optional<ConvexPolytope> meshOf(const std::vector<Affine>& planes, const st
     std::sort(ring.begin(), ring.end());
     for (size_t t = 1; t + 1 < ring.size(); ++t)
       tris.insert(tris.end(), {ring[0].second, ring[t].second, ring[t + 1].second});
-    ++facets;
+    facets.push_back({p, {}});
+    for (const auto& r : ring) facets.back().ring.push_back(r.second);
   }
-  auto mesh = std::make_shared<MeshField>(xyz, tris, "convex polytope of " + std::to_string(facets) + " facets");
+  auto mesh = std::make_shared<MeshField>(xyz, tris, "convex polytope of " + std::to_string(facets.size()) + " facets");
   // An unbounded or flat intersection leaves open facets: not a polytope.
   if (!mesh->check().closed() || !(mesh->volume() > 0)) return std::nullopt;
   ConvexPolytope out;
-  out.field = fieldExpr(mesh, Expr::x(0), Expr::x(1), Expr::x(2));
+  out.mesh = fieldExpr(mesh, Expr::x(0), Expr::x(1), Expr::x(2));
+  out.field = out.mesh;
+  if (facets.size() <= kClosedFormFacets) {
+    out.field = closedFormDistance(facets, verts);
+    ExactTerm t;  // its own exact distance: later operations read it as one
+    t.kind = ExactTerm::Kind::Distance;
+    t.twin = out.field;
+    t.operand = mesh->describe();
+    registerExact(out.field, t);
+  }
   out.planes = planes.size();
-  out.facets = facets;
+  out.facets = facets.size();
   out.vertices = verts.size();
   out.corners = verts;
   return out;

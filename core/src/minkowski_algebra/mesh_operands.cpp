@@ -56,7 +56,7 @@ std::optional<Mesh> closedMeshOf(const Expr& e, bool* isPolytope) {
   if (e.op() != Op::Field || !dynamic_cast<const MeshField*>(e.node().fn.get())) {
     p = convexPolytopeOf(e);
     if (!p) return std::nullopt;
-    field = &p->field;
+    field = &p->mesh;
     *isPolytope = true;
   }
   const auto* m = dynamic_cast<const MeshField*>(field->node().fn.get());

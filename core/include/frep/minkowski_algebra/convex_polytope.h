@@ -21,7 +21,9 @@
 namespace frep::minkowski {
 
 struct ConvexPolytope {
-  Expr field;  // the exact signed distance (positive inside) of the polytope
+  Expr field;  // the exact signed distance (positive inside) of the polytope, in closed form
+               // up to 32 facets (registered as an exact distance), else `mesh`
+  Expr mesh;   // the same distance as a field of the boundary mesh (for mesh algorithms)
   size_t planes = 0, facets = 0, vertices = 0;
   std::vector<std::array<double, 3>> corners;  // its vertices
 };
