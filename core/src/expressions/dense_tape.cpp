@@ -125,12 +125,18 @@ void DenseSimplifier::simplify(const DenseTape& parent, const uint8_t* choices, 
 // Liveness for four boxes at once, without a branch: live4_[r] holds one byte per box, 1 when a
 // later live instruction of that box reads register r (or r holds the result). Walking back, an
 // instruction is live for box j when its output's byte is; it clears that byte and sets its
-// operands' (a decided min/max only its kept operand's), and its index is appended to box j's
-// list, whose count advances by the live byte. These are the instructions simplify's backward
-// pass keeps ("not read again" drops the others), met in the same order.
+// operands' (a decided min/max only its kept operand's), and its index, with box j's choice
+// there in the top two bits, is appended to box j's list, whose count advances by the live
+// byte. These are the instructions simplify's backward pass keeps ("not read again" drops the
+// others), met in the same order.
 void DenseSimplifier::simplify4(const DenseTape& parent, const uint8_t* choices, unsigned wanted,
                                 DenseTape* const out[4]) {
   const size_t size = parent.code.size();
+  if (size >= (size_t(1) << 30)) {  // no room for the choice beside the index (never in practice)
+    for (size_t j = 0; j < 4; ++j)
+      if ((wanted >> j) & 1u) simplify(parent, choices + j, *out[j], 4);
+    return;
+  }
   if (live4_.size() < parent.numRegs) live4_.resize(parent.numRegs);
   if (lists_.size() < 4 * size) lists_.resize(4 * size);
   uint32_t* live = live4_.data();
@@ -154,22 +160,23 @@ void DenseSimplifier::simplify4(const DenseTape& parent, const uint8_t* choices,
     const uint32_t keepA = c & isChoice, keepB = (c >> 1) & isChoice;  // bytes of 1 (a) or 2 (b)
     live[ins.a] |= l & ~keepB;
     live[ins.b] |= l & ~keepA;  // (a unary op's b is its a)
-    lists[0][n0] = uint32_t(i), n0 += l & 1u;
-    lists[1][n1] = uint32_t(i), n1 += (l >> 8) & 1u;
-    lists[2][n2] = uint32_t(i), n2 += (l >> 16) & 1u;
-    lists[3][n3] = uint32_t(i), n3 += l >> 24;
+    // Each entry: the index, and the box's choice there (0 for other ops) in the top two bits.
+    const uint32_t cc = c & (isChoice * 3u), at = uint32_t(i);
+    lists[0][n0] = at | (cc << 30), n0 += l & 1u;
+    lists[1][n1] = at | ((cc >> 8) << 30), n1 += (l >> 8) & 1u;
+    lists[2][n2] = at | ((cc >> 16) << 30), n2 += (l >> 16) & 1u;
+    lists[3][n3] = at | ((cc >> 24) << 30), n3 += l >> 24;
   }
   const size_t counts[4] = {n0, n1, n2, n3};
   for (size_t j = 0; j < 4; ++j)
-    if ((wanted >> j) & 1u) forward(parent, choices + j, lists[j], counts[j], *out[j]);
+    if ((wanted >> j) & 1u) forward(parent, lists[j], counts[j], *out[j]);
 }
 
 // The live instructions of one box in tape order (live[n - 1] first), each output in a new
 // temporary (static single assignment: no register is written twice), so a decided min/max
 // always hands its kept value's register on and no copy is ever needed, and no step waits for
 // a register allocation: every step is a select.
-void DenseSimplifier::forward(const DenseTape& parent, const uint8_t* choices, const uint32_t* live, size_t n,
-                              DenseTape& out) {
+void DenseSimplifier::forward(const DenseTape& parent, const uint32_t* live, size_t n, DenseTape& out) {
   const uint32_t fixed = parent.firstTemp();
   if (map_.size() < parent.numRegs) map_.resize(parent.numRegs);
   uint32_t* map = map_.data();
@@ -182,11 +189,11 @@ void DenseSimplifier::forward(const DenseTape& parent, const uint8_t* choices, c
   uint32_t next = fixed, choicesLeft = 0;
   const DenseInstr* code = parent.code.data();
   for (size_t m = n; m-- > 0;) {
-    const size_t i = live[m];
-    const DenseInstr ins = code[i];
+    const uint32_t e = live[m];
+    const DenseInstr ins = code[e & 0x3fffffffu];
     const uint32_t a = map[ins.a], b = map[ins.b];
     const bool choice = ins.op == Op::Min || ins.op == Op::Max;
-    const uint8_t c = choice ? choices[4 * i] : uint8_t(0);
+    const uint32_t c = e >> 30;
     const bool decided = c != 0;
     *dst = DenseInstr{ins.op, next, a, b};
     dst += !decided;

@@ -54,13 +54,13 @@ class DenseSimplifier {
   void simplify4(const DenseTape& parent, const uint8_t* choices, unsigned wanted, DenseTape* const out[4]);
 
  private:
-  void forward(const DenseTape& parent, const uint8_t* choices, const uint32_t* live, size_t n, DenseTape& out);
+  void forward(const DenseTape& parent, const uint32_t* live, size_t n, DenseTape& out);
   std::vector<uint32_t> bind_;  // parent register -> out register of its live value
   uint32_t boundFixed_ = 0;     // bind_[r] == r for r below it
   std::vector<uint32_t> free_;
   std::vector<DenseInstr> scratch_;  // the simplified code, written back to front
   // simplify4: per parent register, byte j set when box j reads it later; per box, its live
-  // instructions (last first).
+  // instructions (last first) with their choices (index | choice << 30).
   std::vector<uint32_t> live4_;
   std::vector<uint32_t> lists_;
   std::vector<uint32_t> map_;  // forward: parent register -> out register of its value
