@@ -131,7 +131,8 @@ TEST_F(HybridFarm, MeshPartPlusBallIsTheSameThroughTheFarmWithSteinersVolume) {
   EXPECT_TRUE(bytes == readText(path("w2.ply")));  // the same bytes
   // The exact path ran (no search) and the report says so.
   const std::string report = readText(path("w2.ply.report.json"));
-  EXPECT_NE(report.find("exact Minkowski sum parts/cube.obj + ball(r 0.25 at (0.1, 0, -0.05))"), std::string::npos)
+  EXPECT_NE(report.find("exact Minkowski sum parts/cube.obj (12 triangles) as a box + ball(r 0.25 at (0.1, 0, -0.05))"),
+            std::string::npos)
       << report;
   EXPECT_NE(report.find("\"searches\": 0"), std::string::npos) << report;
   // Cube (a = 1) + ball: V = a^3 + 6 a^2 r + 3 pi a r^2 + 4/3 pi r^3 (Steiner), and the

@@ -1,7 +1,12 @@
 // Analytic test models of the mesher and simplifier tests (inside: f >= 0) and their grids.
 #pragma once
 
+#include <cstdint>
+#include <memory>
+#include <vector>
+
 #include "frep/expressions/expr.h"
+#include "frep/geometry/distance_fields.h"
 #include "frep/primitives/ops.h"
 #include "frep/sampling/sample.h"
 
@@ -22,6 +27,29 @@ inline Expr blockAt(double cx, double cy, double cz, double hx, double hy, doubl
              min(hz - (Z() - cz), hz + (Z() - cz)));
 }
 inline Expr torusZ(double R, double r) { return r * r - square(sqrt(square(X()) + square(Y())) - R) - square(Z()); }
+
+// An L-shaped prism [0,2]x[0,1] ∪ [0,1]x[0,2] times [0, h] as a closed mesh: the L hexagon
+// extruded (not convex: the union of the two blocks).
+inline Expr lPrismMesh(double h) {
+  const double L[6][2] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  std::vector<double> xyz;
+  for (double z : {0.0, h})
+    for (const auto& p : L) xyz.insert(xyz.end(), {p[0], p[1], z});
+  // The hexagon as four triangles (fan from the reflex vertex 3), counter-clockwise from +z.
+  const uint32_t cap[4][3] = {{3, 4, 5}, {3, 5, 0}, {3, 0, 1}, {3, 1, 2}};
+  std::vector<uint32_t> tris;
+  for (const auto& t : cap) {
+    tris.insert(tris.end(), {t[0] + 6, t[1] + 6, t[2] + 6});  // top, outward +z
+    tris.insert(tris.end(), {t[0], t[2], t[1]});              // bottom, outward -z
+  }
+  for (uint32_t i = 0; i < 6; ++i) {
+    const uint32_t j = (i + 1) % 6;
+    tris.insert(tris.end(), {i, j, j + 6});
+    tris.insert(tris.end(), {i, j + 6, i + 6});
+  }
+  auto m = std::make_shared<frep::MeshField>(xyz, tris, "L prism");
+  return frep::fieldExpr(m, X(), Y(), Z());
+}
 
 constexpr double kPi = 3.14159265358979323846;
 

@@ -114,10 +114,17 @@ TEST(FrDistanceOffset, WhatIsNotExactSearches) {
   EXPECT_TRUE(hasExtremum(a.field));
   Model b = compileOk(kCube + "my_model(x[3], a[1]) { " + opts + "my_model = frMinkowskiDiff(x, ball, cube, o); }");
   EXPECT_TRUE(hasExtremum(b.field));
-  // A rotated or scaled reading of the distance is not recognised (only translations are).
-  Model c = compileOk(kCube + "sc(x[3], a[1]) { array y[3]; y = [2 * x[1], x[2], x[3]]; sc = cube(y, a); }\n"
+  // A sheared reading of the distance is not recognised (only translations are, and a
+  // polyhedral mesh's scalings: the polytopes it bounds, below).
+  Model c = compileOk(kCube + "sc(x[3], a[1]) { array y[3]; y = [x[1] + x[2], x[2], x[3]]; sc = cube(y, a); }\n"
                               "my_model(x[3], a[1]) { " + opts + "my_model = frMinkowski(x, sc, b2, o); }");
   EXPECT_TRUE(hasExtremum(c.field));
+  // The cube's flat patches read through a scaling bound the box [0, 0.5] x [0, 1]^2: exact.
+  Model s = compileOk(kCube + "sc(x[3], a[1]) { array y[3]; y = [2 * x[1], x[2], x[3]]; sc = cube(y, a); }\n"
+                              "my_model(x[3], a[1]) { my_model = frMinkowski(x, sc, b2); }");
+  EXPECT_FALSE(hasExtremum(s.field));
+  EXPECT_NEAR(evalModel(s, {0.8, 0.5, 0.5}), -0.3 + 0.15, 1e-9);
+  EXPECT_NEAR(evalModel(s, {0.7, 1.2, -0.1}), -std::sqrt(0.04 + 0.04 + 0.01) + 0.15, 1e-9);
   // A translated one is.
   Model d = compileOk(kCube + "sh(x[3], a[1]) { array y[3]; y = [x[1] - 2, x[2], x[3] + 1]; sh = cube(y, a); }\n"
                               "my_model(x[3], a[1]) { my_model = frMinkowski(x, sh, b2); }");

@@ -452,6 +452,13 @@ bool PolytopeUnion::connected() const {
   return components == 1;
 }
 
+std::optional<PolytopeUnion> polytopeUnionOfPieces(const std::vector<std::vector<std::array<double, 4>>>& pieces) {
+  if (pieces.empty() || pieces.size() > kMaxTerms) return std::nullopt;
+  for (const Term& t : pieces)
+    if (t.size() > kMaxTermPlanes) return std::nullopt;
+  return unionOfTerms(pieces, false);
+}
+
 std::optional<PolytopeUnion> polytopeUnionOf(const Expr& e) {
   std::vector<Term> terms;
   if (!normalForm(minMaxForm(e), false, terms)) return std::nullopt;

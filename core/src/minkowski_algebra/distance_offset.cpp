@@ -88,6 +88,14 @@ Expr exactOperand(const Expr& field, bool erosion, Exactness& x) {
     x = {true, true, t->operand};
     return t->twin;  // the same set, read as its exact distance
   }
+  // A small polyhedral mesh (an STL box or L-slab) as its convex pieces: the same set and the
+  // exact distance outside, in closed form (batch and float evaluation, not mesh queries).
+  std::string mesh;
+  if (!erosion && field.op() == Op::Field)
+    if (std::optional<PolytopeUnion> u = polytopeUnionOfMesh(field, &mesh)) {
+      x = {true, false, mesh + (u->pieces > 1 ? " as a " + u->describe() : u->boxes ? " as a box" : " as a polytope")};
+      return u->field;
+    }
   x = exactnessOf(field);
   if (x.outside && x.inside) return field;
   if (std::optional<ConvexPolytope> p = convexPolytopeOf(field)) {

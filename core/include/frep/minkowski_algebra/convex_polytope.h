@@ -55,6 +55,16 @@ struct PolytopeUnion {
 // unbounded or empty.
 std::optional<PolytopeUnion> polytopeUnionOf(const Expr& e);
 
+// The union of convex pieces given by their half-spaces n . X + d >= 0 (unit n), as above;
+// nothing when a piece is unbounded or there are more than 64 pieces or planes in one.
+std::optional<PolytopeUnion> polytopeUnionOfPieces(const std::vector<std::vector<std::array<double, 4>>>& pieces);
+
+// A closed mesh operand (frMesh, up to 256 triangles) that is a convex polyhedron or is covered
+// by at most 8 convex pieces (convex_cover.h), as the union of those polytopes: the mesh
+// distance's set and exact distance outside it, in closed form (cheaper to evaluate than the
+// mesh node, in batches and in float). `what` names the mesh. Nothing otherwise.
+std::optional<PolytopeUnion> polytopeUnionOfMesh(const Expr& e, std::string* what);
+
 // The same forms read from inside, for erosions: the complement of e's set is the union of the
 // terms of -e's normal form (often unbounded: a half-space, a wedge, the outside of a block),
 // and the distance to a union is the least of the distances to its pieces, so field = -(max_i
