@@ -19,256 +19,21 @@ import glob
 import json
 import os
 import re
-import shlex
 import shutil
-import signal
-import socket
 import subprocess
 import sys
 import tempfile
-import time
+
+import deploy_e2e
+from deploy_util import (Check, as_argv, check_flags, failures, flag_value, help_text, interpolate,
+                         program_name, require, set_flag)
+
 
 try:
     import yaml
 except ImportError:  # python3-yaml is in deploy/install-deps.sh
     print("FAIL: python3 cannot import yaml (install python3-yaml: deploy/install-deps.sh)")
     sys.exit(1)
-
-RUN_TIMEOUT = 60  # seconds for one end-to-end topology
-WORKER_LEAVE_TIMEOUT = 20  # seconds for workers to exit after the master finished
-MASTER_DELAY = 1.0  # seconds between starting the workers and the master
-# The master starts computing when the first worker joins (it does not wait for
-# --expect-workers), and this test job is one brick of 0.1 s: a worker whose TCP reconnect
-# comes a little later would find the job over. frep-worker's test hook FREP_TEST_SLOW_MS
-# (docs/farm.md) makes each brick last long enough for both workers to join. It changes no
-# command line.
-WORKER_TEST_ENV = {"FREP_TEST_SLOW_MS": "500"}
-
-SPHERE = "my_model(x[3], a[1]) { my_model = 1 - x[1]^2 - x[2]^2 - x[3]^2; }\n"
-
-failures = []
-
-
-def fail(what, message):
-    failures.append(f"{what}: {message}")
-    print(f"FAIL {what}: {message}", flush=True)
-
-
-def ok(what):
-    print(f"ok   {what}", flush=True)
-
-
-class Check:
-    """with Check("name"): ...  -- an AssertionError inside is reported as a failure."""
-
-    def __init__(self, name):
-        self.name = name
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, kind, value, tb):
-        if kind is None:
-            ok(self.name)
-            return False
-        if issubclass(kind, AssertionError):
-            fail(self.name, str(value))
-            return True
-        if issubclass(kind, Exception):
-            fail(self.name, f"{kind.__name__}: {value}")
-            return True
-        return False
-
-
-def require(condition, message):
-    if not condition:
-        raise AssertionError(message)
-
-
-# ---------------------------------------------------------------------------------------------
-# helpers
-
-def interpolate(value, env):
-    """Compose variable interpolation: ${VAR}, ${VAR:-default}, ${VAR-default}, $VAR, $$."""
-
-    def one(m):
-        if m.group(0) == "$$":
-            return "$"
-        name = m.group(1) or m.group(4)
-        op, default = m.group(2), m.group(3) or ""
-        if op == ":-":
-            return env.get(name) or default
-        if op == "-":
-            return env.get(name, default)
-        return env.get(name, "")
-
-    pattern = r"\$\$|\$\{([A-Za-z_][A-Za-z0-9_]*)(?:(:?-)([^}]*))?\}|\$([A-Za-z_][A-Za-z0-9_]*)"
-    if isinstance(value, str):
-        return re.sub(pattern, one, value)
-    if isinstance(value, list):
-        return [interpolate(v, env) for v in value]
-    if isinstance(value, dict):
-        return {k: interpolate(v, env) for k, v in value.items()}
-    return value
-
-
-def as_argv(value):
-    if value is None:
-        return []
-    if isinstance(value, str):
-        return shlex.split(value)
-    return [str(v) for v in value]
-
-
-def flag_value(argv, flag):
-    for i, a in enumerate(argv):
-        if a == flag and i + 1 < len(argv):
-            return argv[i + 1]
-        if a.startswith(flag + "="):
-            return a.split("=", 1)[1]
-    return None
-
-
-def set_flag(argv, flag, value):
-    out = list(argv)
-    for i, a in enumerate(out):
-        if a == flag and i + 1 < len(out):
-            out[i + 1] = value
-            return out
-        if a.startswith(flag + "="):
-            out[i] = f"{flag}={value}"
-            return out
-    return out + [flag, value]
-
-
-def help_text(binary, *args):
-    p = subprocess.run([binary, *args, "--help"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                       text=True, timeout=30)
-    return p.stdout
-
-
-def check_flags(argv, help_txt, program):
-    """Every option in argv must be named in the program's --help."""
-    missing = []
-    for a in argv:
-        if not a.startswith("-") or a == "-" or re.fullmatch(r"-[0-9.]+", a):
-            continue
-        flag = a.split("=", 1)[0]
-        if not re.search(r"(?<![\w-])" + re.escape(flag) + r"(?![\w-])", help_txt):
-            missing.append(flag)
-    require(not missing, f"{program} --help does not mention {', '.join(missing)} (used in {shlex.join(argv)})")
-
-
-def program_name(argv):
-    return os.path.basename(argv[0]) if argv else ""
-
-
-def free_port():
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def tail(path, n=15):
-    try:
-        with open(path, errors="replace") as f:
-            return "".join(f.readlines()[-n:])
-    except OSError:
-        return "(no output)"
-
-
-def kill_group(p, sig=signal.SIGKILL):
-    try:
-        os.killpg(p.pid, sig)
-    except (ProcessLookupError, PermissionError):
-        pass
-
-
-def check_outputs(out_vdb, what):
-    report_path = out_vdb + ".report.json"
-    require(os.path.isfile(out_vdb) and os.path.getsize(out_vdb) > 0, f"{what}: {out_vdb} was not written")
-    require(os.path.isfile(report_path), f"{what}: {report_path} was not written")
-    with open(report_path) as f:
-        report = json.load(f)
-    seen = report.get("workers_seen")
-    require(seen == 2, f"{what}: report says workers_seen={seen!r}, expected 2")
-
-
-def localize_master(argv, model, out_vdb, port):
-    """The master's command line with the test's model, output, size and a local port."""
-    argv = list(argv)
-    require(len(argv) >= 3 and argv[1] == "sample", f"master command is not `frep sample MODEL ...`: {argv}")
-    argv[0] = os.path.join(BIN_DIR, "frep")
-    argv[2] = model
-    argv = set_flag(argv, "--out", out_vdb)
-    argv = set_flag(argv, "--res", "32")
-    argv = set_flag(argv, "-b", "1.5")
-    argv = set_flag(argv, "--listen", f"tcp://127.0.0.1:{port}")
-    argv = set_flag(argv, "--expect-workers", "2")
-    return argv
-
-
-def local_endpoint(endpoint, port):
-    m = re.fullmatch(r"tcp://([^:/]+):(\d+)", endpoint or "")
-    require(m is not None, f"worker endpoint {endpoint!r} is not tcp://HOST:PORT")
-    return f"tcp://127.0.0.1:{port}"
-
-
-def run_topology(what, master_argv, worker_argvs, worker_env, tmp, out_vdb):
-    """Starts the master and the workers as local processes; checks outputs and exit codes."""
-    procs = []
-    logs = []
-    try:
-        # Workers first, as a cluster often does: they queue their hello until the master binds,
-        # so both are seen even if one could compute this small job alone. (The master starts
-        # computing as soon as the first worker joins.)
-        workers = []
-        for i, argv in enumerate(worker_argvs):
-            wlog = os.path.join(tmp, f"worker{i}.log")
-            logs.append((f"worker {i}", wlog))
-            env = dict(os.environ)
-            env.pop("FREP_MASTER", None)
-            env.update(WORKER_TEST_ENV)
-            env.update(worker_env)
-            with open(wlog, "w") as f:
-                w = subprocess.Popen(argv, stdout=f, stderr=subprocess.STDOUT, cwd=tmp, env=env,
-                                     start_new_session=True)
-            workers.append(w)
-            procs.append(w)
-        time.sleep(MASTER_DELAY)
-        mlog = os.path.join(tmp, "master.log")
-        logs.append(("master", mlog))
-        with open(mlog, "w") as f:
-            master = subprocess.Popen(master_argv, stdout=f, stderr=subprocess.STDOUT, cwd=tmp,
-                                      start_new_session=True)
-        procs.append(master)
-        deadline = time.time() + RUN_TIMEOUT
-        while master.poll() is None:
-            require(time.time() < deadline, f"{what}: the master did not finish within {RUN_TIMEOUT} s")
-            codes = [w.poll() for w in workers]
-            require(None in codes or codes == [0] * len(codes),
-                    f"{what}: every worker exited (codes {codes}) while the master still runs")
-            time.sleep(0.1)
-        rc = master.returncode
-        require(rc == 0, f"{what}: master exited with {rc}")
-        deadline = time.time() + WORKER_LEAVE_TIMEOUT
-        for i, w in enumerate(workers):
-            try:
-                wrc = w.wait(timeout=max(0.1, deadline - time.time()))
-            except subprocess.TimeoutExpired:
-                raise AssertionError(f"{what}: worker {i} still running {WORKER_LEAVE_TIMEOUT} s after the master finished")
-            require(wrc == 0, f"{what}: worker {i} exited with {wrc}")
-        check_outputs(out_vdb, what)
-    except AssertionError as e:
-        detail = "\n".join(f"--- {name} ({shlex.join(p.args) if hasattr(p, 'args') else ''}):\n{tail(log)}"
-                           for (name, log), p in zip(logs, procs))
-        raise AssertionError(f"{e}\n{detail}")
-    finally:
-        for p in procs:
-            if p.poll() is None:
-                kill_group(p)
-                p.wait()
-
 
 # ---------------------------------------------------------------------------------------------
 # checks
@@ -587,163 +352,13 @@ def check_sbatch_flags(text, frep_help, worker_help):
         check_flags(sbatch_command_flags(text, "frep-worker"), worker_help, "frep-worker")
 
 
-# ---------------------------------------------------------------------------------------------
-# end to end, as local processes
-
-def e2e_compose(c):
-    with Check("docker-compose topology as local processes (master + 2 workers)"):
-        require(c, "the compose file did not pass its structure check")
-        with tempfile.TemporaryDirectory(prefix="frep-compose-") as tmp:
-            model = os.path.join(tmp, "sphere.hf")
-            with open(model, "w") as f:
-                f.write(SPHERE)
-            port = free_port()
-            out_vdb = os.path.join(tmp, "out", "sphere.vdb")
-            os.makedirs(os.path.dirname(out_vdb))
-            margv = localize_master(c["master"], model, out_vdb, port)
-            wargv = list(c["worker"])
-            wargv[0] = os.path.join(BIN_DIR, "frep-worker")
-            wargv = set_flag(wargv, "--connect", local_endpoint(flag_value(wargv, "--connect"), port))
-            run_topology("compose", margv, [wargv, wargv], {}, tmp, out_vdb)
-
-
-def e2e_k8s(k):
-    with Check("Kubernetes topology as local processes (master + 2 workers, FREP_MASTER)"):
-        require(k, "the manifests did not pass their structure check")
-        with tempfile.TemporaryDirectory(prefix="frep-k8s-") as tmp:
-            model = os.path.join(tmp, "model.hf")
-            with open(model, "w") as f:
-                f.write(SPHERE)
-            port = free_port()
-            out_vdb = os.path.join(tmp, "output", "model.vdb")
-            os.makedirs(os.path.dirname(out_vdb))
-            margv = localize_master(k["master"], model, out_vdb, port)
-            wargv = list(k["worker"])
-            wargv[0] = os.path.join(BIN_DIR, "frep-worker")
-            env = dict(k["env"])
-            env["FREP_MASTER"] = local_endpoint(env.get("FREP_MASTER"), port)
-            run_topology("k8s", margv, [wargv, wargv], env, tmp, out_vdb)
-
-
-SRUN_STUB = r"""#!/usr/bin/env bash
-# Test stub for srun: starts --ntasks copies of the command on this machine with SLURM_PROCID
-# set, each writing to --output (with %j and %t expanded), and exits with task 0's status.
-n=1; out=""
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --ntasks=*) n="${1#*=}"; shift ;;
-    -n) n="$2"; shift 2 ;;
-    --output=*) out="${1#*=}"; shift ;;
-    -*) shift ;;
-    *) break ;;
-  esac
-done
-echo "srun-stub: $n tasks" >&2
-# Tasks 1..n-1 first and task 0 DELAY s later (a real srun starts them in any order; this
-# order makes sure every worker has joined before the small test job is over).
-pids=()
-for i in $(seq 1 $((n - 1))) 0; do
-  [ "$i" -eq 0 ] && sleep DELAY
-  log="${out:-/dev/stderr}"; log="${log//%j/${SLURM_JOB_ID:-0}}"; log="${log//%t/$i}"
-  SLURM_PROCID=$i SLURM_LOCALID=$i SLURM_NODEID=0 SLURM_STEP_ID=0 "$@" >"$log" 2>&1 &
-  pids[$i]=$!
-done
-# Task 0 (the master) first; then the workers get LEAVE seconds to leave, as the test's other
-# topologies do, and are killed (status 1) if they are still there.
-wait "${pids[0]}"; rc=$?
-echo "srun-stub: task 0 exited $rc" >&2
-for ((t = 0; t < LEAVE * 10; t++)); do
-  alive=0
-  for p in "${pids[@]:1}"; do kill -0 "$p" 2>/dev/null && alive=1; done
-  [ $alive -eq 0 ] && break
-  sleep 0.1
-done
-for i in "${!pids[@]}"; do
-  [ "$i" -eq 0 ] && continue
-  if kill -0 "${pids[$i]}" 2>/dev/null; then
-    echo "srun-stub: task $i still running LEAVE s after task 0 ended: killed" >&2
-    kill -KILL "${pids[$i]}"; wait "${pids[$i]}"
-    [ $rc -eq 0 ] && rc=1
-  else
-    wait "${pids[$i]}"; r=$?
-    echo "srun-stub: task $i exited $r" >&2
-    [ $r -ne 0 ] && [ $rc -eq 0 ] && rc=$r
-  fi
-done
-exit $rc
-""".replace("LEAVE", str(WORKER_LEAVE_TIMEOUT)).replace("DELAY", str(MASTER_DELAY))
-
-SCONTROL_STUB = r"""#!/usr/bin/env bash
-# Test stub for scontrol: `scontrol show hostnames LIST` prints LIST's hosts one per line
-# (plain comma-separated lists only).
-if [ "$1" = show ] && [ "$2" = hostnames ]; then
-  tr ',' '\n' <<< "${3:-$SLURM_JOB_NODELIST}"
-  exit 0
-fi
-echo "scontrol stub: unsupported: $*" >&2
-exit 1
-"""
-
-
-def e2e_sbatch(curve=False):
-    name = "frep.sbatch run with stub srun/scontrol (task 0 master, tasks 1-2 workers)"
-    with Check(name + (", FREP_CURVE_DIR" if curve else "")):
-        script = os.path.join(SRC, "deploy", "slurm", "frep.sbatch")
-        with tempfile.TemporaryDirectory(prefix="frep-slurm-") as tmp:
-            stubs = os.path.join(tmp, "stubs")
-            os.makedirs(stubs)
-            for name, body in (("srun", SRUN_STUB), ("scontrol", SCONTROL_STUB)):
-                with open(os.path.join(stubs, name), "w") as f:
-                    f.write(body)
-                os.chmod(os.path.join(stubs, name), 0o755)
-            model = os.path.join(tmp, "sphere.hf")
-            with open(model, "w") as f:
-                f.write(SPHERE)
-            out_vdb = os.path.join(tmp, "sphere.vdb")
-            env = {k: v for k, v in os.environ.items() if not k.startswith(("SLURM_", "FREP_"))}
-            env.update({
-                "PATH": stubs + os.pathsep + BIN_DIR + os.pathsep + env.get("PATH", "/usr/bin:/bin"),
-                "SLURM_JOB_ID": "4242", "SLURM_JOB_NODELIST": "localhost", "SLURM_NTASKS": "3",
-                "SLURM_NNODES": "1", "SLURM_CPUS_PER_TASK": "1", "SLURM_SUBMIT_DIR": tmp,
-                "FREP_PORT": str(free_port()), "FREP_LOG_DIR": os.path.join(tmp, "logs"),
-            })
-            env.update(WORKER_TEST_ENV)  # the master ignores it
-            if curve:
-                keys = os.path.join(tmp, "keys")
-                k = subprocess.run([os.path.join(BIN_DIR, "frep"), "keygen", keys], stdout=subprocess.PIPE,
-                                   stderr=subprocess.STDOUT, text=True, timeout=30)
-                require(k.returncode == 0, f"frep keygen failed: {k.stdout.strip()}")
-                env["FREP_CURVE_DIR"] = keys
-            log = os.path.join(tmp, "sbatch.log")
-            with open(log, "w") as f:
-                p = subprocess.Popen(["bash", script, model, out_vdb, "--res", "32", "-b", "1.5"], cwd=tmp, env=env,
-                                     stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
-            try:
-                try:
-                    rc = p.wait(timeout=RUN_TIMEOUT + WORKER_LEAVE_TIMEOUT + 10)
-                except subprocess.TimeoutExpired:
-                    raise AssertionError(f"the job did not finish within {RUN_TIMEOUT + WORKER_LEAVE_TIMEOUT} s")
-                require(rc == 0, f"the batch script exited with {rc}")
-                check_outputs(out_vdb, "sbatch")
-            except AssertionError as e:
-                detail = f"--- batch script:\n{tail(log)}"
-                for t in sorted(glob.glob(os.path.join(tmp, "logs", "*.log"))):
-                    detail += f"\n--- {os.path.basename(t)}:\n{tail(t)}"
-                raise AssertionError(f"{e}\n{detail}")
-            finally:
-                if p.poll() is None:
-                    kill_group(p)
-                    p.wait()
-                else:
-                    kill_group(p)  # stray tasks of the stub srun
-
-
 def main():
     global SRC, BIN_DIR
     if len(sys.argv) != 3:
         print(__doc__)
         return 2
     SRC, BIN_DIR = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    deploy_e2e.SRC, deploy_e2e.BIN_DIR = SRC, BIN_DIR
     frep, worker = os.path.join(BIN_DIR, "frep"), os.path.join(BIN_DIR, "frep-worker")
     for b in (frep, worker):
         if not os.access(b, os.X_OK):
@@ -761,10 +376,10 @@ def main():
     sbatch_text = check_sbatch_syntax()
     check_sbatch_flags(sbatch_text, frep_help, worker_help)
 
-    e2e_compose(c)
-    e2e_k8s(k)
-    e2e_sbatch()
-    e2e_sbatch(curve=True)
+    deploy_e2e.e2e_compose(c)
+    deploy_e2e.e2e_k8s(k)
+    deploy_e2e.e2e_sbatch()
+    deploy_e2e.e2e_sbatch(curve=True)
 
     if failures:
         print(f"\n{len(failures)} check(s) failed")
