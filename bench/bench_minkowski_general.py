@@ -20,17 +20,19 @@ the box for the morph; polyhedral sums (bunny (+) tool / block) are exact in bot
 volume is the reference; bunny (+) ball has no closed form: the reference is frep at --ref-res
 (the exact offset path, so only meshing error; printed).
 
-For each case: frep mesh at several resolutions (its default: 2 local workers, or in-process for a
-grid of at most 64^3 points, docs/cli.md; the run's line says which),
-OpenSCAD minkowski() (sphere $fn from --fn) and manifold-3d minkowskiSum (node; the whole
-process and the operation alone). Equal accuracy: for each peer run, the coarsest frep run whose
-|volume error| is at most the peer's; the ratio peer / frep of wall times is printed. Also the
+For each case: frep mesh at several resolutions and simplification tolerances (--tolerances:
+0.1 voxel, frep's default; 0.02; 0, the marching tetrahedra's triangles kept), each with its
+default farm (2 local workers, or in-process for a grid of at most 64^3 points, docs/cli.md; the
+run's line says which), OpenSCAD minkowski() (sphere $fn from --fn) and manifold-3d
+minkowskiSum (node; the whole process and the operation alone). Equal accuracy: for each peer
+run, the fastest frep run whose |volume error| is at most the peer's (both triangle counts
+printed); the ratio peer / frep of wall times is printed. Also the
 per-voxel time of each case against the box (+) ball of the same form (box_ball for HyperFun
-operands, box_stl_ball for meshes) at the same resolution, and whether every frep mesh
-is closed (unpaired edges 0). Never fails on time.
+operands, box_stl_ball for meshes) at the same resolution and the first tolerance, and whether
+every frep mesh is closed (unpaired edges 0). Never fails on time.
 
 Usage: bench/bench_minkowski_general.py [--quick] [--only case,...] [--frep build/bin/frep]
-       [--res 64,96,128] [--timeout 300] [--keep DIR] [--no-peers]
+       [--res 64,96,128] [--tolerances 0.1,0.02,0] [--timeout 300] [--keep DIR] [--no-peers]
 """
 import argparse
 import json
@@ -379,6 +381,8 @@ def main():
     ap.add_argument("--openscad", default="/usr/bin/openscad")
     ap.add_argument("--res", default="24,32,48,64,96,128")
     ap.add_argument("--fn", default="12,24,48", help="peers' sphere segments ($fn), one run each")
+    ap.add_argument("--tolerances", default="0.1,0.02,0",
+                    help="frep mesh --tolerance values, each at every --res (the first: the per-voxel baseline)")
     ap.add_argument("--ref-res", type=int, default=320, help="bunny (+) ball: frep's reference resolution")
     ap.add_argument("--quick", action="store_true", help="--res 64,128 and no reference run")
     ap.add_argument("--only", default="")
@@ -397,6 +401,7 @@ def main():
     have_manifold = have_npm and not args.no_peers
     resolutions = [32, 64] if args.quick else [int(r) for r in args.res.split(",")]
     fns = [12] if args.quick else [int(f) for f in args.fn.split(",")]
+    tolerances = [float(t) for t in args.tolerances.split(",")]
     cases = build_cases(work, npm_dir, have_npm)
     if args.only:
         keep = set(args.only.split(","))
@@ -410,19 +415,22 @@ def main():
         name, box = case["name"], case["box"]
         print("\n== %s (%s), box [-%g, %g]^3" % (name, case["what"], box, box))
         frep_runs = []
-        for res in resolutions:
-            stl = os.path.join(work, "%s_frep_%d.stl" % (name, res))
+        for res, tol in [(r, t) for t in tolerances for r in resolutions]:
+            # The simplifier's tolerance is the user's accuracy knob: 0.1 voxel by default, 0 keeps
+            # the marching tetrahedra's triangles (more of them, a smaller volume error).
+            label = "frep --res %d" % res + ("" if tol == tolerances[0] else " --tolerance %g" % tol)
+            stl = os.path.join(work, "%s_frep_%d_%g.stl" % (name, res, tol))
             p, dt, err = timed([args.frep, "mesh", case["hf"], "-o", "my_model", "-b", "%g" % box, "--res", str(res),
-                                "-O", stl, "--no-progress"], args.timeout)
+                                "--tolerance", "%g" % tol, "-O", stl, "--no-progress"], args.timeout)
             if p is None:
-                print("  frep --res %d failed: %s" % (res, err.strip()))
+                print("  %s failed: %s" % (label, err.strip()))
                 continue
             tris = read_stl(stl)
             report = open(stl + ".report.json", "rb").read()
             path = "search" if b"searches\": 0" not in report else "exact"
             where = "in-process" if b"\"in_process_rule\": \"" in report else "farm"
-            frep_runs.append(dict(res=res, wall=dt, tris=len(tris), vol=volume(tris), open=unpaired_edges(tris), path=path,
-                                  where=where))
+            frep_runs.append(dict(res=res, tol=tol, label=label, wall=dt, tris=len(tris), vol=volume(tris),
+                                  open=unpaired_edges(tris), path=path, where=where))
         peers = []
         r = sphere_radius(case)
         for fn in (fns if r else [0]):
@@ -465,16 +473,16 @@ def main():
         def err_of(v):
             return (v - exact) / exact if exact else float("nan")
         for fr in frep_runs:
-            print("  %-30s %8.2f %9s %10d %+9.4f%% %6d  (%s path, %s)" % ("frep --res %d" % fr["res"], fr["wall"], "", fr["tris"],
+            print("  %-30s %8.2f %9s %10d %+9.4f%% %6d  (%s path, %s)" % (fr["label"], fr["wall"], "", fr["tris"],
                                                                         100 * err_of(fr["vol"]), fr["open"], fr["path"], fr["where"]))
-            if name in BASELINES.values():
+            if name in BASELINES.values() and fr["tol"] == tolerances[0]:
                 base[(case["form"], fr["res"])] = fr["wall"]
         for pp in peers:
             print("  %-30s %8.2f %9s %10d %+9.4f%%" % (pp["who"], pp["wall"], "%.2f" % pp["op"] if pp["op"] is not None else "",
                                                         pp["tris"], 100 * err_of(pp["vol"])))
         for fr in frep_runs:
             key = (case["form"], fr["res"])
-            if key in base and name not in BASELINES.values():
+            if key in base and name not in BASELINES.values() and fr["tol"] == tolerances[0]:
                 print("  per-voxel time at --res %d: %.2fx %s's (the box (+) ball of the same form)" %
                       (fr["res"], fr["wall"] / base[key], BASELINES[case["form"]]))
         for pp in peers:
@@ -484,12 +492,13 @@ def main():
             match = [fr for fr in frep_runs if abs(err_of(fr["vol"])) <= max(e, 1e-12)]
             if match:
                 fr = min(match, key=lambda x: x["wall"])
-                line = "  equal accuracy vs %s (%.4f%%): frep --res %d (%.4f%%) %.2f s; %s / frep = %.2fx" % (
-                    pp["who"], 100 * e, fr["res"], 100 * abs(err_of(fr["vol"])), fr["wall"], pp["who"].split()[0], pp["wall"] / fr["wall"])
+                line = "  equal accuracy vs %s (%.4f%%, %d triangles): %s (%.4f%%, %d) %.2f s; %s / frep = %.2fx" % (
+                    pp["who"], 100 * e, pp["tris"], fr["label"], 100 * abs(err_of(fr["vol"])), fr["tris"], fr["wall"],
+                    pp["who"].split()[0], pp["wall"] / fr["wall"])
             else:
                 best = min(frep_runs, key=lambda x: abs(err_of(x["vol"]))) if frep_runs else None
-                line = "  %s is exact here (%.4f%%): frep's closest --res %s (%.4f%%) %s s vs %.2f s" % (
-                    pp["who"], 100 * e, best["res"] if best else "-", 100 * abs(err_of(best["vol"])) if best else 0,
+                line = "  %s is exact here (%.4f%%): frep's closest %s (%.4f%%) %s s vs %.2f s" % (
+                    pp["who"], 100 * e, best["label"] if best else "-", 100 * abs(err_of(best["vol"])) if best else 0,
                     "%.2f" % best["wall"] if best else "-", pp["wall"])
             print(line)
             summary.append((name, line.strip()))
