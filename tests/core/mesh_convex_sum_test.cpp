@@ -77,8 +77,6 @@ double boxDistance(const V3& p, const V3& lo, const V3& hi) {
   return out > 0 ? -std::sqrt(out) : -in;
 }
 
-Expr lPrism(double h) { return mesh_models::lPrismMesh(h); }
-
 }  // namespace
 
 TEST(MeshConvexSum, ZonotopeOfTwoBoxesHasExactMembershipAndDistance) {
@@ -163,7 +161,7 @@ TEST(MeshConvexSum, NonConvexMeshGrownByABoxIsTheUnionOfTheGrownBlocks) {
   const double h = 0.4;
   const V3 clo{-0.1, -0.2, -0.15}, chi{0.3, 0.05, 0.1};
   Expr sum;
-  ASSERT_TRUE(minkowski::meshConvexSum(axisBox(clo, chi), lPrism(h), 3, &sum));  // either order
+  ASSERT_TRUE(minkowski::meshConvexSum(axisBox(clo, chi), mesh_models::lPrismMesh(h), 3, &sum));  // either order
   const V3 lo1{clo[0], clo[1], clo[2]}, hi1{2 + chi[0], 1 + chi[1], h + chi[2]};
   const V3 lo2{clo[0], clo[1], clo[2]}, hi2{1 + chi[0], 2 + chi[1], h + chi[2]};
   std::mt19937 rng(5);
@@ -292,8 +290,8 @@ TEST(MeshConvexSum, SignOnlyBatchesClassifyEveryPointAsTheValues) {
   // and of the difference (whose inside is the negated outside).
   const V3 clo{-0.1, -0.2, -0.15}, chi{0.3, 0.05, 0.1};
   Expr sum, diff;
-  ASSERT_TRUE(minkowski::meshConvexSum(axisBox(clo, chi), lPrism(0.4), 3, &sum));
-  ASSERT_TRUE(minkowski::meshConvexDifference(lPrism(0.4), axisBox(clo, chi), 3, &diff));
+  ASSERT_TRUE(minkowski::meshConvexSum(axisBox(clo, chi), mesh_models::lPrismMesh(0.4), 3, &sum));
+  ASSERT_TRUE(minkowski::meshConvexDifference(mesh_models::lPrismMesh(0.4), axisBox(clo, chi), 3, &diff));
   for (const Expr* e : {&sum, &diff}) {
     TapePtr tape = Tape::compile(*e, 3);
     BatchEvaluator<double> values, signs;
@@ -339,7 +337,7 @@ TEST(MeshConvexSum, ClassesOfClusteredPointsHoldForThinAndThickOperands) {
   for (const double w : {0.002, 0.006, 0.012, 0.02, 0.3}) {
     const V3 clo{-w, -0.5 * w, -0.7 * w}, chi{0.8 * w, w, 0.3 * w};
     Expr sum;
-    ASSERT_TRUE(minkowski::meshConvexSum(lPrism(h), axisBox(clo, chi), 3, &sum));
+    ASSERT_TRUE(minkowski::meshConvexSum(mesh_models::lPrismMesh(h), axisBox(clo, chi), 3, &sum));
     const V3 lo1{clo[0], clo[1], clo[2]}, hi1{2 + chi[0], 1 + chi[1], h + chi[2]};
     const V3 lo2{clo[0], clo[1], clo[2]}, hi2{1 + chi[0], 2 + chi[1], h + chi[2]};
     auto exact = [&](const double* p) {
@@ -421,8 +419,8 @@ TEST(MeshConvexSum, NonConvexToolIsCutIntoConvexPieces) {
   std::mt19937 rng(23);
   for (const bool bigCut : {true, false}) {
     Expr sum;
-    ASSERT_TRUE(bigCut ? minkowski::meshConvexSum(lPrismAt(s, hb, shift), lPrism(h), 3, &sum)
-                       : minkowski::meshConvexSum(lPrism(h), lPrismAt(s, hb, shift), 3, &sum));
+    ASSERT_TRUE(bigCut ? minkowski::meshConvexSum(lPrismAt(s, hb, shift), mesh_models::lPrismMesh(h), 3, &sum)
+                       : minkowski::meshConvexSum(mesh_models::lPrismMesh(h), lPrismAt(s, hb, shift), 3, &sum));
     // The cut L is covered by its two overlapping bars (convex_cover.h), not ten pyramids.
     const auto term = minkowski::lookupExact(sum);
     ASSERT_TRUE(term);

@@ -18,6 +18,7 @@
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/expr.h"
 #include "frep/geometry/distance_fields.h"
+#include "frep/geometry/vec3.h"
 #include "frep/meshing/mesh.h"
 #include "frep/minkowski_algebra/path_sweep.h"
 #include "frep/minkowski_algebra/registry.h"
@@ -29,19 +30,16 @@ namespace mc = mesh_checks;
 namespace {
 
 using V3 = std::array<double, 3>;
-Expr X() { return Expr::x(0); }
-Expr Y() { return Expr::x(1); }
-Expr Z() { return Expr::x(2); }
+using mesh_models::X;
+using mesh_models::Y;
+using mesh_models::Z;
+using vec3::cross;
+using vec3::dot;
 
 double eval(const Expr& e, const V3& p) {
   TapePtr t = Tape::compile(e, 3);
   PointEvaluator pe;
   return pe.eval(*t, p.data());
-}
-
-double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-V3 cross(const V3& a, const V3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
 Expr meshExpr(const std::vector<double>& xyz, const std::vector<uint32_t>& tris, const char* name) {

@@ -38,10 +38,11 @@ std::vector<Affine> facePlanes(const std::vector<Vec3>& v, const std::vector<std
 std::optional<PolytopeUnion> polytopeUnionOfMesh(const Expr& e, std::string* what) {
   // A mesh standing for another model's set (a sampled operand) carries that model's error.
   const auto* field = e.op() == Op::Field ? dynamic_cast<const MeshField*>(e.node().fn.get()) : nullptr;
-  if (!field || field->setErrorBound() != 0) return std::nullopt;
+  // Sized before the world-space copy: a part of thousands of triangles is refused at once.
+  if (!field || field->setErrorBound() != 0 || field->numTriangles() > kMaxTriangles) return std::nullopt;
   bool isPolytope = false;
   const std::optional<mesh_operands::Mesh> m = mesh_operands::closedMeshOf(e, &isPolytope);
-  if (!m || isPolytope || m->t.size() > kMaxTriangles) return std::nullopt;
+  if (!m || isPolytope) return std::nullopt;
   const double scale = mesh_operands::extentOf(m->v), tol = 1e-9 * scale;
   std::vector<std::vector<Affine>> pieces;
   if (mesh_operands::convexOf(*m, scale)) {
