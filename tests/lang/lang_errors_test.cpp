@@ -190,6 +190,18 @@ TEST(LangDiagnostics, RecoversToReportSeveralErrors) {
   EXPECT_EQ(r.diagnostics[2].message, "unknown name 'zz'");
 }
 
+// The error limit may be reached while the arrays are declared, before any statement runs
+// (a fuzzer's find: the stop escaped and aborted the process).
+TEST(LangDiagnostics, ErrorLimitInArrayDeclarationsStopsCleanly) {
+  std::string decls = "  array v[1]";
+  for (int i = 0; i < 150; ++i) decls += ", v[1]";
+  CompileResult r = compile("m(x[3], a[1]) {\n" + decls + ";\n  m = 1;\n}\n", "arrays.hf");
+  EXPECT_FALSE(r.ok);
+  ASSERT_FALSE(r.diagnostics.empty());
+  EXPECT_LE(r.diagnostics.size(), DiagnosticSink::kMaxErrors + 1) << allDiagnostics(r);
+  EXPECT_EQ(r.diagnostics[0].message, "array 'v' is already declared");
+}
+
 TEST(LangDiagnostics, FailedConditionDoesNotCascade) {
   CompileResult r = compile(obj("if qq > 0 then t = 1; else t = 2; endif;\nm = t;"), "c.hf");
   ASSERT_EQ(r.diagnostics.size(), 1u) << allDiagnostics(r);

@@ -59,17 +59,18 @@ LoweredObject ObjectLowering::run() {
   LoweredObject out;
   out.info = ObjectInfo{obj_.name, obj_.xSize, obj_.aSize, obj_.sSize, obj_.loc.line};
   if (!obj_.headerOk) return out;
-  setUpEnvironment();
-  collectAssigned(obj_.body);
-  // Statements that failed to parse leave their targets poisoned, not unknown (no cascade).
-  for (const auto& name : obj_.brokenNames) {
-    if (env_.count(name)) continue;
-    Value v;
-    v.spelling = name;
-    v.state = Def::Poisoned;
-    env_[name] = v;
-  }
+  // Everything below may stop at the error limit, the array declarations included.
   try {
+    setUpEnvironment();
+    collectAssigned(obj_.body);
+    // Statements that failed to parse leave their targets poisoned, not unknown (no cascade).
+    for (const auto& name : obj_.brokenNames) {
+      if (env_.count(name)) continue;
+      Value v;
+      v.spelling = name;
+      v.state = Def::Poisoned;
+      env_[name] = v;
+    }
     execBlock(obj_.body);
     finish(out);
   } catch (const StopObject&) {
