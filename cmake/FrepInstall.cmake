@@ -19,6 +19,7 @@ install(TARGETS frep_core frep_lang_archive frep_lang frep_io EXPORT frepfarmTar
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(TARGETS frep frep-worker RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(TARGETS frep_vdb LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/frepfarm)  # loaded by both for .vdb work
 install(DIRECTORY core/include/ lang/include/ io/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h")
 # The man page (man 1 frep) and the bash completion, where bash-completion loads a command's

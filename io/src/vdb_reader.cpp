@@ -19,6 +19,7 @@
 #include "allocation_cap.h"
 #include "checked_grid.h"
 #include "vdb_checksum.h"
+#include "vdb_backend.h"
 #include "vdb_isolation.h"
 
 #include "frep/io/format_number.h"
@@ -144,7 +145,7 @@ CheckedGrid readCheckedFloatGrid(const std::string& path, const GridRequest& req
   return out;
 }
 
-SampledVdb readSampledVdb(const std::string& path, const std::string& gridName) {
+SampledVdb detail::openVdbReadSampled(const std::string& path, const std::string& gridName) {
   SampledVdb out;
   CheckedGrid checked = readCheckedFloatGrid(path, {path, gridName, "-o/--object", "mesh", "frep mesh"});
   const openvdb::FloatGrid::Ptr grid = checked.grid;

@@ -25,6 +25,7 @@
 
 #include "frep/io/error.h"
 #include "sealed_vdb_file.h"
+#include "vdb_backend.h"
 #include "vdb_checksum.h"
 
 #ifndef FREP_VERSION
@@ -343,10 +344,6 @@ struct GridAssembly {
 
 }  // namespace
 
-struct LevelSetBuilder::Tree : GridAssembly {
-  using GridAssembly::GridAssembly;
-};
-
 openvdb::FloatGrid::Ptr levelSetGrid(const SampleResult& result) {
   GridAssembly tree(result.grid, result.bandVoxels);
   tree.eager = std::is_sorted(result.leaves.begin(), result.leaves.end(),
@@ -391,15 +388,6 @@ const char* signDescription(VdbStore store) {
 }
 
 }  // namespace
-
-const char* storeName(VdbStore store) {
-  switch (store) {
-    case VdbStore::Raw: return "raw";
-    case VdbStore::Fog: return "fog";
-    case VdbStore::Sdf: break;
-  }
-  return "sdf";
-}
 
 namespace {
 
@@ -496,45 +484,40 @@ void writeGrid(const std::string& path, openvdb::FloatGrid::Ptr grid, const Grid
 
 }  // namespace
 
-void writeLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta) {
+namespace detail {
+
+void openVdbWriteLevelSet(const std::string& path, const SampleResult& result, const VdbMetadata& meta) {
   writeGrid(path, levelSetGrid(result), result.grid, result.bandVoxels, meta);
 }
 
-LevelSetBuilder::LevelSetBuilder(const GridSpec& grid, int bandVoxels, bool spillLeaves)
-    : tree_(std::make_unique<Tree>(grid, bandVoxels)) {
-  if (spillLeaves) tree_->spill = std::make_shared<LeafSpill>(tree_->background);
+namespace {
+
+class OpenVdbLevelSetTree final : public LevelSetTree {
+ public:
+  OpenVdbLevelSetTree(const GridSpec& grid, int bandVoxels, bool spillLeaves)
+      : tree_(std::make_unique<GridAssembly>(grid, bandVoxels)) {
+    if (spillLeaves) tree_->spill = std::make_shared<LeafSpill>(tree_->background);
+  }
+  void addTiles(const std::vector<Tile>& tiles) override { tree_->addTiles(tiles); }
+  void addLeaves(const std::vector<LeafBlock>& leaves) override { tree_->addLeaves(leaves); }
+  uint64_t leavesWrittenOut() const override { return tree_->spill ? tree_->spill->at.size() : 0; }
+  void write(const std::string& path, const VdbMetadata& meta) override {
+    const GridSpec g = tree_->g;
+    const int bandVoxels = tree_->bandVoxels;
+    openvdb::FloatGrid::Ptr grid = tree_->finish();
+    tree_.reset();
+    writeGrid(path, std::move(grid), g, bandVoxels, meta);
+  }
+
+ private:
+  std::unique_ptr<GridAssembly> tree_;
+};
+
+}  // namespace
+
+std::unique_ptr<LevelSetTree> openVdbLevelSetTree(const GridSpec& grid, int bandVoxels, bool spillLeaves) {
+  return std::make_unique<OpenVdbLevelSetTree>(grid, bandVoxels, spillLeaves);
 }
 
-LevelSetBuilder::~LevelSetBuilder() = default;
-
-uint64_t LevelSetBuilder::leavesWrittenOut() const { return tree_ && tree_->spill ? tree_->spill->at.size() : 0; }
-
-void LevelSetBuilder::addTiles(const std::vector<Tile>& tiles) {
-  if (!tree_) throw std::logic_error("LevelSetBuilder: tiles after write");
-  // A tile reaches only towards +x from its origin: one at or past the end in x of every leaf
-  // added so far covers none of them (the farm hands over x-slab by x-slab), and the tree is
-  // then the one all the tiles first would give.
-  for (const Tile& t : tiles)
-    if (leaves_ && t.origin[0] < leavesEndX_)
-      throw std::logic_error("LevelSetBuilder: a tile at x " + std::to_string(t.origin[0]) +
-                             " after leaves up to x " + std::to_string(leavesEndX_) + " it may cover");
-  tree_->addTiles(tiles);
-}
-
-void LevelSetBuilder::addLeaves(const std::vector<LeafBlock>& leaves) {
-  if (!tree_) throw std::logic_error("LevelSetBuilder: leaves after write");
-  tree_->addLeaves(leaves);
-  for (const LeafBlock& l : leaves) leavesEndX_ = std::max(leavesEndX_, int64_t(l.origin[0]) + kLeafDim);
-  leaves_ += leaves.size();
-}
-
-void LevelSetBuilder::write(const std::string& path, const VdbMetadata& meta) {
-  if (!tree_) throw std::logic_error("LevelSetBuilder: written twice");
-  const GridSpec g = tree_->g;
-  const int bandVoxels = tree_->bandVoxels;
-  openvdb::FloatGrid::Ptr grid = tree_->finish();
-  tree_.reset();
-  writeGrid(path, std::move(grid), g, bandVoxels, meta);
-}
-
+}  // namespace detail
 }  // namespace frep::io

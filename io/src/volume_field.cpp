@@ -12,6 +12,7 @@
 #include "frep/io/geometry_files.h"
 #include "frep/io/vdb_reader.h"
 #include "checked_grid.h"
+#include "vdb_backend.h"
 
 namespace frep::io {
 namespace {
@@ -106,8 +107,8 @@ class TempFile {
 
 }  // namespace
 
-std::shared_ptr<const DistanceField> readVolumeField(const std::string& path, const std::string& bytes,
-                                                     const std::string& gridName, uint64_t fileHash) {
+std::shared_ptr<const DistanceField> detail::openVdbReadVolumeField(const std::string& path, const std::string& bytes,
+                                                                   const std::string& gridName, uint64_t fileHash) {
   openvdb::initialize();
   TempFile tmp(bytes);
   const openvdb::FloatGrid::Ptr grid =

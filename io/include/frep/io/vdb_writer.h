@@ -11,6 +11,10 @@
 
 namespace frep::io {
 
+namespace detail {
+class LevelSetTree;
+}
+
 // What the grid holds: a true signed distance (default), the sampler's -f, or a fog volume.
 enum class VdbStore { Sdf, Raw, Fog };
 const char* storeName(VdbStore store);  // "sdf", "raw", "fog" (the --store values)
@@ -76,8 +80,7 @@ class LevelSetBuilder {
   void write(const std::string& path, const VdbMetadata& meta);
 
  private:
-  struct Tree;  // the OpenVDB grid being built (vdb_writer.cpp)
-  std::unique_ptr<Tree> tree_;
+  std::unique_ptr<detail::LevelSetTree> tree_;  // the OpenVDB grid being built (vdb_writer.cpp)
   uint64_t leaves_ = 0;
   int64_t leavesEndX_ = 0;  // past the largest x of the leaves added (addTiles' check)
 };
