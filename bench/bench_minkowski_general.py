@@ -32,7 +32,7 @@ operands, box_stl_ball for meshes) at the same resolution and the first toleranc
 every frep mesh is closed (unpaired edges 0). Never fails on time.
 
 Usage: bench/bench_minkowski_general.py [--quick] [--only case,...] [--frep build/bin/frep]
-       [--res 64,96,128] [--tolerances 0.1,0.02,0] [--timeout 300] [--keep DIR] [--no-peers]
+       [--res 12,16,20,24,32,48,64,72,96,128] [--tolerances 0.1,0.02,0] [--timeout 300] [--keep DIR] [--no-peers]
 """
 import argparse
 import json
@@ -379,7 +379,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--frep", default=os.path.join(ROOT, "build", "bin", "frep"))
     ap.add_argument("--openscad", default="/usr/bin/openscad")
-    ap.add_argument("--res", default="24,32,48,64,96,128")
+    ap.add_argument("--res", default="12,16,20,24,32,48,64,72,96,128")
     ap.add_argument("--fn", default="12,24,48", help="peers' sphere segments ($fn), one run each")
     ap.add_argument("--tolerances", default="0.1,0.02,0",
                     help="frep mesh --tolerance values, each at every --res (the first: the per-voxel baseline)")
