@@ -128,6 +128,7 @@ def check_dockerfile(compose_programs):
     elif subprocess.run(["which", "dpkg"], stdout=subprocess.DEVNULL).returncode == 0:
         with Check("Dockerfile: runtime-package pipeline finds the libraries' packages"):
             cmd = m.group(1).replace("\\\n", " ").replace("/usr/local/bin/", BIN_DIR + "/")
+            cmd = cmd.replace("/usr/local/lib/frepfarm/", BIN_DIR + "/")  # the module, next to them here
             cmd = cmd.replace("> /runtime-packages.txt", "")
             p = subprocess.run(["bash", "-o", "pipefail", "-c", cmd], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, timeout=300)
@@ -135,6 +136,9 @@ def check_dockerfile(compose_programs):
             require(p.returncode == 0, f"pipeline failed: {p.stderr.strip()}")
             require(any(x.startswith("libzmq") for x in pkgs) and "libc6" in pkgs,
                     f"expected libzmq5 and libc6 among {pkgs}")
+            # OpenVDB comes in through the module only (the programs load it for .vdb work).
+            require("libfrep_vdb.so" in cmd and any(x.startswith("libopenvdb") for x in pkgs),
+                    f"the module's libraries (libopenvdb) are not among {pkgs}")
 
 
 def check_compose(docs, frep_help, worker_help):
