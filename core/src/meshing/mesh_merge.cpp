@@ -171,14 +171,15 @@ std::string closureDefect(const std::vector<std::array<uint32_t, 3>>& triangles,
   tbb::parallel_sort(edges.begin(), edges.end());
   for (size_t i = 0; i < edges.size(); ++i) {
     const uint32_t a = uint32_t(edges[i] >> 32), b = uint32_t(edges[i]);
-    const std::string name = std::to_string(a) + "->" + std::to_string(b);
+    // The edge's name only for the first defect: every mesh written passes through here.
+    auto name = [&] { return std::to_string(a) + "->" + std::to_string(b); };
     if (i + 1 < edges.size() && edges[i + 1] == edges[i]) {
-      if (first.empty()) first = "directed edge " + name + " occurs twice";
+      if (first.empty()) first = "directed edge " + name() + " occurs twice";
       ++bad;
       continue;
     }
     if (!std::binary_search(edges.begin(), edges.end(), (uint64_t(b) << 32) | a)) {
-      if (first.empty()) first = "edge " + name + " has no opposite";
+      if (first.empty()) first = "edge " + name() + " has no opposite";
       ++bad;
     }
   }
