@@ -3,11 +3,14 @@
 // BVH instead of the paper's scan of every triangle; sign from the closest feature's
 // angle-weighted pseudonormal on closed meshes and from the generalised winding number on open
 // ones, instead of the ray parity of eq. 7 (distance_fields.h).
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
 #include <map>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "frep/geometry/distance_fields.h"
 
@@ -266,10 +269,13 @@ void MeshField::searchAll(const double* p, Nearest& n) const {
 // The candidates of the lattice cell holding p: every triangle that can be nearest to some
 // point of the cell. With c the cell's centre and T_c its nearest triangle, any point of the
 // cell is within U = |c - T_c| + half the cell's diagonal of T_c, so a triangle farther than U
-// from the whole cell (by its box or its plane) is never nearest there, nor tied. Nothing when
-// p is outside the lattice or the cell has too many candidates.
+// from the whole cell (by its box, its plane or its distance from c less half the diagonal) is
+// never nearest there, nor tied. Nothing when p is outside the lattice or the cell has too
+// many candidates. The list holds pairs (slot, key), key |c - T| as float bits rounded down,
+// sorted by key: a query at p stops at the first key with key - |p - c| beyond its best
+// distance (nearestTriangle), as |p - T| >= |c - T| - |p - c|. count: the pairs.
 const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count) const {
-  return CellLists::at(id_, lattice_, p, count, [&](const double* lo, const double* hi, std::vector<uint32_t>& out) {
+  const uint32_t* list = CellLists::at(id_, lattice_, p, count, [&](const double* lo, const double* hi, std::vector<uint32_t>& out) {
     Bvh::Box box;
     for (int k = 0; k < 3; ++k) box.lo[k] = lo[k], box.hi[k] = hi[k];
     const double cellSize = lattice_.size;
@@ -281,8 +287,10 @@ const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count) cons
     // hierarchy: only cells within a few of their sizes of the surface are worth a list.
     if (c.best2 > 16 * cellSize * cellSize) return false;
     const double halfDiag = 0.5 * std::sqrt(3.0) * cellSize;
-    const double reach = (std::sqrt(c.best2) + halfDiag) * (1 + 1e-9) + 1e-12 * scale_;
-    const size_t first = out.size();
+    const double slack = 1e-12 * scale_;  // a point placed in the cell from a few ulps outside
+    const double reach = (std::sqrt(c.best2) + halfDiag) * (1 + 1e-9) + slack;
+    thread_local std::vector<std::pair<float, uint32_t>> found;
+    found.clear();
     bool fits = true;
     bvh_.nearBox(box, reach, [&](uint32_t slot, uint32_t) {
       const double* v = &corners_[9 * size_t(slot)];
@@ -295,14 +303,31 @@ const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count) cons
       if (gap2 > reach * reach) return true;
       const double* pl = &slotPlanes_[4 * size_t(slot)];
       const double spread = 0.5 * cellSize * (std::abs(pl[0]) + std::abs(pl[1]) + std::abs(pl[2]));
-      if (std::abs(dot(pl, centre) - pl[3]) - spread > reach) return true;
-      out.push_back(slot);
-      fits = out.size() - first <= kMaxCandidates;
+      const double planeGap = std::abs(dot(pl, centre) - pl[3]) - spread;
+      if (planeGap > reach) return true;
+      // The tightest: every point x of the cell has |x - T| >= |c - T| - |x - c| (dc: |c - T|
+      // rounded down).
+      double qq[3];
+      int region;
+      const double dc = std::sqrt(triangleDist2(centre, v, v + 3, v + 6, qq, region)) * (1 - 1e-9);
+      if (dc - halfDiag * (1 + 1e-9) - slack > reach) return true;
+      float g = float(dc);  // the key, rounded down again
+      if (double(g) > dc) g = std::nextafter(g, 0.0f);
+      found.push_back({g, slot});
+      fits = found.size() <= kMaxCandidates;
       return fits;  // too many: the hierarchy answers here
     });
-    std::sort(out.begin() + long(first), out.end());
-    return fits;
+    if (!fits) return false;
+    std::sort(found.begin(), found.end());
+    for (const auto& f : found) {
+      uint32_t bits;
+      std::memcpy(&bits, &f.first, sizeof bits);
+      out.push_back(f.second), out.push_back(bits);
+    }
+    return true;
   });
+  count /= 2;
+  return list;
 }
 
 int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, double& best2, double start2) const {
@@ -319,7 +344,23 @@ int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, 
       if (slot != warm) offer(p, slot, n);
     if (n.found) tWarm = {id_, n.slot};
   } else if (gCandidateCells.load(std::memory_order_relaxed) && (cands = cellCandidates(p, count))) {
-    for (uint32_t i = 0; i < count; ++i) offer(p, cands[i], n);
+    // Near-first: once a candidate's lower bound key - |p - c| exceeds the best distance, so do
+    // all the later ones' (a tie needs a distance equal to the best; the margins: rounding of
+    // |p - c|, and p placed in the cell from a few ulps outside). The cell is cellCandidates'.
+    uint64_t key;
+    int64_t ijk[3];
+    double lo[3], hi[3], pc[3];
+    lattice_.cellOf(p, key, ijk);
+    lattice_.cellBox(ijk, lo, hi);
+    for (int k = 0; k < 3; ++k) pc[k] = p[k] - 0.5 * (lo[k] + hi[k]);
+    const double fromCentre = std::sqrt(dot(pc, pc)) * (1 + 1e-9) + 1e-12 * scale_;
+    for (uint32_t i = 0; i < count; ++i) {
+      float g;
+      std::memcpy(&g, &cands[2 * i + 1], sizeof g);
+      const double gap = double(g) - fromCentre;
+      if (gap > 0 && gap * gap > n.best2 * (1 + 1e-9)) break;
+      offer(p, cands[2 * i], n);
+    }
   } else {
     // Warm start: the previous nearest triangle's distance, a little above so that it and its
     // ties still count, bounds the search.
