@@ -274,14 +274,25 @@ void MeshField::searchAll(const double* p, Nearest& n) const {
 // many candidates. The list holds pairs (slot, key), key |c - T| as float bits rounded down,
 // sorted by key: a query at p stops at the first key with key - |p - c| beyond its best
 // distance (nearestTriangle), as |p - T| >= |c - T| - |p - c|. count: the pairs.
-const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count) const {
-  const uint32_t* list = CellLists::at(id_, lattice_, p, count, [&](const double* lo, const double* hi, std::vector<uint32_t>& out) {
-    Bvh::Box box;
-    for (int k = 0; k < 3; ++k) box.lo[k] = lo[k], box.hi[k] = hi[k];
+const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, double* centre) const {
+  uint64_t key;
+  int64_t ijk[3];
+  if (!lattice_.cellOf(p, key, ijk)) return nullptr;
+  Bvh::Box box;
+  lattice_.cellBox(ijk, box.lo, box.hi);
+  for (int k = 0; k < 3; ++k) centre[k] = 0.5 * (box.lo[k] + box.hi[k]);
+  const uint32_t* list = CellLists::get(id_, key, count, [&](std::vector<uint32_t>& out) {
     const double cellSize = lattice_.size;
-    double centre[3];
-    for (int k = 0; k < 3; ++k) centre[k] = 0.5 * (box.lo[k] + box.hi[k]);
     Nearest c{std::numeric_limits<double>::infinity()};
+    // Seeded by this thread's last nearest triangle (a query nearby), a little above its
+    // distance so that the nearest and its ties still count: only best2 is read, the same
+    // whatever the seed.
+    if (tWarm.field == id_) {
+      double qq[3];
+      int region;
+      const double* v = &corners_[9 * size_t(tWarm.slot)];
+      c.best2 = triangleDist2(centre, v, v + 3, v + 6, qq, region) * (1 + 2e-9) + 1e-300;
+    }
     searchAll(centre, c);
     // A cell far from the mesh (its reach a sphere over many triangles) is left to the
     // hierarchy: only cells within a few of their sizes of the surface are worth a list.
@@ -335,6 +346,7 @@ int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, 
   const size_t nt = tris_.size() / 3;
   uint32_t count = 0;
   const uint32_t* cands = nullptr;
+  double centre[3];  // of the cell of the candidates
   if (nt <= 16) {  // a few triangles: all of them, no hierarchy
     // This thread's last nearest first: its distance lets the plane test skip most of the
     // others (a convex polytope's facets). The answer is canonical, so the order is free.
@@ -343,16 +355,12 @@ int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, 
     for (uint32_t slot = 0; slot < nt; ++slot)
       if (slot != warm) offer(p, slot, n);
     if (n.found) tWarm = {id_, n.slot};
-  } else if (gCandidateCells.load(std::memory_order_relaxed) && (cands = cellCandidates(p, count))) {
+  } else if (gCandidateCells.load(std::memory_order_relaxed) && (cands = cellCandidates(p, count, centre))) {
     // Near-first: once a candidate's lower bound key - |p - c| exceeds the best distance, so do
     // all the later ones' (a tie needs a distance equal to the best; the margins: rounding of
     // |p - c|, and p placed in the cell from a few ulps outside). The cell is cellCandidates'.
-    uint64_t key;
-    int64_t ijk[3];
-    double lo[3], hi[3], pc[3];
-    lattice_.cellOf(p, key, ijk);
-    lattice_.cellBox(ijk, lo, hi);
-    for (int k = 0; k < 3; ++k) pc[k] = p[k] - 0.5 * (lo[k] + hi[k]);
+    double pc[3];
+    sub(p, centre, pc);
     const double fromCentre = std::sqrt(dot(pc, pc)) * (1 + 1e-9) + 1e-12 * scale_;
     for (uint32_t i = 0; i < count; ++i) {
       float g;
@@ -361,6 +369,7 @@ int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, 
       if (gap > 0 && gap * gap > n.best2 * (1 + 1e-9)) break;
       offer(p, cands[2 * i], n);
     }
+    if (n.found) tWarm = {id_, n.slot};
   } else {
     // Warm start: the previous nearest triangle's distance, a little above so that it and its
     // ties still count, bounds the search.
