@@ -273,7 +273,7 @@ void MeshField::searchAll(const double* p, Nearest& n) const {
 // never nearest there, nor tied. Nothing when p is outside the lattice or the cell has too
 // many candidates. The list holds pairs (slot, key), key |c - T| as float bits rounded down,
 // sorted by key: a query at p stops at the first key with key - |p - c| beyond its best
-// distance (nearestTriangle), as |p - T| >= |c - T| - |p - c|. count: the pairs.
+// distance (nearestTriangle), as |p - T| >= |c - T| - |p - c|. count: the pairs; centre: c.
 const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, double* centre) const {
   uint64_t key;
   int64_t ijk[3];

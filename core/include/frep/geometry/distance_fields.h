@@ -155,7 +155,7 @@ class MeshField : public DistanceField {
   std::vector<double> faceN_, vertN_, edgeN_;  // pseudonormals
   std::vector<uint32_t> triEdge_;              // 3 edge ids per triangle (edge k: v[k]-v[k+1])
   std::vector<double> corners_;                // 9 coordinates per triangle, in bvh_.order()
-  std::vector<double> slotPlanes_;             // unit normal, offset, centroid, radius; same order
+  std::vector<double> slotPlanes_;             // unit normal and offset per triangle, same order
   uint64_t id_ = CellLists::newOwner();        // per-thread caches' key (an address may be reused)
   uint64_t classId_ = CellLists::newOwner();   // the lists of classValue's cells
   CellLattice lattice_;                        // of the candidate cells
