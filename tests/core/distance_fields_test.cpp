@@ -400,6 +400,42 @@ TEST(MeshField, AnswersDoNotDependOnTheOrderOfQueriesOrTheCells) {
   }
 }
 
+// A cell's list is walked nearest to its centre first and a query stops at the first triangle
+// whose |c - T| - |p - c| exceeds its best distance. Pairs of points a hair either side of
+// offsets of a fine torus 1 to 4 lattice cells out and in (the simplifier's inside/outside
+// pairs, where the lists are longest): the same bits through the cells as through the whole
+// hierarchy (a stop by |c - T| alone fails here), and the brute force's distance.
+TEST(MeshField, NearFirstCellListsStopWithTheSameAnswers) {
+  const Soup soup = torus(0.8, 0.3, 64, 32);
+  MeshField m(soup.xyz, soup.tris, "fine torus");
+  const double cell = 2.2 / 128;  // the lattice: 128 cells along the longest side
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> angle(0, 2 * M_PI), offset(-4 * cell, 4 * cell);
+  std::vector<std::array<double, 3>> pts;
+  for (int i = 0; i < 2000; ++i) {
+    const double u = angle(rng), w = angle(rng), s = offset(rng);
+    const double n[3] = {std::cos(w) * std::cos(u), std::cos(w) * std::sin(u), std::sin(w)};
+    for (double e : {-1e-3, 1e-3}) {
+      const double t = 0.3 + s + e;
+      pts.push_back({0.8 * std::cos(u) + t * n[0], 0.8 * std::sin(u) + t * n[1], t * n[2]});
+    }
+  }
+  std::vector<std::array<double, 4>> cells;
+  for (const auto& p : pts) {
+    std::array<double, 4> a;
+    a[0] = m.gradient(p.data(), &a[1]);
+    cells.push_back(a);
+  }
+  MeshField::useCandidateCells(false);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    std::array<double, 4> a;
+    a[0] = m.gradient(pts[i].data(), &a[1]);
+    ASSERT_EQ(std::memcmp(&a, &cells[i], sizeof a), 0) << "point " << i;
+  }
+  MeshField::useCandidateCells(true);
+  for (size_t i = 0; i < pts.size(); i += 3) ASSERT_NEAR(std::fabs(cells[i][0]), bruteDist3D(soup, pts[i].data()), 1e-12);
+}
+
 // A mesh of at most 16 triangles is scanned whole, this thread's last nearest triangle first:
 // on the lattice points around a cube (12 triangles; ties between faces, edges and corners) the
 // value and gradient (the closest point chosen among ties) are bit for bit the same in order,
