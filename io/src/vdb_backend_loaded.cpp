@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <climits>
-#include <mutex>
 #include <string>
 
 #include <typeinfo>
@@ -84,9 +83,7 @@ void keepForModule(std::vector<LeafBlock>& leaves, std::vector<Tile>& tiles) {
 }
 
 const VdbBackend& vdbBackend() {
-  static std::once_flag once;
-  static const VdbBackend* backend = nullptr;
-  std::call_once(once, [] { backend = load(); });  // a throw leaves it to be tried again
+  static const VdbBackend* const backend = load();  // thread-safe; a throw leaves it to be tried again
   return *backend;
 }
 
