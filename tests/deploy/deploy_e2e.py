@@ -92,39 +92,39 @@ def run_topology(what, master_argv, worker_argvs, worker_env, tmp, out_vdb):
 
 
 
+def run_local_recipe(name, spec, model_name, out_dir, point_workers):
+    """A recipe's master and two workers as local processes on a free port: the master's argv
+    localized, the workers' pointed at it by point_workers(argv, env, port) (a flag or FREP_MASTER)."""
+    with tempfile.TemporaryDirectory(prefix="frep-%s-" % name) as tmp:
+        model = os.path.join(tmp, model_name)
+        with open(model, "w") as f:
+            f.write(SPHERE)
+        port = free_port()
+        out_vdb = os.path.join(tmp, out_dir, os.path.splitext(model_name)[0] + ".vdb")
+        os.makedirs(os.path.dirname(out_vdb))
+        margv = localize_master(spec["master"], model, out_vdb, port)
+        wargv = list(spec["worker"])
+        wargv[0] = os.path.join(BIN_DIR, "frep-worker")
+        env = dict(spec.get("env", {}))
+        wargv = point_workers(wargv, env, port)
+        run_topology(name, margv, [wargv, wargv], env, tmp, out_vdb)
+
+
 def e2e_compose(c):
     with Check("docker-compose topology as local processes (master + 2 workers)"):
         require(c, "the compose file did not pass its structure check")
-        with tempfile.TemporaryDirectory(prefix="frep-compose-") as tmp:
-            model = os.path.join(tmp, "sphere.hf")
-            with open(model, "w") as f:
-                f.write(SPHERE)
-            port = free_port()
-            out_vdb = os.path.join(tmp, "out", "sphere.vdb")
-            os.makedirs(os.path.dirname(out_vdb))
-            margv = localize_master(c["master"], model, out_vdb, port)
-            wargv = list(c["worker"])
-            wargv[0] = os.path.join(BIN_DIR, "frep-worker")
-            wargv = set_flag(wargv, "--connect", local_endpoint(flag_value(wargv, "--connect"), port))
-            run_topology("compose", margv, [wargv, wargv], {}, tmp, out_vdb)
+        run_local_recipe("compose", c, "sphere.hf", "out", lambda argv, env, port: set_flag(
+            argv, "--connect", local_endpoint(flag_value(argv, "--connect"), port)))
 
 
 def e2e_k8s(k):
+    def point_workers(argv, env, port):
+        env["FREP_MASTER"] = local_endpoint(env.get("FREP_MASTER"), port)
+        return argv
+
     with Check("Kubernetes topology as local processes (master + 2 workers, FREP_MASTER)"):
         require(k, "the manifests did not pass their structure check")
-        with tempfile.TemporaryDirectory(prefix="frep-k8s-") as tmp:
-            model = os.path.join(tmp, "model.hf")
-            with open(model, "w") as f:
-                f.write(SPHERE)
-            port = free_port()
-            out_vdb = os.path.join(tmp, "output", "model.vdb")
-            os.makedirs(os.path.dirname(out_vdb))
-            margv = localize_master(k["master"], model, out_vdb, port)
-            wargv = list(k["worker"])
-            wargv[0] = os.path.join(BIN_DIR, "frep-worker")
-            env = dict(k["env"])
-            env["FREP_MASTER"] = local_endpoint(env.get("FREP_MASTER"), port)
-            run_topology("k8s", margv, [wargv, wargv], env, tmp, out_vdb)
+        run_local_recipe("k8s", k, "model.hf", "output", point_workers)
 
 
 SRUN_STUB = r"""#!/usr/bin/env bash

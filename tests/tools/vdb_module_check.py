@@ -34,8 +34,8 @@ def demangled(names):
     return out.split("\n")
 
 
-needed_by_module = {s for s, d in zip(sorted(symbols(MODULE, "--undefined-only")),
-                                      demangled(symbols(MODULE, "--undefined-only"))) if "frep::" in d}
+undefined = sorted(symbols(MODULE, "--undefined-only"))
+needed_by_module = {s for s, d in zip(undefined, demangled(undefined)) if "frep::" in d}
 check(len(needed_by_module) > 0, "the module calls frepfarm functions of the program (%d)" % len(needed_by_module))
 for program in (FREP, WORKER):
     name = os.path.basename(program)
