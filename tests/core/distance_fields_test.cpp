@@ -408,7 +408,7 @@ TEST(MeshField, AnswersDoNotDependOnTheOrderOfQueriesOrTheCells) {
 TEST(MeshField, NearFirstCellListsStopWithTheSameAnswers) {
   const Soup soup = torus(0.8, 0.3, 64, 32);
   MeshField m(soup.xyz, soup.tris, "fine torus");
-  const double cell = 2.2 / 128;  // the lattice: 128 cells along the longest side
+  const double cell = 2.2 / 64;  // the lattice: 64 cells along the longest side
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> angle(0, 2 * M_PI), offset(-4 * cell, 4 * cell);
   std::vector<std::array<double, 3>> pts;

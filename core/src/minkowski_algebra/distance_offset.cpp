@@ -2,12 +2,15 @@
 // (distance_offset.h).
 #include "frep/minkowski_algebra/distance_offset.h"
 
+#include <cmath>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "frep/extremum/extremum.h"
 #include "frep/geometry/field.h"
+#include "frep/geometry/mesh_offset_field.h"
 #include "frep/minkowski_algebra/convex_polytope.h"
 #include "frep/minkowski_algebra/registry.h"
 
@@ -62,7 +65,16 @@ std::string ballText(const Ball& b) {
 // registered as a BallOffset term.
 Expr offsetField(const Expr& f, const Ball& b, bool erosion, ExactTerm t) {
   Expr r;
-  if (!erosion) {
+  const auto mesh = f.op() == Op::Field ? std::dynamic_pointer_cast<const MeshField>(f.node().fn) : nullptr;
+  if (mesh && mesh->check().closed() && b.radius > 0 && std::isfinite(b.radius)) {
+    // A mesh's offset as one field: the same values, and inside/outside from a triangle within
+    // r (mesh_offset_field.h).
+    const Expr g = fieldCall(std::make_shared<MeshOffsetField>(mesh, erosion ? -b.radius : b.radius), f.arg(0),
+                             f.arg(1), f.arg(2));
+    std::vector<Expr> xs;
+    for (uint32_t i = 0; i < 3; ++i) xs.push_back(erosion ? Expr::x(i) + Expr(b.centre[i]) : Expr::x(i) - b.centre[i]);
+    r = remap(g, xs);
+  } else if (!erosion) {
     MinkowskiOptions o;
     o.aIsDistance = o.bIsBall = true;
     o.ballCenter.assign(b.centre.begin(), b.centre.end());

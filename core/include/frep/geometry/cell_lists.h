@@ -27,7 +27,8 @@ struct CellLattice {
 
 class CellLists {
  public:
-  static constexpr uint32_t kNone = UINT32_MAX;  // a cell given no list
+  static constexpr uint32_t kNone = UINT32_MAX;         // a cell given no list
+  static constexpr uint32_t kPending = UINT32_MAX - 1;  // a cell seen once: no list yet
   // A key for a new owner (a field): the lists of different owners never mix.
   static uint64_t newOwner();
   // The list of the cell of `lattice` holding p, built by build(lo, hi, out) from the cell's
@@ -45,23 +46,30 @@ class CellLists {
     });
   }
   // The list of `key` for `owner` on this thread, built by build(out) (appending to out and
-  // returning false for "no list") the first time; nullptr when the cell has no list.
+  // returning false for "no list") the second time a query reaches the cell; nullptr when the
+  // cell has no list, or none yet. A list costs a few queries without one: a cell that sees
+  // one query only (a coarse grid, a pass over scattered points) is not worth it.
   template <typename Build>
   static const uint32_t* get(uint64_t owner, uint64_t key, uint32_t& count, Build&& build) {
     Lists& l = listsOf(owner);
-    if (!(l.hasLast && l.lastKey == key)) {  // runs of queries stay in one cell
+    if (!(l.hasLast && l.lastKey == key) || l.last.second == kPending) {  // runs of queries stay in one cell
       Slot* slot = l.find(key);
       if (slot->key != key) {
-        if (l.items.size() > kMaxItems) l.clear(), slot = l.find(key);
+        *slot = {key, 0, kPending};
+        if (++l.used * 2 > l.slots.size()) slot = l.grow(key);
+      } else if (slot->count == kPending) {
+        if (l.items.size() > kMaxItems) {
+          l.clear(), slot = l.find(key);
+          ++l.used;
+        }
         const uint32_t first = uint32_t(l.items.size());
         const bool has = build(l.items);
         if (!has) l.items.resize(first);
         *slot = {key, first, has ? uint32_t(l.items.size() - first) : kNone};
-        if (++l.used * 2 > l.slots.size()) slot = l.grow(key);
       }
       l.hasLast = true, l.lastKey = key, l.last = {slot->first, slot->count};
     }
-    if (l.last.second == kNone) return nullptr;
+    if (l.last.second >= kPending) return nullptr;
     count = l.last.second;
     return l.items.data() + l.last.first;
   }

@@ -121,6 +121,10 @@ class MeshField : public DistanceField {
   // value(p). For callers that ask only inside or outside.
   double classValue(const double p[3]) const;
   double gradient(const double p[3], double g[3]) const override;
+  // The class of value(p) + level (>= 0 inside; a value of 0 may read as outside), level != 0:
+  // a ball sum's (r) or difference's (-r) offset, mostly from a triangle within r rather than
+  // the nearest (mesh_offset_field.h). Any other call: value(p) + level.
+  double offsetClass(const double p[3], double level) const;
   uint64_t contentHash() const override { return hash_; }
   std::string describe() const override { return name_; }
   const MeshCheck& check() const { return check_; }
@@ -163,7 +167,8 @@ class MeshField : public DistanceField {
   struct Nearest;  // mesh_field.cpp
   void offer(const double* p, uint32_t slot, Nearest& n) const;
   void searchAll(const double* p, Nearest& n) const;
-  const uint32_t* cellCandidates(const double* p, uint32_t& count, double* centre) const;
+  const uint32_t* cellCandidates(const double* p, uint32_t& count, double* centre, double& centreValue) const;
+  bool insideAt(const double* p, uint32_t t, int region, const double* q, bool bySlot = true) const;
   double setError_ = 0;
   Bvh bvh_;
   MeshCheck check_;
