@@ -7,12 +7,12 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
-#include <map>
 #include <stdexcept>
 #include <utility>
 #include <vector>
 
 #include "frep/geometry/distance_fields.h"
+#include "geometry/mesh_topology.h"
 
 namespace frep {
 
@@ -97,14 +97,7 @@ MeshField::MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::s
   for (uint32_t i : tris)
     if (i >= nv) throw std::invalid_argument("a triangle refers to vertex " + std::to_string(i + 1) + " of " + std::to_string(nv));
   // Weld equal coordinates (STL stores each triangle's corners separately).
-  std::map<std::array<double, 3>, uint32_t> index;
-  std::vector<uint32_t> remapV(nv);
-  for (size_t i = 0; i < nv; ++i) {
-    std::array<double, 3> key{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
-    auto it = index.emplace(key, uint32_t(xyz_.size() / 3));
-    if (it.second) xyz_.insert(xyz_.end(), key.begin(), key.end());
-    remapV[i] = it.first->second;
-  }
+  const std::vector<uint32_t> remapV = mesh_topology::weldVertices(xyz, xyz_);
   for (size_t t = 0; t < tris.size(); t += 3) {
     const uint32_t a = remapV[tris[t]], b = remapV[tris[t + 1]], c = remapV[tris[t + 2]];
     if (a == b || b == c || c == a) {
@@ -114,7 +107,8 @@ MeshField::MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::s
     tris_.insert(tris_.end(), {a, b, c});
   }
   if (tris_.empty()) throw std::invalid_argument("every triangle of the mesh is degenerate");
-  orientConsistently();
+  const mesh_topology::EdgeUses edges = mesh_topology::edgeUsesOf(tris_);
+  orientConsistently(edges);
   // An inside-out mesh (clockwise seen from outside) would make every sign wrong: orient it so
   // that the enclosed volume is positive.
   if (volume() < 0.0)
@@ -123,8 +117,6 @@ MeshField::MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::s
   faceN_.assign(3 * nt, 0.0);
   vertN_.assign(xyz_.size(), 0.0);
   triEdge_.resize(3 * nt);
-  std::map<std::pair<uint32_t, uint32_t>, uint32_t> edgeId;
-  std::vector<uint32_t> edgeUses;
   std::vector<Bvh::Box> boxes(nt);
   for (size_t t = 0; t < nt; ++t) {
     const double* v[3] = {&xyz_[3 * tris_[3 * t]], &xyz_[3 * tris_[3 * t + 1]], &xyz_[3 * tris_[3 * t + 2]]};
@@ -139,28 +131,32 @@ MeshField::MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::s
       normalise(u), normalise(w);
       const double ang = std::acos(std::max(-1.0, std::min(1.0, dot(u, w))));
       for (int k = 0; k < 3; ++k) vertN_[3 * tris_[3 * t + c] + k] += ang * n[k];
-      const uint32_t i0 = tris_[3 * t + c], i1 = tris_[3 * t + (c + 1) % 3];
-      auto key = std::make_pair(std::min(i0, i1), std::max(i0, i1));
-      auto it = edgeId.emplace(key, uint32_t(edgeUses.size()));
-      if (it.second) edgeUses.push_back(0), edgeN_.insert(edgeN_.end(), {0.0, 0.0, 0.0});
-      const uint32_t e = it.first->second;
-      ++edgeUses[e];
-      for (int k = 0; k < 3; ++k) edgeN_[3 * e + k] += n[k];
-      triEdge_[3 * t + c] = e;
     }
     for (int k = 0; k < 3; ++k) {
       boxes[t].lo[k] = std::min({v[0][k], v[1][k], v[2][k]});
       boxes[t].hi[k] = std::max({v[0][k], v[1][k], v[2][k]});
     }
   }
-  for (const auto& kv : edgeId) {
-    const uint32_t uses = edgeUses[kv.second];
-    if (uses == 1) {
+  // One edge per key, numbered in key order; its pseudonormal sums its triangles' normals in
+  // triangle order. A flip may have moved a use's corner: the triangle's corner that runs along
+  // the key is the one.
+  for (size_t i = 0, ne = 0; i < edges.key.size(); ++ne) {
+    const uint64_t key = edges.key[i];
+    edgeN_.insert(edgeN_.end(), {0.0, 0.0, 0.0});
+    size_t j = i;
+    for (; j < edges.key.size() && edges.key[j] == key; ++j) {
+      const size_t t = edges.use[j] / 3;
+      for (size_t c = 0; c < 3; ++c)
+        if (mesh_topology::edgeKey(tris_[3 * t + c], tris_[3 * t + (c + 1) % 3]) == key) triEdge_[3 * t + c] = uint32_t(ne);
+      for (int k = 0; k < 3; ++k) edgeN_[3 * ne + k] += faceN_[3 * t + k];
+    }
+    if (j - i == 1) {
       ++check_.openEdges;
-      if (check_.firstOpen.size() < 5) check_.firstOpen.push_back({kv.first.first, kv.first.second});
-    } else if (uses > 2) {
+      if (check_.firstOpen.size() < 5) check_.firstOpen.push_back({uint32_t(key >> 32), uint32_t(key)});
+    } else if (j - i > 2) {
       ++check_.nonManifoldEdges;
     }
+    i = j;
   }
   bvh_.build(boxes);
   // Each triangle's corners in one block, in the hierarchy's leaf order: a query reads the
@@ -194,22 +190,25 @@ MeshField::MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::s
   hash_ = h;
 }
 
-void MeshField::orientConsistently() {
+void MeshField::orientConsistently(const mesh_topology::EdgeUses& edges) {
   // Breadth-first over triangles joined by manifold edges: a neighbour that runs a shared edge in
   // the same direction is flipped (patches or STL files with mixed windings).
   const size_t nt = tris_.size() / 3;
-  std::map<std::pair<uint32_t, uint32_t>, std::vector<uint32_t>> byEdge;
-  for (uint32_t t = 0; t < nt; ++t)
-    for (int c = 0; c < 3; ++c) {
-      const uint32_t a = tris_[3 * t + c], b = tris_[3 * t + (c + 1) % 3];
-      byEdge[{std::min(a, b), std::max(a, b)}].push_back(t);
+  // across[3 t + c]: the other triangle of the edge from corner c to c + 1 of t as given, when
+  // that edge has two uses (a manifold edge).
+  std::vector<uint32_t> across(3 * nt, UINT32_MAX);
+  for (size_t i = 0; i + 1 < edges.key.size(); ++i)
+    if (edges.key[i] == edges.key[i + 1] && (i == 0 || edges.key[i - 1] != edges.key[i]) &&
+        (i + 2 == edges.key.size() || edges.key[i + 2] != edges.key[i])) {
+      across[edges.use[i]] = edges.use[i + 1] / 3;
+      across[edges.use[i + 1]] = edges.use[i] / 3;
     }
   auto runs = [&](uint32_t t, uint32_t a, uint32_t b) {  // does t have the directed edge a->b?
     for (int c = 0; c < 3; ++c)
       if (tris_[3 * t + c] == a && tris_[3 * t + (c + 1) % 3] == b) return true;
     return false;
   };
-  std::vector<char> seen(nt, 0);
+  std::vector<char> seen(nt, 0), flipped(nt, 0);
   std::vector<uint32_t> queue;
   for (uint32_t start = 0; start < nt; ++start) {
     if (seen[start]) continue;
@@ -219,12 +218,11 @@ void MeshField::orientConsistently() {
       const uint32_t t = queue[q];
       for (int c = 0; c < 3; ++c) {
         const uint32_t a = tris_[3 * t + c], b = tris_[3 * t + (c + 1) % 3];
-        const auto& users = byEdge[{std::min(a, b), std::max(a, b)}];
-        if (users.size() != 2) continue;
-        const uint32_t u = users[0] == t ? users[1] : users[0];
-        if (seen[u]) continue;
+        // Corner c of a flipped (a, c', b') is the edge given from corner 2 - c of (a, b', c').
+        const uint32_t u = across[3 * size_t(t) + size_t(flipped[t] ? 2 - c : c)];
+        if (u == UINT32_MAX || seen[u]) continue;
         seen[u] = 1;
-        if (runs(u, a, b)) std::swap(tris_[3 * u + 1], tris_[3 * u + 2]);
+        if (runs(u, a, b)) std::swap(tris_[3 * u + 1], tris_[3 * u + 2]), flipped[u] = 1;
         queue.push_back(u);
       }
     }

@@ -25,6 +25,9 @@
 #include "frep/geometry/field.h"
 
 namespace frep {
+namespace mesh_topology {
+struct EdgeUses;  // geometry/mesh_topology.h (internal)
+}
 
 // An axis-aligned box hierarchy over primitives' boxes, for nearest-primitive queries.
 class Bvh {
@@ -176,7 +179,7 @@ class MeshField : public DistanceField {
   std::string name_;
   double signedDistance(const double* p, double* q) const;
   int64_t nearestTriangle(const double* p, double* q, int& region, double& best2, double start2 = INFINITY) const;
-  void orientConsistently();
+  void orientConsistently(const mesh_topology::EdgeUses& edges);
   bool sameGeometry(const DistanceField& o) const override {
     const auto& m = static_cast<const MeshField&>(o);
     return m.xyz_ == xyz_ && m.tris_ == tris_;
