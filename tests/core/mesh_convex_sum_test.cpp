@@ -8,7 +8,10 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <cstring>
 #include <random>
+
+#include <tbb/task_arena.h>
 
 #include "core/mesh_checks.h"
 #include "core/mesh_models.h"
@@ -476,4 +479,52 @@ TEST(MeshConvexSum, NonConvexToolIsCutIntoConvexPieces) {
     }
   }
   EXPECT_GT(inside, 300);
+}
+
+// The boundary pieces' pruning tests the triangles in parallel; each test is a function of its
+// triangle alone, so the sum built on one thread and on all of them is the same field: the
+// same count of pieces and the same bits at every point (a fine torus, so that the pruning
+// runs in several chunks).
+TEST(MeshConvexSum, PruningOnOneThreadOrManyBuildsTheSameSum) {
+  const int nu = 64, nv = 32;
+  std::vector<double> xyz;
+  std::vector<uint32_t> tris;
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const double u = 2 * M_PI * i / nu, w = 2 * M_PI * j / nv;
+      xyz.insert(xyz.end(),
+                 {(0.8 + 0.3 * std::cos(w)) * std::cos(u), (0.8 + 0.3 * std::cos(w)) * std::sin(u), 0.3 * std::sin(w)});
+    }
+  auto id = [&](int i, int j) { return uint32_t((i % nu) * nv + (j % nv)); };
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j)
+      tris.insert(tris.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+  const Expr torus = fieldExpr(std::make_shared<MeshField>(xyz, tris, "torus"), X(), Y(), Z());
+  auto build = [&](double side, Expr* sum) {
+    return minkowski::meshConvexSum(torus, axisBox({-side, -0.6 * side, -0.4 * side}, {side, side, side}), 3, sum);
+  };
+  Expr one, many;
+  tbb::task_arena single(1);
+  bool ok = false;
+  single.execute([&] { ok = build(0.05, &one); });
+  ASSERT_TRUE(ok);
+  // Other sums push this one out of the cache of recent builds, so it is built again.
+  for (int k = 1; k <= 8; ++k) {
+    Expr other;
+    ASSERT_TRUE(build(0.05 + 0.01 * k, &other));
+  }
+  ASSERT_TRUE(build(0.05, &many));
+  const auto termOne = minkowski::lookupExact(one), termMany = minkowski::lookupExact(many);
+  ASSERT_TRUE(termOne && termMany);
+  EXPECT_EQ(termOne->operand, termMany->operand);  // with the count of pieces kept
+  EXPECT_NE(termOne->operand.find("boundary pieces"), std::string::npos) << termOne->operand;
+  const TapePtr t1 = Tape::compile(one, 3), t2 = Tape::compile(many, 3);
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(-1.3, 1.3);
+  PointEvaluator pe;
+  for (int i = 0; i < 2000; ++i) {
+    const V3 p{u(rng), u(rng), 0.4 * u(rng)};
+    const double a = pe.eval(*t1, p.data()), b = pe.eval(*t2, p.data());
+    ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << i;
+  }
 }

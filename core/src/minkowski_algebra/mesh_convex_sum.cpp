@@ -14,6 +14,9 @@
 #include <string>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "frep/geometry/cell_lists.h"
 #include "frep/geometry/distance_fields.h"
 #include "frep/minkowski_algebra/convex_cover.h"
@@ -253,8 +256,9 @@ class MeshConvexSumField : public DistanceField {
   // Drops the pieces that lie in the interior of one convex T ⊕ B (all three corners strictly
   // inside it) or of A + b0 (a ball about the centroid holding the triangle inside A): they hold
   // no boundary point, so the rest still covers the boundary and the distance stays exact.
+  // Each triangle's test is a pure function of it (the lists and caches only speed it up), so
+  // the triangles are tested in parallel and the kept ones gathered in their order.
   void pruneInterior(std::vector<double>& soup, std::vector<uint32_t>& tris, double tol) const {
-    std::vector<uint32_t> kept;
     auto depth = [&](uint32_t cell, const double* p) {
       const Cell& c = cells_[cell];
       double m = INFINITY;
@@ -264,7 +268,7 @@ class MeshConvexSumField : public DistanceField {
       }
       return m;
     };
-    for (size_t t = 0; t + 2 < tris.size(); t += 3) {
+    auto isInterior = [&](size_t t) {
       const double* v[3] = {&soup[3 * tris[t]], &soup[3 * tris[t + 1]], &soup[3 * tris[t + 2]]};
       double c[3], r2 = 0;
       for (int k = 0; k < 3; ++k) c[k] = (v[0][k] + v[1][k] + v[2][k]) / 3;
@@ -286,8 +290,15 @@ class MeshConvexSumField : public DistanceField {
       if (list)
         for (uint32_t j = 0; j < count && inCell(list[j]); ++j) {}
       else if (!interior) cellBvh_.containing(v[0], inCell);
-      if (!interior) kept.insert(kept.end(), {tris[t], tris[t + 1], tris[t + 2]});
-    }
+      return interior;
+    };
+    std::vector<char> interior(tris.size() / 3);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, interior.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) interior[i] = isInterior(3 * i);
+    });
+    std::vector<uint32_t> kept;
+    for (size_t i = 0; i < interior.size(); ++i)
+      if (!interior[i]) kept.insert(kept.end(), {tris[3 * i], tris[3 * i + 1], tris[3 * i + 2]});
     if (kept.empty() && !tris.empty()) kept.assign(tris.begin(), tris.begin() + 3);  // MeshField needs one
     tris.swap(kept);
   }
