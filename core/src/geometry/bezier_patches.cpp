@@ -2,6 +2,7 @@
 // cell count to the chord deviation delta (Choporov-Hybrid, nonuniform-surface-mesh, eq. 8-9).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -108,13 +109,32 @@ TriangleMesh tessellateBezierPatches(const std::vector<double>& ctrl, int du, in
     for (size_t k = 3; k < per; ++k) allSame = allSame && ctrl[p * per + k] == ctrl[p * per + k % 3];
     if (allSame) throw std::invalid_argument("patch " + std::to_string(p + 1) + " is degenerate: all its control points are equal");
   }
+  // At most about 2^20 triangles in all (and 512 cells a side): a surface whose delta asks for
+  // more (a far control point, a delta tiny against the extent) is an error, not hours of work.
+  const int mMax = int(std::min(512.0, std::floor(std::sqrt(double(1 << 19) / double(patches)))));
+  auto tooFine = [&](double needed) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "delta %g needs about %.3g cells a side on each of the %zu patches, more than the %d allowed "
+                  "(2^20 triangles in all): give a larger delta",
+                  delta, needed, patches, mMax);
+    return std::invalid_argument(buf);
+  };
+  if (n > mMax)
+    throw std::invalid_argument("n = " + std::to_string(n) + " cells a side on each of the " + std::to_string(patches) +
+                                " patches is more than the " + std::to_string(mMax) +
+                                " allowed (2^20 triangles in all)");
   int m = n;
   for (;;) {
     double dev = 0.0;
     for (size_t p = 0; p < patches; ++p) dev = std::max(dev, deviation(P, p, m));
-    if (dev <= delta || m >= 512) break;
-    // The interpolation error falls as m^-2: jump close to the needed count in one step.
-    m = std::min(512, std::max(m + 1, int(std::ceil(m * std::sqrt(dev / delta) * 1.05))));
+    if (dev <= delta) break;
+    if (m >= mMax) throw tooFine(m * std::sqrt(dev / delta) * 1.05);  // not within delta at the cap
+    // The interpolation error falls as m^-2: jump close to the needed count in one step; one
+    // far past the cap is refused before the cap's costly check.
+    const double needed = m * std::sqrt(dev / delta) * 1.05;
+    if (!(needed <= 4.0 * mMax)) throw tooFine(needed);
+    m = std::min(mMax, std::max(m + 1, int(std::ceil(needed))));
   }
   TriangleMesh out;
   out.cells = m;
