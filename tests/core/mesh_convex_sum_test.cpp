@@ -486,20 +486,8 @@ TEST(MeshConvexSum, NonConvexToolIsCutIntoConvexPieces) {
 // same count of pieces and the same bits at every point (a fine torus, so that the pruning
 // runs in several chunks).
 TEST(MeshConvexSum, PruningOnOneThreadOrManyBuildsTheSameSum) {
-  const int nu = 64, nv = 32;
-  std::vector<double> xyz;
-  std::vector<uint32_t> tris;
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      const double u = 2 * M_PI * i / nu, w = 2 * M_PI * j / nv;
-      xyz.insert(xyz.end(),
-                 {(0.8 + 0.3 * std::cos(w)) * std::cos(u), (0.8 + 0.3 * std::cos(w)) * std::sin(u), 0.3 * std::sin(w)});
-    }
-  auto id = [&](int i, int j) { return uint32_t((i % nu) * nv + (j % nv)); };
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j)
-      tris.insert(tris.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-  const Expr torus = fieldExpr(std::make_shared<MeshField>(xyz, tris, "torus"), X(), Y(), Z());
+  const mesh_models::TorusSoup soup = mesh_models::torusSoup(0.8, 0.3, 64, 32);
+  const Expr torus = fieldExpr(std::make_shared<MeshField>(soup.xyz, soup.tris, "torus"), X(), Y(), Z());
   auto build = [&](double side, Expr* sum) {
     return minkowski::meshConvexSum(torus, axisBox({-side, -0.6 * side, -0.4 * side}, {side, side, side}), 3, sum);
   };

@@ -1,6 +1,7 @@
 // Analytic test models of the mesher and simplifier tests (inside: f >= 0) and their grids.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -55,6 +56,27 @@ constexpr double kPi = 3.14159265358979323846;
 
 inline frep::GridSpec cubeGrid(double half, int res) {
   return frep::GridSpec::fromBounds({-half, -half, -half}, {half, half, half}, res);
+}
+
+// The torus of radii R, r about the z axis as a closed mesh of nu x nv quads, two triangles
+// each (xyz: 3 coordinates a vertex; tris: 3 indices a triangle).
+struct TorusSoup {
+  std::vector<double> xyz;
+  std::vector<uint32_t> tris;
+};
+inline TorusSoup torusSoup(double R, double r, int nu, int nv) {
+  TorusSoup s;
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const double u = 2 * M_PI * i / nu, w = 2 * M_PI * j / nv;
+      s.xyz.insert(s.xyz.end(),
+                   {(R + r * std::cos(w)) * std::cos(u), (R + r * std::cos(w)) * std::sin(u), r * std::sin(w)});
+    }
+  auto id = [&](int i, int j) { return uint32_t((i % nu) * nv + (j % nv)); };
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j)
+      s.tris.insert(s.tris.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+  return s;
 }
 
 }  // namespace mesh_models

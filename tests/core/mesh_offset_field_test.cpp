@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "core/mesh_models.h"
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/field_function.h"
 #include "frep/expressions/tape.h"
@@ -23,21 +24,10 @@ namespace {
 
 constexpr double kR = 0.8, kTube = 0.3;
 
-// The torus of radii kR, kTube as a closed mesh of nu x nv quads (two triangles each).
+// The torus of radii kR, kTube as a closed mesh field of nu x nv quads.
 std::shared_ptr<const MeshField> torusMesh(int nu, int nv) {
-  std::vector<double> xyz;
-  std::vector<uint32_t> tris;
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      const double u = 2 * M_PI * i / nu, w = 2 * M_PI * j / nv;
-      xyz.insert(xyz.end(), {(kR + kTube * std::cos(w)) * std::cos(u), (kR + kTube * std::cos(w)) * std::sin(u),
-                             kTube * std::sin(w)});
-    }
-  auto id = [&](int i, int j) { return uint32_t((i % nu) * nv + (j % nv)); };
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j)
-      tris.insert(tris.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-  return std::make_shared<MeshField>(xyz, tris, "torus");
+  const mesh_models::TorusSoup s = mesh_models::torusSoup(kR, kTube, nu, nv);
+  return std::make_shared<MeshField>(s.xyz, s.tris, "torus");
 }
 
 // Pairs a hair, a few hairs or up to 0.06 either side of the offset surface at `level` (from

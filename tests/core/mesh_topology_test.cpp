@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/mesh_models.h"
 #include "frep/geometry/distance_fields.h"
 #include "geometry/mesh_topology.h"
 
@@ -48,36 +49,21 @@ TEST(MeshTopology, EdgeUsesAreSortedByKeyThenUse) {
 }
 
 // A torus of nu x nv quads, a fraction of its triangles given clockwise.
-std::pair<std::vector<double>, std::vector<uint32_t>> scrambledTorus(int nu, int nv, double flipped, unsigned seed) {
-  std::vector<double> xyz;
-  std::vector<uint32_t> tris;
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      const double u = 2 * M_PI * i / nu, w = 2 * M_PI * j / nv;
-      xyz.insert(xyz.end(),
-                 {(0.8 + 0.3 * std::cos(w)) * std::cos(u), (0.8 + 0.3 * std::cos(w)) * std::sin(u), 0.3 * std::sin(w)});
-    }
-  auto id = [&](int i, int j) { return uint32_t((i % nu) * nv + (j % nv)); };
+mesh_models::TorusSoup scrambledTorus(int nu, int nv, double flipped, unsigned seed) {
+  mesh_models::TorusSoup s = mesh_models::torusSoup(0.8, 0.3, nu, nv);
   std::mt19937 rng(seed);
   std::bernoulli_distribution flip(flipped);
-  auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
-    if (flip(rng)) std::swap(b, c);
-    tris.insert(tris.end(), {a, b, c});
-  };
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      add(id(i, j), id(i + 1, j), id(i + 1, j + 1));
-      add(id(i, j), id(i + 1, j + 1), id(i, j + 1));
-    }
-  return {xyz, tris};
+  for (size_t t = 0; t < s.tris.size(); t += 3)
+    if (flip(rng)) std::swap(s.tris[t + 1], s.tris[t + 2]);
+  return s;
 }
 
 TEST(MeshTopology, OrientationWalkFixesScatteredFlips) {
   const auto clean = scrambledTorus(40, 20, 0.0, 1);
-  const MeshField reference(clean.first, clean.second, "torus");
+  const MeshField reference(clean.xyz, clean.tris, "torus");
   for (double fraction : {0.3, 0.7, 1.0}) {
     const auto mixed = scrambledTorus(40, 20, fraction, 2);
-    const MeshField f(mixed.first, mixed.second, "mixed torus");
+    const MeshField f(mixed.xyz, mixed.tris, "mixed torus");
     ASSERT_TRUE(f.check().closed());
     // Every edge run once each way: one orientation throughout.
     std::map<std::pair<uint32_t, uint32_t>, int> runs;

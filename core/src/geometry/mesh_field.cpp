@@ -85,6 +85,13 @@ uint32_t floatBitsDown(double x) {
   return bits;
 }
 
+// The key of pair i of a cell's candidate list (cellCandidates).
+double candidateKey(const uint32_t* list, uint32_t i) {
+  float g;
+  std::memcpy(&g, &list[2 * i + 1], sizeof g);
+  return double(g);
+}
+
 void normalise(double* v) {
   const double l = std::sqrt(dot(v, v));
   if (l > 0) v[0] /= l, v[1] /= l, v[2] /= l;
@@ -286,16 +293,22 @@ void MeshField::searchAll(const double* p, Nearest& n) const {
 // never nearest there, nor tied. Nothing when p is outside the lattice or the cell has too
 // many candidates. The list holds pairs (slot, key), key |c - T| as float bits rounded down,
 // sorted by key: a query at p stops at the first key with key - |p - c| beyond its best
-// distance (nearestTriangle), as |p - T| >= |c - T| - |p - c|. count: the pairs; centre: c;
-// centreValue: f(c) with its magnitude rounded down (0 on an open mesh: no sign), kept in a
-// header pair before the list (offsetClass: a point nearer c than |f(c)| has c's class).
-const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, double* centre, double& centreValue) const {
+// distance (nearestTriangle), as |p - T| >= |c - T| - |p - c|. count: the pairs; fromCentre:
+// |p - c| rounded up, with margins for its rounding and for p placed in the cell from a few
+// ulps outside; centreValue: f(c) with its magnitude rounded down (0 on an open mesh: no
+// sign), kept in a header pair before the list (offsetClass: a point nearer c than |f(c)| has
+// c's class). candidateKey(list, i): pair i's key.
+const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, double& fromCentre,
+                                          double& centreValue) const {
   uint64_t key;
   int64_t ijk[3];
   if (!lattice_.cellOf(p, key, ijk)) return nullptr;
   Bvh::Box box;
   lattice_.cellBox(ijk, box.lo, box.hi);
+  double centre[3], pc[3];
   for (int k = 0; k < 3; ++k) centre[k] = 0.5 * (box.lo[k] + box.hi[k]);
+  sub(p, centre, pc);
+  fromCentre = std::sqrt(dot(pc, pc)) * (1 + 1e-9) + 1e-12 * scale_;
   const uint32_t* list = CellLists::get(id_, key, count, [&](std::vector<uint32_t>& out) {
     const double cellSize = lattice_.size;
     Nearest c{std::numeric_limits<double>::infinity()};
@@ -362,7 +375,7 @@ int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, 
   const size_t nt = tris_.size() / 3;
   uint32_t count = 0;
   const uint32_t* cands = nullptr;
-  double centre[3], centreValue;  // of the cell of the candidates
+  double fromCentre, centreValue;  // of the cell of the candidates
   if (nt <= 16) {  // a few triangles: all of them, no hierarchy
     // This thread's last nearest first: its distance lets the plane test skip most of the
     // others (a convex polytope's facets). The answer is canonical, so the order is free.
@@ -371,17 +384,12 @@ int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, 
     for (uint32_t slot = 0; slot < nt; ++slot)
       if (slot != warm) offer(p, slot, n);
     if (n.found) tWarm = {id_, n.slot};
-  } else if (gCandidateCells.load(std::memory_order_relaxed) && (cands = cellCandidates(p, count, centre, centreValue))) {
+  } else if (gCandidateCells.load(std::memory_order_relaxed) &&
+             (cands = cellCandidates(p, count, fromCentre, centreValue))) {
     // Near-first: once a candidate's lower bound key - |p - c| exceeds the best distance, so do
-    // all the later ones' (a tie needs a distance equal to the best; the margins: rounding of
-    // |p - c|, and p placed in the cell from a few ulps outside). The cell is cellCandidates'.
-    double pc[3];
-    sub(p, centre, pc);
-    const double fromCentre = std::sqrt(dot(pc, pc)) * (1 + 1e-9) + 1e-12 * scale_;
+    // all the later ones' (a tie needs a distance equal to the best).
     for (uint32_t i = 0; i < count; ++i) {
-      float g;
-      std::memcpy(&g, &cands[2 * i + 1], sizeof g);
-      const double gap = double(g) - fromCentre;
+      const double gap = candidateKey(cands, i) - fromCentre;
       if (gap > 0 && gap * gap > n.best2 * (1 + 1e-9)) break;
       offer(p, cands[2 * i], n);
     }
@@ -451,16 +459,11 @@ double MeshField::offsetClass(const double* p, double level) const {
   };
   if (tWarm.field == id_ && tWarm.slot < nt && within(tWarm.slot)) return near;
   uint32_t count = 0;
-  double centre[3], centreValue;
-  const uint32_t* cands = cellCandidates(p, count, centre, centreValue);
+  double fromCentre, centreValue;
+  const uint32_t* cands = cellCandidates(p, count, fromCentre, centreValue);
   if (!cands) return value(p) + level;
-  double pc[3];
-  sub(p, centre, pc);
-  const double fromCentre = std::sqrt(dot(pc, pc)) * (1 + 1e-9) + 1e-12 * scale_;
   for (uint32_t i = 0; i < count; ++i) {
-    float g;
-    std::memcpy(&g, &cands[2 * i + 1], sizeof g);
-    if (double(g) - fromCentre > rSlack) break;  // this one and the rest: farther than r
+    if (candidateKey(cands, i) - fromCentre > rSlack) break;  // this one and the rest: farther than r
     const uint32_t slot = cands[2 * i];
     const double* pl = &slotPlanes_[4 * size_t(slot)];
     const double slack = 1e-13 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) + std::abs(pl[3]));
