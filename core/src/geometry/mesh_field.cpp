@@ -147,24 +147,23 @@ MeshField::MeshField(std::vector<double> xyz, std::vector<uint32_t> tris, std::s
   // One edge per key, numbered in key order; its pseudonormal sums its triangles' normals in
   // triangle order. A flip may have moved a use's corner: the triangle's corner that runs along
   // the key is the one.
-  for (size_t i = 0, ne = 0; i < edges.key.size(); ++ne) {
-    const uint64_t key = edges.key[i];
+  edges.forEachEdge([&](size_t first, size_t last) {
+    const uint64_t key = edges.key[first];
+    const size_t e = edgeN_.size() / 3;
     edgeN_.insert(edgeN_.end(), {0.0, 0.0, 0.0});
-    size_t j = i;
-    for (; j < edges.key.size() && edges.key[j] == key; ++j) {
+    for (size_t j = first; j < last; ++j) {
       const size_t t = edges.use[j] / 3;
       for (size_t c = 0; c < 3; ++c)
-        if (mesh_topology::edgeKey(tris_[3 * t + c], tris_[3 * t + (c + 1) % 3]) == key) triEdge_[3 * t + c] = uint32_t(ne);
-      for (int k = 0; k < 3; ++k) edgeN_[3 * ne + k] += faceN_[3 * t + k];
+        if (mesh_topology::edgeKey(tris_[3 * t + c], tris_[3 * t + (c + 1) % 3]) == key) triEdge_[3 * t + c] = uint32_t(e);
+      for (int k = 0; k < 3; ++k) edgeN_[3 * e + k] += faceN_[3 * t + k];
     }
-    if (j - i == 1) {
+    if (last - first == 1) {
       ++check_.openEdges;
       if (check_.firstOpen.size() < 5) check_.firstOpen.push_back({uint32_t(key >> 32), uint32_t(key)});
-    } else if (j - i > 2) {
+    } else if (last - first > 2) {
       ++check_.nonManifoldEdges;
     }
-    i = j;
-  }
+  });
   bvh_.build(boxes);
   // Each triangle's corners in one block, in the hierarchy's leaf order: a query reads the
   // triangles of a leaf from consecutive memory.
@@ -204,12 +203,11 @@ void MeshField::orientConsistently(const mesh_topology::EdgeUses& edges) {
   // across[3 t + c]: the other triangle of the edge from corner c to c + 1 of t as given, when
   // that edge has two uses (a manifold edge).
   std::vector<uint32_t> across(3 * nt, UINT32_MAX);
-  for (size_t i = 0; i + 1 < edges.key.size(); ++i)
-    if (edges.key[i] == edges.key[i + 1] && (i == 0 || edges.key[i - 1] != edges.key[i]) &&
-        (i + 2 == edges.key.size() || edges.key[i + 2] != edges.key[i])) {
-      across[edges.use[i]] = edges.use[i + 1] / 3;
-      across[edges.use[i + 1]] = edges.use[i] / 3;
-    }
+  edges.forEachEdge([&](size_t first, size_t last) {
+    if (last - first != 2) return;
+    across[edges.use[first]] = edges.use[first + 1] / 3;
+    across[edges.use[first + 1]] = edges.use[first] / 3;
+  });
   auto runs = [&](uint32_t t, uint32_t a, uint32_t b) {  // does t have the directed edge a->b?
     for (int c = 0; c < 3; ++c)
       if (tris_[3 * t + c] == a && tris_[3 * t + (c + 1) % 3] == b) return true;
@@ -263,12 +261,17 @@ struct MeshField::Nearest {
 
 void MeshField::useCandidateCells(bool on) { gCandidateCells = on; }
 
-// Offers triangle `slot` to n: skipped when its plane is farther than the best (the slack, for
-// the plane's rounding, keeps every triangle that could tie), else measured.
-inline void MeshField::offer(const double* p, uint32_t slot, Nearest& n) const {
+// A lower bound of p's distance to triangle `slot`: its distance to the triangle's plane, less
+// a slack for the plane's rounding (so every triangle that could tie stays in).
+inline double MeshField::planeGap(const double* p, uint32_t slot) const {
   const double* pl = &slotPlanes_[4 * size_t(slot)];
   const double slack = 1e-13 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) + std::abs(pl[3]));
-  const double h = std::abs(dot(pl, p) - pl[3]) - slack;
+  return std::abs(dot(pl, p) - pl[3]) - slack;
+}
+
+// Offers triangle `slot` to n: skipped when its plane is farther than the best, else measured.
+inline void MeshField::offer(const double* p, uint32_t slot, Nearest& n) const {
+  const double h = planeGap(p, slot);
   if (h > 0 && h * h > n.best2 * (1 + 1e-9)) return;
   double qq[3];
   int region;
@@ -326,7 +329,7 @@ const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, doub
     // hierarchy: only cells within a few of their sizes of the surface are worth a list.
     if (c.best2 > 16 * cellSize * cellSize) return false;
     const bool hasClass = check_.closed() && c.found;
-    out.push_back(hasClass && insideAt(centre, c.slot, c.region, c.q) ? 1u : 0u);
+    out.push_back(hasClass && insideAt(centre, bvh_.order()[c.slot], c.region, c.q) ? 1u : 0u);
     out.push_back(floatBitsDown(hasClass ? std::sqrt(c.best2) * (1 - 1e-9) : 0.0));
     const double halfDiag = 0.5 * std::sqrt(3.0) * cellSize;
     const double slack = 1e-12 * scale_;  // a point placed in the cell from a few ulps outside
@@ -419,14 +422,13 @@ double MeshField::signedDistance(const double* p, double* q) const {
   if (q) q[0] = bq[0], q[1] = bq[1], q[2] = bq[2];
   const double d = std::sqrt(best2);
   if (d == 0.0) return 0.0;
-  const bool inside = check_.closed() ? insideAt(p, uint32_t(t), bestRegion, bq, false) : windingNumber(p) > 0.5;
+  const bool inside = check_.closed() ? insideAt(p, uint32_t(t), bestRegion, bq) : windingNumber(p) > 0.5;
   return inside ? d : -d;
 }
 
 // Closed meshes: inside iff p - q points against the pseudonormal of the nearest feature
-// (region of triangle t, by slot or by index) at q.
-bool MeshField::insideAt(const double* p, uint32_t t, int region, const double* q, bool bySlot) const {
-  if (bySlot) t = bvh_.order()[t];
+// (region of triangle t) at q.
+bool MeshField::insideAt(const double* p, uint32_t t, int region, const double* q) const {
   const double* n;
   if (region == 0) n = &faceN_[3 * size_t(t)];
   else if (region <= 3) n = &vertN_[3 * size_t(tris_[3 * size_t(t) + size_t(region) - 1])];
@@ -465,9 +467,7 @@ double MeshField::offsetClass(const double* p, double level) const {
   for (uint32_t i = 0; i < count; ++i) {
     if (candidateKey(cands, i) - fromCentre > rSlack) break;  // this one and the rest: farther than r
     const uint32_t slot = cands[2 * i];
-    const double* pl = &slotPlanes_[4 * size_t(slot)];
-    const double slack = 1e-13 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) + std::abs(pl[3]));
-    if (std::abs(dot(pl, p) - pl[3]) - slack > rSlack) continue;  // its plane is farther than r
+    if (planeGap(p, slot) > rSlack) continue;  // its plane is farther than r
     if (within(slot)) {
       tWarm = {id_, slot};
       return near;

@@ -3,6 +3,7 @@
 // its load in std::map welding and edge lookups).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -19,6 +20,14 @@ std::vector<uint32_t> weldVertices(const std::vector<double>& xyz, std::vector<d
 struct EdgeUses {
   std::vector<uint64_t> key;
   std::vector<uint32_t> use;
+  // Calls f(first, last) for each edge: its uses are [first, last) of the arrays.
+  template <typename F>
+  void forEachEdge(F&& f) const {
+    for (size_t i = 0, j; i < key.size(); i = j) {
+      for (j = i + 1; j < key.size() && key[j] == key[i];) ++j;
+      f(i, j);
+    }
+  }
 };
 inline uint64_t edgeKey(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b : uint64_t(b) << 32 | a; }
 EdgeUses edgeUsesOf(const std::vector<uint32_t>& tris);

@@ -64,6 +64,8 @@ std::string ballText(const Ball& b) {
 // The sum by minkowskiSum's analytic shortcut (f(x - c) + r), the difference as f(x + c) - r;
 // registered as a BallOffset term.
 Expr offsetField(const Expr& f, const Ball& b, bool erosion, ExactTerm t) {
+  std::vector<Expr> xs;  // where the operand is read: x - c for the sum, x + c for the difference
+  for (uint32_t i = 0; i < 3; ++i) xs.push_back(erosion ? Expr::x(i) + Expr(b.centre[i]) : Expr::x(i) - b.centre[i]);
   Expr r;
   const auto mesh = f.op() == Op::Field ? std::dynamic_pointer_cast<const MeshField>(f.node().fn) : nullptr;
   if (mesh && mesh->check().closed() && b.radius > 0 && std::isfinite(b.radius)) {
@@ -71,8 +73,6 @@ Expr offsetField(const Expr& f, const Ball& b, bool erosion, ExactTerm t) {
     // r (mesh_offset_field.h).
     const Expr g = fieldCall(std::make_shared<MeshOffsetField>(mesh, erosion ? -b.radius : b.radius), f.arg(0),
                              f.arg(1), f.arg(2));
-    std::vector<Expr> xs;
-    for (uint32_t i = 0; i < 3; ++i) xs.push_back(erosion ? Expr::x(i) + Expr(b.centre[i]) : Expr::x(i) - b.centre[i]);
     r = remap(g, xs);
   } else if (!erosion) {
     MinkowskiOptions o;
@@ -81,8 +81,6 @@ Expr offsetField(const Expr& f, const Ball& b, bool erosion, ExactTerm t) {
     o.ballRadius = b.radius;
     r = minkowskiSum(f, Expr(0.0), 3, Bounds{}, o);
   } else {
-    std::vector<Expr> xs;
-    for (uint32_t i = 0; i < 3; ++i) xs.push_back(Expr::x(i) + Expr(b.centre[i]));
     r = remap(f, xs) - Expr(b.radius);
   }
   t.kind = ExactTerm::Kind::BallOffset;

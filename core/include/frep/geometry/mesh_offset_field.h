@@ -26,8 +26,6 @@ class MeshOffsetField : public FieldFunction {
   double gradient(const double p[3], double g[3]) const override { return mesh_->gradient(p, g) + level_; }
   Interval bound(const Interval box[3]) const override;
   double setErrorBound() const override { return mesh_->setErrorBound(); }
-  const MeshField& mesh() const { return *mesh_; }
-  double level() const { return level_; }
 
  private:
   std::shared_ptr<const MeshField> mesh_;
