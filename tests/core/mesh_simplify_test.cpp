@@ -351,6 +351,38 @@ TEST(MeshSimplify, FloatSignsGiveTheDoubleMesh) {
   }
 }
 
+// Levels decided by interval bounds (the triangle's two offset boxes) give the mesh of every
+// sample evaluated: flat faces of axis-aligned and tilted R-function blocks (thin boxes, decided)
+// joined by a blend (curved, not decided), a sphere, and a block rotated off the axes (whose
+// faces' boxes are thick: mostly not decided).
+TEST(MeshSimplify, IntervalDecidedLevelsGiveTheSampledMesh) {
+  Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  auto block = [&](double cx, double cy, double cz, double hx, double hy, double hz) {
+    return rIntersection(rIntersection(hx - abs(x - cx), hy - abs(y - cy)), hz - abs(z - cz));
+  };
+  const Expr seat = block(0.0, 0.0, 0.1, 0.6, 0.6, 0.08), leg = block(0.3, 0.3, -0.3, 0.08, 0.08, 0.35);
+  const Expr chairLike = rUnion(seat, leg) + 0.02 / (1.0 + square(seat / 0.1) + square(leg / 0.1));
+  const double c = std::cos(0.4), s = std::sin(0.4);
+  const Expr tilted = rIntersection(rIntersection(0.5 - abs(c * x + s * y), 0.4 - abs(c * y - s * x)), 0.3 - abs(z));
+  int decidedSomewhere = 0;
+  for (const Expr& m : {chairLike, sphereAt(0.01, -0.02, 0.03, 0.7), tilted, torusAndNotchedBlock()}) {
+    TapePtr tape = Tape::compile(m, 3);
+    GridSpec g = cubeGrid(1.0, 96);
+    Mesh a = meshGrid(tape, g), b = a;
+    SimplifyOptions on, off;
+    on.tolerance = off.tolerance = 0.1;
+    off.intervalLevels = false;
+    const SimplifyStats sa = simplifyMesh(a, tape, g, on), sb = simplifyMesh(b, tape, g, off);
+    EXPECT_GT(sa.collapses, 500u);
+    EXPECT_EQ(sa.collapses, sb.collapses);
+    EXPECT_EQ(sa.errorBound, sb.errorBound);
+    EXPECT_LE(sa.modelEvals, sb.modelEvals);
+    decidedSomewhere += sa.modelEvals < sb.modelEvals;
+    expectSameMesh(a, b);
+  }
+  EXPECT_GE(decidedSomewhere, 2);  // the path ran (the chair-like blocks, the notched block)
+}
+
 TEST(MeshSimplify, WithoutSharpFeaturesEveryVertexStaysAMesherVertex) {
   Expr m = blockAt(0.013, -0.021, 0.007, 0.9, 0.7, 0.5);
   GridSpec g = cubeGrid(1.2, 48);

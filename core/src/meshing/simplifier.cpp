@@ -26,6 +26,7 @@ Simplifier::Simplifier(Work&& work, const TapePtr& tape, const GridSpec& grid, c
                                 " coordinates; give values for x[4..] (fixedCoords)");
   batch_.setFieldSignsOnly(true);  // crossed() reads the class of each value alone
   floatSigns_ = opt_.floatSigns && FloatErrorBound::supports(*tape_);
+  intervalLevels_ = opt_.intervalLevels && !tape_->hasExtrema() && tape_->fields().empty();
 }
 
 // Collapses until no candidate is left; then work(), vertexAlive() and triangleAlive() hold

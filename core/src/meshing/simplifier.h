@@ -225,6 +225,9 @@ class Simplifier {
   // bound (float_error.h) decides the sign, in double for the rest (the same classes as double
   // throughout; the inputs' lanes are reused for the double ones).
   void classify(size_t n);
+  // Does every sample of q's level (de: its offset along q.d) pass, by interval bounds of f over
+  // the boxes of the triangle moved by -de and by +de? False: not decided (sample them).
+  bool offsetsDecided(const LevelQuery& q, const V3& de);
   int levelOf(uint32_t t);
   bool errorPasses(std::vector<LevelQuery>& qs, const std::vector<V3>& gone, const std::vector<uint32_t>& replaced);
 
@@ -325,6 +328,20 @@ class Simplifier {
   double bound_ = -1;                // < 0: none yet
   std::vector<uint32_t> redo_;
   std::array<char, 2 * kPairsPerCall> inside_{};
+  // A level of at least kIntervalSamples samples is first tried by two interval evaluations
+  // (offsetsDecided): where the triangle lies in a flat face of the model (most of a CSG of
+  // blocks), both boxes are thin and decide it at the cost of a few point evaluations. Only
+  // for tapes whose interval extension holds every double evaluation in its box (interval.h):
+  // no extremum (its bound is a search's) and no field (its own bounds).
+  // Tried while it pays: a level of n samples when n times the share of tries that decided
+  // (counted since this run began, from an even start) is at least kIntervalSamples. A curved
+  // surface's levels are rarely decided (sphere ∩ gyroid) and then cost more than they spare.
+  static constexpr size_t kIntervalSamples = 32;
+  bool worthIntervals(size_t n) const { return n * (intervalPasses_ + 1) >= kIntervalSamples * (intervalTries_ + 2); }
+  uint64_t intervalTries_ = 0, intervalPasses_ = 0;
+  bool intervalLevels_ = false;
+  IntervalEvaluator ieval_;
+  std::vector<Interval> ibox_;
   int maxLevel_ = 0;  // the last error level
   // e_k = tol * 2^k for every level a triangle can hold (int8_t): a level carried from a
   // worker's payload may exceed maxLevel_ (the decoder allows up to 15), and still counts.

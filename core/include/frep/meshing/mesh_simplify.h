@@ -59,6 +59,10 @@ struct SimplifyOptions {
   // rest (frep/evaluators/float_error.h; tapes it does not cover: double throughout). Never
   // changes the result; false: double throughout (for tests).
   bool floatSigns = true;
+  // A level of many samples first tried by interval bounds of the model over the two boxes its
+  // samples lie in (simplifier.h, offsetsDecided), where the tape's interval extension holds its
+  // double values. Never changes the result; false: every sample evaluated (for tests).
+  bool intervalLevels = true;
   // The mesh's bricks of this many cells (from index 0) went through simplifyRegion already:
   // their blocks are not done again. 0: none.
   int bricksSimplified = 0;
