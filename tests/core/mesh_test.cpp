@@ -156,6 +156,22 @@ TEST(Mesh, Block) {
   checkVerticesOnSurface(b, c.mesh, g.voxel);
 }
 
+// A field linear along every grid edge (a block's faces, a tilted slab): false position's first
+// step from the two ends lands on the root, often exactly (f = 0). Such a root ends the edge's
+// search: two end values, that step and at most one more, never the bisections that a zero
+// end value used to trigger (12 evaluations an edge).
+TEST(Mesh, RootsHitExactlyEndTheirEdgesSearch) {
+  Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
+  const Expr slab = min(min(0.31 - abs(0.6 * x + 0.8 * z - 0.05), 0.7 - abs(0.8 * x - 0.6 * z)), 0.6 - abs(y));
+  for (const Expr& m : {blockAt(0.013, -0.021, 0.007, 0.61, 0.43, 0.37), slab}) {
+    TapePtr tape = Tape::compile(m, 3);
+    Mesh mesh = meshGrid(tape, cubeGrid(1.0, 48), {}, 0);
+    ASSERT_GT(mesh.positions.size(), 1000u);
+    EXPECT_EQ(mc::checkEdgePairs(mesh.triangles, mesh.positions.size()), "");
+    EXPECT_LT(double(mesh.stats.rootEvals), 4.5 * double(mesh.positions.size()));
+  }
+}
+
 TEST(Mesh, GridAlignedBlockHasNoDegenerateTriangles) {
   // Faces exactly on grid planes: many values are exactly 0 and roots fall on grid points.
   GridSpec g = cubeGrid(1.0, 65);  // voxel 1/32: +-0.5 are grid planes

@@ -535,6 +535,10 @@ class RegionMesher {
         }
         if (it > 0 && std::abs(t - prevT[l]) < 1e-10) done[l] = true;
         if (noise > 0 && std::abs(f) <= noise) done[l] = true;
+        // A root hit exactly (an exact distance's first false-position step on a flat piece
+        // often is): it becomes the inside end with fa = 0, where false position stalls, and
+        // the steps left would bisect towards it from outside; the vertex is that root.
+        if (f == 0) done[l] = true;
         prevT[l] = t;
         if (std::isnan(f)) illinois[l] = false;
         if (insideValue(f)) {
