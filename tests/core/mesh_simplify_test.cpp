@@ -324,17 +324,23 @@ TEST(MeshSimplify, SameResultForAnyThreadCount) {
   EXPECT_EQ(sa.modelEvals, sb.modelEvals);
 }
 
-// The error check's signs in float with the certified double fallback give the double path's
-// mesh: R-function blocks joined by a blended union (the division of hfBlendUni), as
-// examples/chair.hf is built, and the split tests' model (min, max, square roots).
-TEST(MeshSimplify, FloatSignsGiveTheDoubleMesh) {
+namespace {
+// R-function blocks joined by a blended union (the division of hfBlendUni), as
+// examples/chair.hf is built.
+Expr chairLike() {
   Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
   auto block = [&](double cx, double cy, double cz, double hx, double hy, double hz) {
     return rIntersection(rIntersection(hx - abs(x - cx), hy - abs(y - cy)), hz - abs(z - cz));
   };
   const Expr seat = block(0.0, 0.0, 0.1, 0.6, 0.6, 0.08), leg = block(0.3, 0.3, -0.3, 0.08, 0.08, 0.35);
-  const Expr chairLike = rUnion(seat, leg) + 0.02 / (1.0 + square(seat / 0.1) + square(leg / 0.1));
-  for (const Expr& m : {chairLike, torusAndNotchedBlock()}) {
+  return rUnion(seat, leg) + 0.02 / (1.0 + square(seat / 0.1) + square(leg / 0.1));
+}
+}  // namespace
+
+// The error check's signs in float with the certified double fallback give the double path's
+// mesh: the chair-like blocks and the split tests' model (min, max, square roots).
+TEST(MeshSimplify, FloatSignsGiveTheDoubleMesh) {
+  for (const Expr& m : {chairLike(), torusAndNotchedBlock()}) {
     TapePtr tape = Tape::compile(m, 3);
     ASSERT_TRUE(FloatErrorBound::supports(*tape));
     GridSpec g = cubeGrid(1.0, 80);
@@ -357,15 +363,10 @@ TEST(MeshSimplify, FloatSignsGiveTheDoubleMesh) {
 // faces' boxes are thick: mostly not decided).
 TEST(MeshSimplify, IntervalDecidedLevelsGiveTheSampledMesh) {
   Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
-  auto block = [&](double cx, double cy, double cz, double hx, double hy, double hz) {
-    return rIntersection(rIntersection(hx - abs(x - cx), hy - abs(y - cy)), hz - abs(z - cz));
-  };
-  const Expr seat = block(0.0, 0.0, 0.1, 0.6, 0.6, 0.08), leg = block(0.3, 0.3, -0.3, 0.08, 0.08, 0.35);
-  const Expr chairLike = rUnion(seat, leg) + 0.02 / (1.0 + square(seat / 0.1) + square(leg / 0.1));
   const double c = std::cos(0.4), s = std::sin(0.4);
   const Expr tilted = rIntersection(rIntersection(0.5 - abs(c * x + s * y), 0.4 - abs(c * y - s * x)), 0.3 - abs(z));
   int decidedSomewhere = 0;
-  for (const Expr& m : {chairLike, sphereAt(0.01, -0.02, 0.03, 0.7), tilted, torusAndNotchedBlock()}) {
+  for (const Expr& m : {chairLike(), sphereAt(0.01, -0.02, 0.03, 0.7), tilted, torusAndNotchedBlock()}) {
     TapePtr tape = Tape::compile(m, 3);
     GridSpec g = cubeGrid(1.0, 96);
     Mesh a = meshGrid(tape, g), b = a;
