@@ -2,55 +2,56 @@
 #include "frep/lang/library/library.h"
 
 #include <algorithm>
-#include <cctype>
 
 namespace frep::lang {
 namespace {
 
 std::string lowerCase(std::string_view s) {
   std::string out(s);
-  for (auto& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (auto& c : out)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');  // names are ASCII: no locale
   return out;
 }
 
 // Function-local static: registrations from other translation units may run before any
-// namespace-scope object of this file is constructed.
-std::vector<LibraryFunction>& registry() {
-  static std::vector<LibraryFunction> fns;
-  return fns;
-}
-
-bool lessByName(const LibraryFunction& a, const LibraryFunction& b) {
-  std::string la = lowerCase(a.name), lb = lowerCase(b.name);
-  return la != lb ? la < lb : a.name < b.name;
+// namespace-scope object of this file is constructed. Sorted by lower-cased name, each
+// function's lower-cased name kept beside it: every program registers a few hundred functions
+// at start-up, and lower-casing both sides of every comparison there cost ~1 ms a process.
+struct Registry {
+  std::vector<LibraryFunction> fns;
+  std::vector<std::string> keys;  // keys[i]: fns[i].name lower-cased
+};
+Registry& registry() {
+  static Registry r;
+  return r;
 }
 
 }  // namespace
 
 void registerLibraryFunction(LibraryFunction fn) {
-  auto& fns = registry();
+  Registry& r = registry();
   std::string key = lowerCase(fn.name);
   // A second registration of a name replaces the first (tests register fakes this way).
-  auto same = std::find_if(fns.begin(), fns.end(),
-                           [&](const LibraryFunction& f) { return lowerCase(f.name) == key; });
-  if (same != fns.end()) fns.erase(same);
-  auto pos = std::upper_bound(fns.begin(), fns.end(), fn, lessByName);
-  fns.insert(pos, std::move(fn));
+  auto same = std::find(r.keys.begin(), r.keys.end(), key);
+  if (same != r.keys.end()) {
+    r.fns.erase(r.fns.begin() + (same - r.keys.begin()));
+    r.keys.erase(same);
+  }
+  // The keys are unique now: sorted by them alone.
+  const size_t at = size_t(std::upper_bound(r.keys.begin(), r.keys.end(), key) - r.keys.begin());
+  r.fns.insert(r.fns.begin() + std::ptrdiff_t(at), std::move(fn));
+  r.keys.insert(r.keys.begin() + std::ptrdiff_t(at), std::move(key));
 }
 
 const LibraryFunction* findLibraryFunction(std::string_view name) {
-  std::string key = lowerCase(name);
-  const auto& fns = registry();
-  // Sorted by lower-cased name, so a binary search finds it.
-  auto it = std::lower_bound(fns.begin(), fns.end(), key, [](const LibraryFunction& f,
-                                                              const std::string& k) {
-    return lowerCase(f.name) < k;
-  });
-  if (it != fns.end() && lowerCase(it->name) == key) return &*it;
+  const std::string key = lowerCase(name);
+  const Registry& r = registry();
+  auto it = std::lower_bound(r.keys.begin(), r.keys.end(), key);
+  if (it != r.keys.end() && *it == key) return &r.fns[size_t(it - r.keys.begin())];
   return nullptr;
 }
 
-const std::vector<LibraryFunction>& libraryFunctions() { return registry(); }
+const std::vector<LibraryFunction>& libraryFunctions() { return registry().fns; }
 
 bool registerAll(std::vector<LibraryFunction> fns) {
   for (auto& f : fns) registerLibraryFunction(std::move(f));
