@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 #include <cstdio>
 
@@ -335,6 +336,18 @@ Expr chairLike() {
   const Expr seat = block(0.0, 0.0, 0.1, 0.6, 0.6, 0.08), leg = block(0.3, 0.3, -0.3, 0.08, 0.08, 0.35);
   return rUnion(seat, leg) + 0.02 / (1.0 + square(seat / 0.1) + square(leg / 0.1));
 }
+
+// The model's mesh at res^3 simplified within 0.1 voxel with `on` and with `off` (their
+// tolerances set here): the same mesh expected; both runs' stats.
+std::pair<SimplifyStats, SimplifyStats> simplifiedBothWays(const TapePtr& tape, int res, SimplifyOptions on,
+                                                           SimplifyOptions off) {
+  GridSpec g = cubeGrid(1.0, res);
+  Mesh a = meshGrid(tape, g), b = a;
+  on.tolerance = off.tolerance = 0.1;
+  const SimplifyStats sa = simplifyMesh(a, tape, g, on), sb = simplifyMesh(b, tape, g, off);
+  expectSameMesh(a, b);
+  return {sa, sb};
+}
 }  // namespace
 
 // The error check's signs in float with the certified double fallback give the double path's
@@ -343,43 +356,34 @@ TEST(MeshSimplify, FloatSignsGiveTheDoubleMesh) {
   for (const Expr& m : {chairLike(), torusAndNotchedBlock()}) {
     TapePtr tape = Tape::compile(m, 3);
     ASSERT_TRUE(FloatErrorBound::supports(*tape));
-    GridSpec g = cubeGrid(1.0, 80);
-    Mesh a = meshGrid(tape, g), b = a;
-    SimplifyOptions flt, dbl;
-    flt.tolerance = dbl.tolerance = 0.1;
+    SimplifyOptions dbl;
     dbl.floatSigns = false;
-    const SimplifyStats sa = simplifyMesh(a, tape, g, flt), sb = simplifyMesh(b, tape, g, dbl);
+    const auto [sa, sb] = simplifiedBothWays(tape, 80, {}, dbl);
     EXPECT_GT(sa.collapses, 1000u);
     EXPECT_EQ(sa.collapses, sb.collapses);
     EXPECT_EQ(sa.modelEvals, sb.modelEvals);
     EXPECT_EQ(sa.errorBound, sb.errorBound);
-    expectSameMesh(a, b);
   }
 }
 
 // Levels decided by interval bounds (the triangle's two offset boxes) give the mesh of every
-// sample evaluated: flat faces of axis-aligned and tilted R-function blocks (thin boxes, decided)
-// joined by a blend (curved, not decided), a sphere, and a block rotated off the axes (whose
-// faces' boxes are thick: mostly not decided).
+// sample evaluated: flat faces of axis-aligned R-function blocks (thin boxes, decided) joined by
+// a blend (curved, not decided), a sphere, a block rotated off the axes (whose faces' boxes are
+// thick: mostly not decided) and the notched block.
 TEST(MeshSimplify, IntervalDecidedLevelsGiveTheSampledMesh) {
   Expr x = Expr::x(0), y = Expr::x(1), z = Expr::x(2);
   const double c = std::cos(0.4), s = std::sin(0.4);
   const Expr tilted = rIntersection(rIntersection(0.5 - abs(c * x + s * y), 0.4 - abs(c * y - s * x)), 0.3 - abs(z));
   int decidedSomewhere = 0;
   for (const Expr& m : {chairLike(), sphereAt(0.01, -0.02, 0.03, 0.7), tilted, torusAndNotchedBlock()}) {
-    TapePtr tape = Tape::compile(m, 3);
-    GridSpec g = cubeGrid(1.0, 96);
-    Mesh a = meshGrid(tape, g), b = a;
-    SimplifyOptions on, off;
-    on.tolerance = off.tolerance = 0.1;
+    SimplifyOptions off;
     off.intervalLevels = false;
-    const SimplifyStats sa = simplifyMesh(a, tape, g, on), sb = simplifyMesh(b, tape, g, off);
+    const auto [sa, sb] = simplifiedBothWays(Tape::compile(m, 3), 96, {}, off);
     EXPECT_GT(sa.collapses, 500u);
     EXPECT_EQ(sa.collapses, sb.collapses);
     EXPECT_EQ(sa.errorBound, sb.errorBound);
     EXPECT_LE(sa.modelEvals, sb.modelEvals);
     decidedSomewhere += sa.modelEvals < sb.modelEvals;
-    expectSameMesh(a, b);
   }
   EXPECT_GE(decidedSomewhere, 2);  // the path ran (the chair-like blocks, the notched block)
 }

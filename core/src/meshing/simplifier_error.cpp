@@ -180,18 +180,16 @@ bool Simplifier::offsetsDecided(const LevelQuery& q, const V3& de) {
   }
   const double pad = 1e-9 * reach + 1e-300;
   if (!(pad < INFINITY)) return false;  // no box: coordinates beyond double's range
+  ++intervalTries_;
   for (const double side : {-1.0, 1.0}) {
     for (uint32_t k = 0; k < spatial; ++k) ibox_[k] = Interval(lo[k] + side * de[k] - pad, hi[k] + side * de[k] + pad);
     const Interval f = ieval_.eval(*tape_, ibox_.data());
     // insideValue: f >= 0. Clear of 0 by a margin as well: the batch evaluator's formulas may
     // round differently from the interval ops' in the last bits where a bound grazes 0.
     const double margin = 1e-12 * (std::fabs(f.lo) + std::fabs(f.hi));
-    if (!(side < 0 ? f.lo > margin : f.hi < -margin)) {
-      ++intervalTries_;
-      return false;
-    }
+    if (!(side < 0 ? f.lo > margin : f.hi < -margin)) return false;
   }
-  ++intervalTries_, ++intervalPasses_;
+  ++intervalPasses_;
   return true;
 }
 

@@ -31,16 +31,16 @@ Registry& registry() {
 void registerLibraryFunction(LibraryFunction fn) {
   Registry& r = registry();
   std::string key = lowerCase(fn.name);
-  // A second registration of a name replaces the first (tests register fakes this way).
-  auto same = std::find(r.keys.begin(), r.keys.end(), key);
-  if (same != r.keys.end()) {
-    r.fns.erase(r.fns.begin() + (same - r.keys.begin()));
-    r.keys.erase(same);
+  // Sorted by the keys, which are unique: a second registration of a name replaces the first
+  // in place (tests register fakes this way).
+  const auto it = std::lower_bound(r.keys.begin(), r.keys.end(), key);
+  const size_t at = size_t(it - r.keys.begin());
+  if (it != r.keys.end() && *it == key) {
+    r.fns[at] = std::move(fn);
+    return;
   }
-  // The keys are unique now: sorted by them alone.
-  const size_t at = size_t(std::upper_bound(r.keys.begin(), r.keys.end(), key) - r.keys.begin());
   r.fns.insert(r.fns.begin() + std::ptrdiff_t(at), std::move(fn));
-  r.keys.insert(r.keys.begin() + std::ptrdiff_t(at), std::move(key));
+  r.keys.insert(it, std::move(key));
 }
 
 const LibraryFunction* findLibraryFunction(std::string_view name) {
