@@ -19,7 +19,8 @@ install(TARGETS frep_core frep_lang_archive frep_lang frep_io EXPORT frepfarmTar
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(TARGETS frep frep-worker RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-install(TARGETS frep_vdb LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/frepfarm)  # loaded by both for .vdb work
+# The modules the programs load when a job needs them (frep/io/program_module.h).
+install(TARGETS frep_vdb frep_mesh_files frep_view LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/frepfarm)
 install(DIRECTORY core/include/ lang/include/ io/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h")
 # The man page (man 1 frep) and the bash completion, where bash-completion loads a command's

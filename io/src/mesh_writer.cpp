@@ -249,8 +249,8 @@ void writeMesh(const std::string& path, const Mesh& input, MeshFormat format, co
   const Mesh& mesh = toY ? rotated : input;
   switch (format) {
     case MeshFormat::Wrl: return detail::writeVrml(path, mesh, options);
-    case MeshFormat::ThreeMf: return detail::write3mf(path, mesh, options);
-    case MeshFormat::Glb: return detail::writeGlb(path, mesh, options);
+    case MeshFormat::ThreeMf: return detail::meshFilesBackend().write3mf(path, mesh, options);
+    case MeshFormat::Glb: return detail::meshFilesBackend().writeGlb(path, mesh, options);
     default: break;
   }
   Bytes b(path);

@@ -54,8 +54,7 @@ std::unique_ptr<LevelSetTree> openVdbLevelSetTree(const GridSpec& grid, int band
 std::shared_ptr<const DistanceField> openVdbReadVolumeField(const std::string& path, const std::string& bytes,
                                                             const std::string& grid, uint64_t fileHash);
 
-// The module's entry point and the version it must answer (a module of another build refused).
+// The module's entry point (a frep::io::ModuleEntry: a module of another build answers nothing).
 inline constexpr const char* kVdbModuleEntry = "frep_vdb_backend";
-using VdbModuleEntry = const VdbBackend* (*)(const char* version, size_t tableSize);
 
 }  // namespace frep::io::detail

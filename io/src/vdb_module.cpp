@@ -10,8 +10,7 @@
 #define FREP_VERSION "unknown"
 #endif
 
-extern "C" __attribute__((visibility("default"))) const frep::io::detail::VdbBackend* frep_vdb_backend(
-    const char* version, size_t tableSize) {
+extern "C" __attribute__((visibility("default"))) const void* frep_vdb_backend(const char* version, size_t tableSize) {
   // A module of another build (a stale install next to a new program) answers nothing.
   if (!version || std::strcmp(version, FREP_VERSION) != 0 || tableSize != sizeof(frep::io::detail::VdbBackend))
     return nullptr;

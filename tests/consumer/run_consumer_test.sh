@@ -27,12 +27,17 @@ case " $verbs " in *" mesh "*) ;; *) echo "the installed completion offers '$ver
 echo "man page and completion installed ($verbs)"
 "$prefix/bin/frep" --version
 "$prefix/bin/frep-worker" --help >/dev/null
-# The installed frep finds its OpenVDB module (LIBDIR/frepfarm/libfrep_vdb.so) for .vdb work.
+# The installed frep finds its modules (LIBDIR/frepfarm): OpenVDB (libfrep_vdb.so) for .vdb work.
 printf 'ball(x[3], a[1]) { ball = 1 - x[1]^2 - x[2]^2 - x[3]^2; }\n' >"$tmp/ball.hf"
 "$prefix/bin/frep" sample "$tmp/ball.hf" -O "$tmp/ball.vdb" -b 1.5 --res 16 --workers 0 >/dev/null
 "$prefix/bin/frep" mesh "$tmp/ball.vdb" -O "$tmp/ball.ply" >/dev/null
 [ -s "$tmp/ball.ply" ] || { echo "the installed frep wrote no mesh of its .vdb"; exit 1; }
 echo "installed frep: .vdb written and read through $(find "$prefix" -name libfrep_vdb.so | sed "s|$prefix/||")"
+# ... and its mesh file module for .3mf and .glb.
+"$prefix/bin/frep" mesh "$tmp/ball.hf" -O "$tmp/ball.3mf" -b 1.5 --res 16 >/dev/null
+"$prefix/bin/frep" mesh "$tmp/ball.hf" -O "$tmp/ball.glb" -b 1.5 --res 16 >/dev/null
+[ -s "$tmp/ball.3mf" ] && [ -s "$tmp/ball.glb" ] || { echo "the installed frep wrote no .3mf or .glb"; exit 1; }
+echo "installed frep: .3mf and .glb written through $(find "$prefix" -name libfrep_mesh_files.so | sed "s|$prefix/||")"
 
 expect=0.6875
 cmake -S "$here" -B "$tmp/cmake-build" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >"$tmp/configure.log" \

@@ -128,7 +128,7 @@ def check_dockerfile(compose_programs):
     elif subprocess.run(["which", "dpkg"], stdout=subprocess.DEVNULL).returncode == 0:
         with Check("Dockerfile: runtime-package pipeline finds the libraries' packages"):
             cmd = m.group(1).replace("\\\n", " ").replace("/usr/local/bin/", BIN_DIR + "/")
-            cmd = cmd.replace("/usr/local/lib/frepfarm/", BIN_DIR + "/")  # the module, next to them here
+            cmd = cmd.replace("/usr/local/lib/frepfarm/", BIN_DIR + "/")  # the modules, next to them here
             cmd = cmd.replace("> /runtime-packages.txt", "")
             p = subprocess.run(["bash", "-o", "pipefail", "-c", cmd], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, timeout=300)
@@ -136,9 +136,10 @@ def check_dockerfile(compose_programs):
             require(p.returncode == 0, f"pipeline failed: {p.stderr.strip()}")
             require(any(x.startswith("libzmq") for x in pkgs) and "libc6" in pkgs,
                     f"expected libzmq5 and libc6 among {pkgs}")
-            # OpenVDB comes in through the module only (the programs load it for .vdb work).
-            require("libfrep_vdb.so" in cmd and any(x.startswith("libopenvdb") for x in pkgs),
-                    f"the module's libraries (libopenvdb) are not among {pkgs}")
+            # OpenVDB, lib3MF and cpp-httplib come in through the modules only (loaded when a job
+            # needs them): every module's libraries must be among the packages.
+            for lib in ("libopenvdb", "lib3mf", "libcpp-httplib"):
+                require(any(x.startswith(lib) for x in pkgs), f"the modules' library {lib} is not among {pkgs}")
 
 
 def check_compose(docs, frep_help, worker_help):

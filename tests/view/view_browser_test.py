@@ -146,10 +146,11 @@ def main():
 
 
 def run(work):
-    # Copies of frep and frep-worker: the build tree's may be relinked while the test runs.
+    # Copies of frep, frep-worker and the modules frep view loads (its server, and the .glb writer
+    # of its frep mesh children): the build tree's may be relinked while the test runs.
     os.makedirs(os.path.join(work, "bin"))
     frep = os.path.join(work, "bin", "frep")
-    for name in ("frep", "frep-worker"):
+    for name in ("frep", "frep-worker", "libfrep_view.so", "libfrep_mesh_files.so"):
         shutil.copy2(os.path.join(os.path.dirname(FREP), name), os.path.join(work, "bin", name))
     model = os.path.join(work, "model.hf")
     save(model, SPHERE)

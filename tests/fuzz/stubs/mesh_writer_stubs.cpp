@@ -6,7 +6,17 @@
 #include "mesh_writers.h"
 
 namespace frep::io::detail {
-void writeVrml(const std::string&, const Mesh&, const MeshWriteOptions&) { throw std::logic_error("not in the fuzz build"); }
-void write3mf(const std::string&, const Mesh&, const MeshWriteOptions&) { throw std::logic_error("not in the fuzz build"); }
-void writeGlb(const std::string&, const Mesh&, const MeshWriteOptions&) { throw std::logic_error("not in the fuzz build"); }
+namespace {
+void notInFuzzBuild(const std::string&, const Mesh&, const MeshWriteOptions&) {
+  throw std::logic_error("not in the fuzz build");
+}
+}  // namespace
+
+void writeVrml(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options) {
+  notInFuzzBuild(path, mesh, options);
+}
+const MeshFilesBackend& meshFilesBackend() {
+  static const MeshFilesBackend table{notInFuzzBuild, notInFuzzBuild};
+  return table;
+}
 }  // namespace frep::io::detail

@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
-"""frep and frep-worker load OpenVDB only for .vdb work (io/src/vdb_backend.h). Checks:
-- neither program needs libopenvdb (readelf NEEDED) nor loads it for a mesh job (LD_DEBUG=files);
-- every frepfarm symbol the module libfrep_vdb.so leaves undefined is exported by both programs
-  (a missing one would fail only when a job first reads or writes a .vdb, e.g. in a worker);
-- a .vdb job loads it and works; a program copied away from its module fails with exit 4 and a
-  message naming the paths tried, and writes no output, while a mesh job there still works.
-  vdb_module_check.py BIN_DIR"""
+"""frep and frep-worker load OpenVDB only for .vdb work, frep lib3MF and tinygltf only to write a
+.3mf or a .glb and cpp-httplib only for frep view (frep/io/program_module.h). Checks:
+- neither program needs those libraries (readelf NEEDED) nor loads them or any module for a mesh
+  job (LD_DEBUG=files);
+- every frepfarm symbol a module leaves undefined is exported by each program that loads it
+  (a missing one would fail only when a job first needs the module, e.g. in a worker);
+- a .vdb, .3mf or .glb job loads its module and works; a program copied away from its modules
+  fails with exit 4 and a message naming the paths tried, and writes no output, while a mesh job
+  there still works.
+  module_check.py BIN_DIR"""
 import os
 import shutil
 import subprocess
@@ -13,7 +16,11 @@ import sys
 import tempfile
 
 BIN = os.path.abspath(sys.argv[1])
-FREP, WORKER, MODULE = (os.path.join(BIN, n) for n in ("frep", "frep-worker", "libfrep_vdb.so"))
+FREP, WORKER = (os.path.join(BIN, n) for n in ("frep", "frep-worker"))
+# module -> (the programs that load it, the libraries it keeps out of them)
+MODULES = {"libfrep_vdb.so": ((FREP, WORKER), ("libopenvdb",)),
+           "libfrep_mesh_files.so": ((FREP,), ("lib3MF", "libtinygltf", "libzip", "libcrypto")),
+           "libfrep_view.so": ((FREP,), ("libcpp-httplib", "libssl", "libcrypto"))}
 BALL = "ball(x[3], a[1]) { ball = 1 - x[1]^2 - x[2]^2 - x[3]^2; }\n"
 failures = []
 
@@ -34,16 +41,16 @@ def demangled(names):
     return out.split("\n")
 
 
-undefined = sorted(symbols(MODULE, "--undefined-only"))
-needed_by_module = {s for s, d in zip(undefined, demangled(undefined)) if "frep::" in d}
-check(len(needed_by_module) > 0, "the module calls frepfarm functions of the program (%d)" % len(needed_by_module))
-for program in (FREP, WORKER):
-    name = os.path.basename(program)
-    dyn = subprocess.run(["readelf", "-d", program], capture_output=True, text=True, check=True).stdout
-    check("libopenvdb" not in dyn, name + " does not need libopenvdb")
-    missing = needed_by_module - symbols(program, "--defined-only")
-    check(not missing, name + " exports every frepfarm symbol the module needs" +
-          ("; missing: " + ", ".join(demangled(missing)) if missing else ""))
+for module, (programs, libraries) in MODULES.items():
+    undefined = sorted(symbols(os.path.join(BIN, module), "--undefined-only"))
+    needed_by_module = {s for s, d in zip(undefined, demangled(undefined)) if "frep::" in d}
+    for program in programs:
+        name = os.path.basename(program)
+        dyn = subprocess.run(["readelf", "-d", program], capture_output=True, text=True, check=True).stdout
+        check(not any(lib in dyn for lib in libraries), "%s needs none of %s" % (name, ", ".join(libraries)))
+        missing = needed_by_module - symbols(program, "--defined-only")
+        check(not missing, "%s exports every frepfarm symbol %s needs (%d)" % (name, module, len(needed_by_module)) +
+              ("; missing: " + ", ".join(demangled(missing)) if missing else ""))
 
 with tempfile.TemporaryDirectory() as tmp:
     model = os.path.join(tmp, "ball.hf")
@@ -53,8 +60,8 @@ with tempfile.TemporaryDirectory() as tmp:
     r = subprocess.run([FREP, "mesh", model, "-O", os.path.join(tmp, "ball.ply"), "--res", "16", "-b", "1.5", "--workers", "0"],
                        capture_output=True, text=True, env=env)
     loaded = "".join(open(os.path.join(tmp, f)).read() for f in os.listdir(tmp) if f.startswith("ld."))
-    check(r.returncode == 0 and "libopenvdb" not in loaded and "libfrep_vdb" not in loaded,
-          "frep mesh of a .hf loads neither OpenVDB nor the module (rc %d)" % r.returncode)
+    check(r.returncode == 0 and "libopenvdb" not in loaded and "libfrep_" not in loaded and "lib3MF" not in loaded
+          and "libcrypto" not in loaded, "frep mesh of a .hf to a .ply loads no module nor their libraries (rc %d)" % r.returncode)
     for f in os.listdir(tmp):
         if f.startswith("ld."):
             os.remove(os.path.join(tmp, f))
@@ -78,6 +85,16 @@ with tempfile.TemporaryDirectory() as tmp:
         check(r.returncode == 0, "frVolume of the .vdb meshed with %s workers (rc %d) %s" % (workers, r.returncode, r.stderr[-300:]))
         meshes.append(open(out, "rb").read() if r.returncode == 0 else b"")
     check(meshes[0] == meshes[1] and len(meshes[0]) > 1000, "the same bytes in-process and on 2 workers")
+    # .3mf (a ZIP archive) and .glb through the mesh file module.
+    for ext, magic in ((".3mf", b"PK"), (".glb", b"glTF")):
+        for f in os.listdir(tmp):
+            if f.startswith("ld."):
+                os.remove(os.path.join(tmp, f))
+        out = os.path.join(tmp, "ball" + ext)
+        r = subprocess.run([FREP, "mesh", model, "-O", out, "--res", "16", "-b", "1.5"], capture_output=True, text=True, env=env)
+        loaded = "".join(open(os.path.join(tmp, f)).read() for f in os.listdir(tmp) if f.startswith("ld."))
+        check(r.returncode == 0 and open(out, "rb").read(4).startswith(magic) and "libfrep_mesh_files" in loaded
+              and "libfrep_vdb" not in loaded, "frep mesh to a %s loads the mesh file module only (rc %d)" % (ext, r.returncode))
 
     # A program without its module: a clear error, exit 4 (docs/cli.md), no output file.
     alone = os.path.join(tmp, "alone")
@@ -90,6 +107,16 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r.returncode == 4 and "OpenVDB module" in r.stderr and "libfrep_vdb.so: not found" in r.stderr
           and not os.path.exists(out), "without the module: exit 4, the paths tried named, no file (rc %d: %s)"
           % (r.returncode, r.stderr.strip()[-300:]))
+    for ext in (".3mf", ".glb"):
+        out = os.path.join(tmp, "never" + ext)
+        r = subprocess.run([os.path.join(alone, "frep"), "mesh", model, "-O", out, "--res", "16", "-b", "1.5"],
+                           capture_output=True, text=True)
+        check(r.returncode == 4 and "mesh file module" in r.stderr and "libfrep_mesh_files.so: not found" in r.stderr
+              and not os.path.exists(out), "without the module a %s: exit 4, the paths tried named, no file (rc %d: %s)"
+              % (ext, r.returncode, r.stderr.strip()[-300:]))
+    r = subprocess.run([os.path.join(alone, "frep"), "view", model, "--port", "0"], capture_output=True, text=True, timeout=60)
+    check(r.returncode == 4 and "libfrep_view.so: not found" in r.stderr,
+          "without the module frep view: exit 4, the paths tried named (rc %d: %s)" % (r.returncode, r.stderr.strip()[-300:]))
     r = subprocess.run([os.path.join(alone, "frep"), "mesh", model, "-O", os.path.join(tmp, "alone.ply"), "--res", "16", "-b", "1.5"],
                        capture_output=True, text=True)
     check(r.returncode == 0, "without the module a mesh job still runs (rc %d)" % r.returncode)
