@@ -32,6 +32,7 @@ MeshOutput resolve(const std::string& field, const std::string& path, const std:
     return o;
   }
   o.format = f.empty() ? io::meshFormatFromPath(field, path) : io::meshFormatFromName(field, format);
+  io::requireMeshWriter(o.format);  // a missing writer module fails now, not after the job
   return o;
 }
 

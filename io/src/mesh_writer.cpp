@@ -242,6 +242,10 @@ UpAxis resolvedUpAxis(MeshFormat format, UpAxis up) {
   return format == MeshFormat::Glb ? UpAxis::Y : UpAxis::Z;
 }
 
+void requireMeshWriter(MeshFormat format) {
+  if (format == MeshFormat::ThreeMf || format == MeshFormat::Glb) (void)detail::meshFilesBackend();
+}
+
 void writeMesh(const std::string& path, const Mesh& input, MeshFormat format, const MeshWriteOptions& options) {
   Mesh rotated;
   const bool toY = resolvedUpAxis(format, options.up) == UpAxis::Y;

@@ -46,6 +46,10 @@ struct MeshWriteOptions {
   UpAxis up = UpAxis::Default;
 };
 
+// Loads now what writing `format` needs (frep loads the 3MF and glTF writers on demand,
+// frep/io/program_module.h), so that a broken install fails before a job, not after it.
+// Throws Error(kExitInternal) naming the paths tried.
+void requireMeshWriter(MeshFormat format);
 // Writes `mesh` to `path` (the caller's temporary file). Throws Error(kExitIoError).
 void writeMesh(const std::string& path, const Mesh& mesh, MeshFormat format, const MeshWriteOptions& options);
 inline void writeMesh(const std::string& path, const Mesh& mesh, MeshFormat format, const std::string& comment) {
