@@ -24,7 +24,8 @@ For each case: frep mesh at several resolutions and simplification tolerances (-
 0.1 voxel, frep's default; 0.02; 0, the marching tetrahedra's triangles kept), each with its
 default farm (2 local workers, or in-process for a grid of at most 64^3 points, docs/cli.md; the
 run's line says which), OpenSCAD minkowski() (sphere $fn from --fn) and manifold-3d
-minkowskiSum (node; the whole process and the operation alone). Equal accuracy: for each peer
+minkowskiSum (node; the whole process and the operation alone). A run under 1 s is timed by the
+median of 5 (any program). Equal accuracy: for each peer
 run, the fastest frep run whose |volume error| is at most the peer's (both triangle counts
 printed); the ratio peer / frep of wall times is printed. Also the
 per-voxel time of each case against the box (+) ball of the same form (box_ball for HyperFun
@@ -225,16 +226,22 @@ def ensure_npm(work):
 # ---------------------------------------------------------------------------------------------
 
 
-def timed(cmd, timeout):
-    t0 = time.monotonic()
-    try:
-        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return None, timeout, "timeout after %g s" % timeout
-    dt = time.monotonic() - t0
-    if p.returncode != 0:
-        return None, dt, p.stderr.decode(errors="replace")[-300:]
-    return p, dt, ""
+def timed(cmd, timeout, repeats=5, short=1.0):
+    """Runs cmd; a run shorter than `short` seconds is repeated up to `repeats` times and timed by
+    the median, as one run of a few milliseconds is mostly the scheduler's noise (frep and the
+    peers alike)."""
+    times = []
+    while True:
+        t0 = time.monotonic()
+        try:
+            p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return None, timeout, "timeout after %g s" % timeout
+        times.append(time.monotonic() - t0)
+        if p.returncode != 0:
+            return None, times[-1], p.stderr.decode(errors="replace")[-300:]
+        if times[0] >= short or len(times) >= repeats:
+            return p, sorted(times)[len(times) // 2], ""
 
 
 def unpaired_edges(tris_xyz):
