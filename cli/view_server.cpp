@@ -15,7 +15,6 @@
 #include <iostream>
 #include <thread>
 
-#include "arg_parse.h"
 #include "commands.h"
 #include "exit_codes.h"
 #include "view_child.h"
