@@ -17,6 +17,7 @@
 #include "frep/farm/job.h"
 #include "exit_codes.h"
 #include "frep/master/journal.h"
+#include "frep/worker/job_model.h"
 
 namespace frep::cli {
 
@@ -38,6 +39,8 @@ farm::JobSpec makeJob(const LoadedModel& m, const std::string& modelPath, const 
   for (double c : m.spec.constant) job.add_map_constant(c);
   job.set_iso(m.spec.iso);
   farm::setGrid(job, grid);
+  // The job's bytes are the ones m was compiled from: an in-process run need not compile it again.
+  farm::rememberCompiledModel(job, m.model);
   return job;
 }
 

@@ -5,6 +5,7 @@
 #include "farm_test_util.h"
 #include "frep/evaluators/eval.h"
 #include "frep/expressions/field_function.h"
+#include "frep/lang/hyperfun.h"
 #include "frep/lang/library/library.h"
 
 namespace farmtest {
@@ -118,6 +119,16 @@ TEST(ModelFiles, TheLastModelIsReusedOnlyForTheSameInputs) {
   EXPECT_DOUBLE_EQ(valueAt(other), -0.5);
   other.set_object("big");
   EXPECT_DOUBLE_EQ(valueAt(other), 0.5) << "another object of the same file served the old model";
+  // A model compiled elsewhere in the process from the same inputs (the frep command compiles the
+  // file from disk before it makes the job) is taken as it is.
+  frep::lang::CompileOptions options;
+  options.files["ball.stl"] = "3";
+  const frep::lang::CompileResult compiled = frep::lang::compile(source, "test.hf", options);
+  ASSERT_TRUE(compiled.ok);
+  const int loadsBefore = loads;
+  rememberCompiledModel(ballJob("3", source), compiled.model);
+  EXPECT_DOUBLE_EQ(valueAt(ballJob("3", source)), 1.5);
+  EXPECT_EQ(loads, loadsBefore) << "the remembered model was compiled again";
   frep::lang::setFileFieldLoader(before);
 }
 

@@ -71,9 +71,14 @@ class LastModel {
   bool has_ = false;
 };
 
-lang::Model compiledModel(const JobSpec& job) {
-  // Never destroyed: its expressions must not outlive the tables they are interned in at exit.
+// Never destroyed: its expressions must not outlive the tables they are interned in at exit.
+LastModel& lastModel() {
   static LastModel& last = *new LastModel;
+  return last;
+}
+
+lang::Model compiledModel(const JobSpec& job) {
+  LastModel& last = lastModel();
   if (std::optional<lang::Model> m = last.find(job, workerDataDir())) return *m;
   lang::CompileOptions opt;
   opt.object = job.object();
@@ -133,6 +138,10 @@ Vec3 vec3(const google::protobuf::RepeatedField<double>& v, const char* name) {
   return {v[0], v[1], v[2]};
 }
 }  // namespace
+
+void rememberCompiledModel(const JobSpec& job, const lang::Model& model) {
+  lastModel().keep(job, workerDataDir(), model);
+}
 
 Expr jobFieldOf(const JobSpec& job) {
   uint32_t dims = 0;

@@ -14,6 +14,7 @@
 #include "farm.pb.h"
 #include "frep/expressions/tape.h"
 #include "frep/geometry/vec3.h"
+#include "frep/lang/hyperfun.h"
 #include "frep/render/raycast.h"
 
 namespace frep::farm {
@@ -22,6 +23,10 @@ namespace frep::farm {
 // tape of the field clipped to the RenderSpec's box and composed with its camera (viewTape).
 // Throws std::runtime_error with the diagnostics when the model does not compile.
 TapePtr compileJobModel(const JobSpec& job);
+// The job's model as compiled elsewhere in this process from the same inputs (the frep command
+// compiles the model file from disk, and the job carries those bytes): the job's compilations in
+// this process (compileJobModel, jobFieldOf) then reuse it instead of compiling it again.
+void rememberCompiledModel(const JobSpec& job, const lang::Model& model);
 // One line per exact Minkowski algebra term of the model (Roerdink: no search, error bound 0),
 // for the report next to describeErrorBounds' lines.
 std::vector<std::string> describeExactTerms(const JobSpec& job);
