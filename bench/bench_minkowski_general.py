@@ -480,12 +480,12 @@ def main():
         def err_of(v):
             return (v - exact) / exact if exact else float("nan")
         for fr in frep_runs:
-            print("  %-30s %8.2f %9s %10d %+9.4f%% %6d  (%s path, %s)" % (fr["label"], fr["wall"], "", fr["tris"],
+            print("  %-30s %8.3f %9s %10d %+9.4f%% %6d  (%s path, %s)" % (fr["label"], fr["wall"], "", fr["tris"],
                                                                         100 * err_of(fr["vol"]), fr["open"], fr["path"], fr["where"]))
             if name in BASELINES.values() and fr["tol"] == tolerances[0]:
                 base[(case["form"], fr["res"])] = fr["wall"]
         for pp in peers:
-            print("  %-30s %8.2f %9s %10d %+9.4f%%" % (pp["who"], pp["wall"], "%.2f" % pp["op"] if pp["op"] is not None else "",
+            print("  %-30s %8.3f %9s %10d %+9.4f%%" % (pp["who"], pp["wall"], "%.2f" % pp["op"] if pp["op"] is not None else "",
                                                         pp["tris"], 100 * err_of(pp["vol"])))
         for fr in frep_runs:
             key = (case["form"], fr["res"])
@@ -501,14 +501,14 @@ def main():
             match = [fr for fr in frep_runs if abs(err_of(fr["vol"])) <= max(e, 1e-6)]
             if match:
                 fr = min(match, key=lambda x: x["wall"])
-                line = "  equal accuracy vs %s (%.4f%%, %d triangles): %s (%.4f%%, %d) %.2f s; %s / frep = %.2fx" % (
+                line = "  equal accuracy vs %s (%.4f%%, %d triangles): %s (%.4f%%, %d) %.3f s; %s / frep = %.2fx" % (
                     pp["who"], 100 * e, pp["tris"], fr["label"], 100 * abs(err_of(fr["vol"])), fr["tris"], fr["wall"],
                     pp["who"].split()[0], pp["wall"] / fr["wall"])
             else:
                 best = min(frep_runs, key=lambda x: abs(err_of(x["vol"]))) if frep_runs else None
-                line = "  %s is exact here (%.4f%%): frep's closest %s (%.4f%%) %s s vs %.2f s" % (
+                line = "  %s is exact here (%.4f%%): frep's closest %s (%.4f%%) %s s vs %.3f s" % (
                     pp["who"], 100 * e, best["label"] if best else "-", 100 * abs(err_of(best["vol"])) if best else 0,
-                    "%.2f" % best["wall"] if best else "-", pp["wall"])
+                    "%.3f" % best["wall"] if best else "-", pp["wall"])
             print(line)
             summary.append((name, line.strip()))
     print("\nsummary (equal accuracy)")
