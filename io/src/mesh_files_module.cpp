@@ -14,6 +14,5 @@ extern "C" __attribute__((visibility("default"))) const void* frep_mesh_files_ba
   using frep::io::detail::MeshFilesBackend;
   // A module of another build (a stale install next to a new program) answers nothing.
   if (!version || std::strcmp(version, FREP_VERSION) != 0 || tableSize != sizeof(MeshFilesBackend)) return nullptr;
-  static const MeshFilesBackend table{frep::io::detail::write3mf, frep::io::detail::writeGlb};
-  return &table;
+  return &frep::io::detail::linkedMeshFiles();
 }
