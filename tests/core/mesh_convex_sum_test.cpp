@@ -385,6 +385,98 @@ TEST(MeshConvexSum, ClassesOfClusteredPointsHoldForThinAndThickOperands) {
   }
 }
 
+TEST(MeshConvexSum, TiltedTetrahedronToolKeepsEveryClassNearTheSurface) {
+  // L prism ⊕ a tetrahedron in no special position. Each cell T ⊕ B is tested on its facets
+  // only, a point first against the plane that separates its lattice cell's centre most, and a
+  // point nearer that centre than the first cell's depth there is inside with no plane tested:
+  // every class checked against the union of the two blocks ⊕ B, each the intersection of all
+  // its candidate supporting planes (the blocks' and B's normals and the edge products),
+  // independent of the triangles, at clustered points within 0.03 of the surface.
+  const std::array<V3, 4> tv{V3{0.05, -0.07, 0.02}, V3{-0.11, 0.04, -0.06}, V3{0.02, 0.13, 0.09},
+                             V3{-0.03, -0.02, 0.17}};
+  Expr tet;
+  for (int f = 0; f < 4; ++f) {
+    const V3 &a = tv[size_t((f + 1) % 4)], &b = tv[size_t((f + 2) % 4)], &c = tv[size_t((f + 3) % 4)];
+    V3 n = cross({b[0] - a[0], b[1] - a[1], b[2] - a[2]}, {c[0] - a[0], c[1] - a[1], c[2] - a[2]});
+    const V3& d = tv[size_t(f)];
+    if (dot(n, d) > dot(n, a)) n = {-n[0], -n[1], -n[2]};  // outward: away from the fourth corner
+    const double l = std::sqrt(dot(n, n));
+    const Expr plane = (dot(n, a) - (n[0] * X() + n[1] * Y() + n[2] * Z())) / l;
+    tet = f == 0 ? plane : min(tet, plane);
+  }
+  const double h = 0.4;
+  Expr sum;
+  ASSERT_TRUE(minkowski::meshConvexSum(mesh_models::lPrismMesh(h), tet, 3, &sum));
+  // The exact sum: block ⊕ B = {p : u . p <= h_block(u) + h_B(u)} over the candidate normals.
+  std::vector<V3> dirs{V3{1, 0, 0}, V3{0, 1, 0}, V3{0, 0, 1}};
+  std::vector<V3> normals{{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (size_t i = 0; i < 4; ++i)
+    for (size_t j = i + 1; j < 4; ++j) {
+      const V3 e{tv[j][0] - tv[i][0], tv[j][1] - tv[i][1], tv[j][2] - tv[i][2]};
+      for (const V3& d : dirs) {
+        const V3 n = cross(d, e);
+        normals.push_back(n), normals.push_back({-n[0], -n[1], -n[2]});
+      }
+      for (size_t k = j + 1; k < 4; ++k) {
+        const V3 f{tv[k][0] - tv[i][0], tv[k][1] - tv[i][1], tv[k][2] - tv[i][2]};
+        const V3 n = cross(e, f);
+        normals.push_back(n), normals.push_back({-n[0], -n[1], -n[2]});
+      }
+    }
+  auto blockSum = [&](const V3& p, const V3& lo, const V3& hi) {
+    double depth = INFINITY;
+    for (const V3& n : normals) {
+      const double l = std::sqrt(dot(n, n));
+      double hb = 0, ht = -INFINITY;
+      for (int k = 0; k < 3; ++k) hb += n[size_t(k)] * (n[size_t(k)] > 0 ? hi[size_t(k)] : lo[size_t(k)]);
+      for (const V3& v : tv) ht = std::max(ht, dot(n, v));
+      depth = std::min(depth, (hb + ht - dot(n, p)) / l);
+    }
+    return depth;  // > 0 inside, < 0 outside (a lower bound of the distance there)
+  };
+  auto exact = [&](const V3& p) {
+    return std::max(blockSum(p, {0, 0, 0}, {2, 1, h}), blockSum(p, {0, 0, 0}, {1, 2, h}));
+  };
+  TapePtr tape = Tape::compile(sum, 3);
+  BatchEvaluator<double> values, signs;
+  signs.setFieldSignsOnly(true);
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-0.2, 2.2), jitter(-0.03, 0.03);
+  int in = 0, out = 0;
+  for (int round = 0; round < 60; ++round) {
+    const size_t n = BatchEvaluator<double>::kBatch;
+    values.reserve(*tape);
+    signs.reserve(*tape);
+    V3 c{0, 0, 0};
+    for (size_t i = 0; i < n; ++i) {
+      if (i % 32 == 0) {  // a centre on the sum's surface: bisect between an inside and an outside point
+        V3 a{u(rng), u(rng), u(rng) * h / 2.2}, b{u(rng), u(rng), -0.5 + u(rng)};
+        if ((exact(a) > 0) == (exact(b) > 0)) a = {0.5, 0.5, 0.5 * h};
+        if (exact(a) <= 0) std::swap(a, b);
+        if (exact(a) <= 0 || exact(b) > 0) continue;
+        for (int k = 0; k < 50; ++k) {
+          const V3 m{0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])};
+          (exact(m) > 0 ? a : b) = m;
+        }
+        c = a;
+      }
+      for (uint32_t k = 0; k < 3; ++k) values.in(k)[i] = signs.in(k)[i] = c[k] + jitter(rng);
+    }
+    const double* f = values.eval(*tape, n);
+    const double* sg = signs.eval(*tape, n);
+    for (size_t i = 0; i < n; ++i) {
+      const V3 p{values.in(0)[i], values.in(1)[i], values.in(2)[i]};
+      const double e = exact(p);
+      if (std::abs(e) < 1e-9) continue;
+      ASSERT_EQ(sg[i] >= 0, e > 0) << "class at " << p[0] << " " << p[1] << " " << p[2];
+      ASSERT_EQ(f[i] >= 0, e > 0) << "value at " << p[0] << " " << p[1] << " " << p[2];
+      (e > 0 ? in : out) += 1;
+    }
+  }
+  EXPECT_GT(in, 2000);
+  EXPECT_GT(out, 2000);
+}
+
 // An L prism s ([0,2]x[0,1] ∪ [0,1]x[0,2]) x [0, h] + shift as a closed mesh (lPrism's faces).
 Expr lPrismAt(double s, double h, const V3& shift) {
   const double L[6][2] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};

@@ -56,7 +56,7 @@ void CellLists::Lists::clear() {
   slots.assign(1024, Slot{kEmpty, 0, 0});
   used = 0;
   items.clear();
-  hasLast = false;
+  for (Slot& r : recent) r = Slot{kEmpty, 0, kNone};
 }
 
 // Twice the slots, every key placed again; the new slot of key.

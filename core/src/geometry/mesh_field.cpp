@@ -85,11 +85,30 @@ uint32_t floatBitsDown(double x) {
   return bits;
 }
 
-// The key of pair i of a cell's candidate list (cellCandidates).
-double candidateKey(const uint32_t* list, uint32_t i) {
+// A cell's candidate list (cellCandidates): per candidate its slot, its key and its linear
+// lower bound's unit direction and base, as floats.
+constexpr uint32_t kCandidateWords = 6;
+float floatAt(const uint32_t* w) {
   float g;
-  std::memcpy(&g, &list[2 * i + 1], sizeof g);
-  return double(g);
+  std::memcpy(&g, w, sizeof g);
+  return g;
+}
+uint32_t floatBits(float g) {
+  uint32_t bits;
+  std::memcpy(&bits, &g, sizeof bits);
+  return bits;
+}
+uint32_t candidateSlot(const uint32_t* list, uint32_t i) { return list[kCandidateWords * i]; }
+double candidateKey(const uint32_t* list, uint32_t i) { return double(floatAt(&list[kCandidateWords * i + 1])); }
+// A lower bound of |p - T| for candidate i, pc = p - c and fromCentre >= |pc|: T lies in the
+// half-space n . (x - q) <= 0 (q: T's nearest point to c, n: the unit vector from q to c), so
+// |p - T| >= n . (p - q) = |c - q| + n . pc, tight where p moves along the cell's surface rather
+// than towards it (the key's |c - T| - |pc| is not). The base carries the slack for q's and n's
+// rounding; 1e-7 |pc| covers n rounded to float.
+double linearGap(const uint32_t* list, uint32_t i, const double* pc, double fromCentre) {
+  const uint32_t* e = &list[kCandidateWords * i];
+  const double n0 = floatAt(e + 2), n1 = floatAt(e + 3), n2 = floatAt(e + 4), base = floatAt(e + 5);
+  return base + (n0 * pc[0] + n1 * pc[1] + n2 * pc[2]) - 1e-7 * fromCentre;
 }
 
 void normalise(double* v) {
@@ -294,21 +313,22 @@ void MeshField::searchAll(const double* p, Nearest& n) const {
 // cell is within U = |c - T_c| + half the cell's diagonal of T_c, so a triangle farther than U
 // from the whole cell (by its box, its plane or its distance from c less half the diagonal) is
 // never nearest there, nor tied. Nothing when p is outside the lattice or the cell has too
-// many candidates. The list holds pairs (slot, key), key |c - T| as float bits rounded down,
-// sorted by key: a query at p stops at the first key with key - |p - c| beyond its best
-// distance (nearestTriangle), as |p - T| >= |c - T| - |p - c|. count: the pairs; fromCentre:
+// many candidates. The list holds per candidate (kCandidateWords) its slot, key |c - T| as
+// float bits rounded down and linearGap's bound, sorted by key: a query at p stops at the first
+// key with key - |p - c| beyond its best distance (nearestTriangle), as |p - T| >= |c - T| -
+// |p - c|, and skips those whose linear bound is beyond it. count: the candidates; fromCentre:
 // |p - c| rounded up, with margins for its rounding and for p placed in the cell from a few
 // ulps outside; centreValue: f(c) with its magnitude rounded down (0 on an open mesh: no
 // sign), kept in a header pair before the list (offsetClass: a point nearer c than |f(c)| has
-// c's class). candidateKey(list, i): pair i's key.
-const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, double& fromCentre,
-                                          double& centreValue) const {
+// c's class). pc: p - c (linearGap).
+const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, double& fromCentre, double& centreValue,
+                                          double* pc) const {
   uint64_t key;
   int64_t ijk[3];
   if (!lattice_.cellOf(p, key, ijk)) return nullptr;
   Bvh::Box box;
   lattice_.cellBox(ijk, box.lo, box.hi);
-  double centre[3], pc[3];
+  double centre[3];
   for (int k = 0; k < 3; ++k) centre[k] = 0.5 * (box.lo[k] + box.hi[k]);
   sub(p, centre, pc);
   fromCentre = std::sqrt(dot(pc, pc)) * (1 + 1e-9) + 1e-12 * scale_;
@@ -334,7 +354,13 @@ const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, doub
     const double halfDiag = 0.5 * std::sqrt(3.0) * cellSize;
     const double slack = 1e-12 * scale_;  // a point placed in the cell from a few ulps outside
     const double reach = (std::sqrt(c.best2) + halfDiag) * (1 + 1e-9) + slack;
-    thread_local std::vector<std::pair<float, uint32_t>> found;
+    struct Found {
+      float key;
+      uint32_t slot;
+      float n[3], base;
+      bool operator<(const Found& o) const { return key != o.key ? key < o.key : slot < o.slot; }
+    };
+    thread_local std::vector<Found> found;
     found.clear();
     bool fits = true;
     bvh_.nearBox(box, reach, [&](uint32_t slot, uint32_t) {
@@ -354,22 +380,44 @@ const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, doub
       // rounded down).
       double qq[3];
       int region;
-      const double dc = std::sqrt(triangleDist2(centre, v, v + 3, v + 6, qq, region)) * (1 - 1e-9);
+      const double dExact = std::sqrt(triangleDist2(centre, v, v + 3, v + 6, qq, region));
+      const double dc = dExact * (1 - 1e-9);
       if (dc - halfDiag * (1 + 1e-9) - slack > reach) return true;
-      found.push_back({downToFloat(dc), slot});  // the key, rounded down again
+      Found f{downToFloat(dc), slot, {0, 0, 0}, -INFINITY};  // the key, rounded down again
+      // linearGap's direction and base, where c is clear of T (else n is ill-conditioned):
+      // q within delta of the true nearest point turns n by at most 2 delta / d, which moves
+      // n . (x - q) for x in T by at most delta (1 + 2 diam(T) / d).
+      if (dExact > 1e-6 * cellSize) {
+        const double delta = 1e-12 * scale_;
+        double diam2 = 0;
+        for (int a = 0; a < 3; ++a)
+          for (int b = a + 1; b < 3; ++b) {
+            double e[3];
+            sub(v + 3 * b, v + 3 * a, e);
+            diam2 = std::max(diam2, dot(e, e));
+          }
+        double n[3];
+        sub(centre, qq, n);
+        normalise(n);
+        for (int k = 0; k < 3; ++k) f.n[k] = float(n[k]);
+        f.base = downToFloat(dExact * (1 - 1e-9) - delta * (1 + 2 * std::sqrt(diam2) / dExact));
+      }
+      found.push_back(f);
       fits = found.size() <= kMaxCandidates;
       return fits;  // too many: the hierarchy answers here
     });
     if (!fits) return false;
     std::sort(found.begin(), found.end());
-    for (const auto& f : found) out.push_back(f.second), out.push_back(floatBitsDown(f.first));
+    for (const Found& f : found)
+      out.insert(out.end(), {f.slot, floatBits(f.key), floatBits(f.n[0]), floatBits(f.n[1]), floatBits(f.n[2]),
+                             floatBits(f.base)});
     return true;
   });
   if (!list) return nullptr;
   float fc;
   std::memcpy(&fc, &list[1], sizeof fc);
   centreValue = list[0] ? double(fc) : -double(fc);
-  count = count / 2 - 1;
+  count = (count - 2) / kCandidateWords;
   return list + 2;
 }
 
@@ -378,7 +426,7 @@ int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, 
   const size_t nt = tris_.size() / 3;
   uint32_t count = 0;
   const uint32_t* cands = nullptr;
-  double fromCentre, centreValue;  // of the cell of the candidates
+  double fromCentre, centreValue, pc[3];  // of the cell of the candidates
   if (nt <= 16) {  // a few triangles: all of them, no hierarchy
     // This thread's last nearest first: its distance lets the plane test skip most of the
     // others (a convex polytope's facets). The answer is canonical, so the order is free.
@@ -388,13 +436,16 @@ int64_t MeshField::nearestTriangle(const double* p, double* q, int& bestRegion, 
       if (slot != warm) offer(p, slot, n);
     if (n.found) tWarm = {id_, n.slot};
   } else if (gCandidateCells.load(std::memory_order_relaxed) &&
-             (cands = cellCandidates(p, count, fromCentre, centreValue))) {
+             (cands = cellCandidates(p, count, fromCentre, centreValue, pc))) {
     // Near-first: once a candidate's lower bound key - |p - c| exceeds the best distance, so do
-    // all the later ones' (a tie needs a distance equal to the best).
+    // all the later ones' (a tie needs a distance equal to the best); one whose linear bound
+    // does is skipped.
     for (uint32_t i = 0; i < count; ++i) {
       const double gap = candidateKey(cands, i) - fromCentre;
       if (gap > 0 && gap * gap > n.best2 * (1 + 1e-9)) break;
-      offer(p, cands[2 * i], n);
+      const double linear = linearGap(cands, i, pc, fromCentre);
+      if (linear > 0 && linear * linear > n.best2 * (1 + 1e-9)) continue;
+      offer(p, candidateSlot(cands, i), n);
     }
     if (n.found) tWarm = {id_, n.slot};
   } else {
@@ -452,21 +503,28 @@ double MeshField::offsetClass(const double* p, double level) const {
     return value(p) + level;
   const double r = std::abs(level), rSlack = r * (1 + 1e-9);
   const double near = level > 0 ? 1.0 : -1.0;  // the class when some triangle is within r
+  const double r2 = r * r;
   auto within = [&](uint32_t slot) {
     double qq[3];
     int region;
     const double* v = &corners_[9 * size_t(slot)];
-    const double d = std::sqrt(triangleDist2(p, v, v + 3, v + 6, qq, region));
+    const double d2 = triangleDist2(p, v, v + 3, v + 6, qq, region);
+    // d2 clear of r^2 (1e-12 covers r * r's rounding) decides fl(sqrt(d2)) against r without
+    // the square root (fl(sqrt) is monotone and correctly rounded)
+    if (d2 < r2 * (1 - 1e-12)) return true;
+    if (d2 > r2 * (1 + 1e-12)) return false;
+    const double d = std::sqrt(d2);
     return level > 0 ? d <= r : d < r;
   };
-  if (tWarm.field == id_ && tWarm.slot < nt && within(tWarm.slot)) return near;
+  if (tWarm.field == id_ && tWarm.slot < nt && planeGap(p, tWarm.slot) <= rSlack && within(tWarm.slot)) return near;
   uint32_t count = 0;
-  double fromCentre, centreValue;
-  const uint32_t* cands = cellCandidates(p, count, fromCentre, centreValue);
+  double fromCentre, centreValue, pc[3];
+  const uint32_t* cands = cellCandidates(p, count, fromCentre, centreValue, pc);
   if (!cands) return value(p) + level;
   for (uint32_t i = 0; i < count; ++i) {
     if (candidateKey(cands, i) - fromCentre > rSlack) break;  // this one and the rest: farther than r
-    const uint32_t slot = cands[2 * i];
+    if (linearGap(cands, i, pc, fromCentre) > rSlack) continue;  // this one is farther than r
+    const uint32_t slot = candidateSlot(cands, i);
     if (planeGap(p, slot) > rSlack) continue;  // its plane is farther than r
     if (within(slot)) {
       tWarm = {id_, slot};

@@ -75,6 +75,9 @@ class MeshConvexSumField : public DistanceField {
     for (const Bvh::Box& x : boxes)
       for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], x.lo[k]), hi[k] = std::max(hi[k], x.hi[k]);
     lattice_ = CellLattice::over(lo, hi, 128, 0);
+    // The rounding of a plane's value at a lattice cell's centre and of |p - c|, far above it.
+    centreSlack_ = 1e-9 * lattice_.size + 1e-14 * (std::abs(lo[0]) + std::abs(lo[1]) + std::abs(lo[2]) +
+                                                   std::abs(hi[0]) + std::abs(hi[1]) + std::abs(hi[2]));
     cellBoxes_ = std::move(boxes);
     cellClasses_ = lattice_.size * std::sqrt(3.0) < 1.9 * memoRadius_;
     for (size_t i = 0; i < bs.size(); ++i) convolutionPieces(a, bs[i], pieceDirs[i], complement_, tol, tri);
@@ -113,6 +116,37 @@ class MeshConvexSumField : public DistanceField {
     return bDirs;
   }
 
+  // Whether the supporting plane of T ⊕ B of normal u (T's and B's support hT, hB) holds a
+  // facet: the corners of T and of B within tol of their support span two directions. Near-ties
+  // count as ties, so a doubtful plane is kept (a supporting plane is never wrong, only slow).
+  static bool isFacet(const V3 tv[3], const Convex& b, const V3& u, double hT, double hB, double tol) {
+    V3 dirs[2];
+    int found = 0;
+    auto add = [&](const V3& d) {
+      const double l2 = dot(d, d);
+      if (!(l2 > tol * tol)) return false;
+      if (found == 0) {
+        dirs[found++] = d;
+        return false;
+      }
+      const V3 c = cross(dirs[0], d);
+      return dot(c, c) > 1e-20 * dot(dirs[0], dirs[0]) * l2;  // a second direction: a facet
+    };
+    const V3* t0 = nullptr;
+    for (int k = 0; k < 3; ++k)
+      if (dot(u, tv[k]) >= hT - tol) {
+        if (!t0) t0 = &tv[k];
+        else if (add(sub(tv[k], *t0))) return true;
+      }
+    const V3* b0 = nullptr;
+    for (const V3& p : b.v)
+      if (dot(u, p) >= hB - tol) {
+        if (!b0) b0 = &p;
+        else if (add(sub(p, *b0))) return true;
+      }
+    return false;
+  }
+
   // The cells T ⊕ B of every triangle T of A: their planes and boxes.
   void addCells(const Mesh& a, const Convex& b, const std::vector<V3>& bDirs, double tol,
                 std::vector<Bvh::Box>& boxes) {
@@ -129,6 +163,7 @@ class MeshConvexSumField : public DistanceField {
     // A B with no facets is a segment or a point (a path's piece); one with facets has volume.
     const bool flatB = bNormals.empty();
     std::vector<V3> normals;
+    std::vector<std::array<double, 4>> touching;
     for (const auto& t : a.t) {
       const V3 tv[3] = {a.v[t[0]], a.v[t[1]], a.v[t[2]]};
       // The candidate facet normals of T ⊕ B, each once: two within 1e-12 are one (rounding), but
@@ -176,12 +211,22 @@ class MeshConvexSumField : public DistanceField {
         for (int k = 0; k < 3; ++k) inPlane(sub(tv[(k + 1) % 3], tv[k]));
         for (const V3& d : bDirs) inPlane(d);
       }
+      // The facets of T ⊕ B first, the planes that touch it in an edge or a corner after: the
+      // queries' c_T needs only the facets (inside a convex polytope the nearest of its
+      // supporting planes is a facet's, so the min is the same), the lists' separation test
+      // takes all (a corner's plane may separate a lattice cell that no facet does). A flat sum
+      // (B parallel to T) keeps all: its edges' planes bound it within its plane.
       const uint32_t first = uint32_t(planes_.size());
+      touching.clear();
       for (const V3& u : normals) {
         const double hT = std::max({dot(u, tv[0]), dot(u, tv[1]), dot(u, tv[2])}), hB = b.support(u);
-        planes_.push_back({u[0], u[1], u[2], hT + hB});
+        const std::array<double, 4> plane{u[0], u[1], u[2], hT + hB};
+        if (parallel || isFacet(tv, b, u, hT, hB, tol)) planes_.push_back(plane);
+        else touching.push_back(plane);
       }
-      cells_.push_back({first, uint32_t(planes_.size()) - first});
+      const uint32_t facets = uint32_t(planes_.size()) - first;
+      planes_.insert(planes_.end(), touching.begin(), touching.end());
+      cells_.push_back({first, facets, uint32_t(planes_.size()) - first});
       Bvh::Box box;
       for (int k = 0; k < 3; ++k) {
         box.lo[k] = std::min({tv[0][size_t(k)], tv[1][size_t(k)], tv[2][size_t(k)]}) + bLo[size_t(k)] - tol;
@@ -242,13 +287,15 @@ class MeshConvexSumField : public DistanceField {
   static thread_local SignMemo tSignMemo[kSignMemos];
   static thread_local int tSignMemoNext;
   std::vector<std::array<double, 4>> planes_;  // u . x <= h
+  static constexpr uint32_t kNoLead = UINT32_MAX;
   struct Cell {
-    uint32_t first, count;
+    uint32_t first, count, all;  // planes_[first, first + count): its facets; to first + all: every plane
   };
   std::vector<Cell> cells_;
   std::vector<Bvh::Box> cellBoxes_;
   Bvh cellBvh_;
   CellLattice lattice_;  // of the lists of cells whose boxes meet a lattice cell
+  double centreSlack_ = 0;
   std::shared_ptr<const MeshField> soup_;
   size_t pieces_ = 0;
   uint64_t hash_ = 0;
@@ -286,9 +333,10 @@ class MeshConvexSumField : public DistanceField {
         return !interior;
       };
       uint32_t count = 0;
-      const uint32_t* list = interior ? nullptr : cellsNear(v[0], count);
+      double fromCentre;
+      const uint32_t* list = interior ? nullptr : cellsNear(v[0], count, fromCentre);
       if (list)
-        for (uint32_t j = 0; j < count && inCell(list[j]); ++j) {}
+        for (uint32_t j = 0; j < count && inCell(list[j]); j += kListWords) {}
       else if (!interior) cellBvh_.containing(v[0], inCell);
       return interior;
     };
@@ -367,9 +415,17 @@ class MeshConvexSumField : public DistanceField {
     double g = -INFINITY;
     // A cell's planes stop as soon as its c_T cannot raise g (or, for the class, is negative).
     const double floor = firstInside ? 0.0 : -INFINITY;
-    auto visit = [&](uint32_t i) {
+    // lead: a plane of the cell to try first (the one farthest below the lattice cell's centre,
+    // which separates most points of the lattice cell outside the cell), or kNoLead. Its value
+    // joins the facets' min: inside the cell it is no smaller (a supporting plane), outside
+    // the min is negative either way.
+    auto visit = [&](uint32_t i, uint32_t lead) {
       const Cell& c = cells_[i];
       double m = INFINITY;
+      if (lead != kNoLead) {
+        const auto& u = planes_[c.first + lead];
+        m = u[3] - (u[0] * p[0] + u[1] * p[1] + u[2] * p[2]);
+      }
       const double stop = std::max(g, floor);
       for (uint32_t k = c.first; k < c.first + c.count && m >= stop && (m > g || firstInside); ++k) {
         const auto& u = planes_[k];
@@ -379,34 +435,66 @@ class MeshConvexSumField : public DistanceField {
       return !(firstInside && g >= 0);
     };
     uint32_t count = 0;
-    const uint32_t* list = cellsNear(p, count);
+    double fromCentre = 0;
+    const uint32_t* list = cellsNear(p, count, fromCentre);
     if (!list) {
-      cellBvh_.containing(p, visit);
+      cellBvh_.containing(p, [&](uint32_t i) { return visit(i, kNoLead); });
       return g;
+    }
+    // The class: c_T is 1-Lipschitz (unit normals), so the first cell's c_T at the centre
+    // beyond |p - c| puts p inside it (the list is sorted by that value, the first is the
+    // largest), with no plane tested.
+    if (firstInside && count > 0) {
+      const double depth = listDepth(list) - fromCentre;
+      if (depth >= 0) return depth;
     }
     // The list holds every cell whose box meets p's lattice cell; the same boxes as the
     // hierarchy's test (closed) pick those that hold p, so g is the same max.
-    for (uint32_t j = 0; j < count; ++j) {
+    for (uint32_t j = 0; j < count; j += kListWords) {
       const Bvh::Box& b = cellBoxes_[list[j]];
       if (p[0] < b.lo[0] || p[0] > b.hi[0] || p[1] < b.lo[1] || p[1] > b.hi[1] || p[2] < b.lo[2] || p[2] > b.hi[2])
         continue;
-      if (!visit(list[j])) break;
+      if (!visit(list[j], list[j + 1])) break;
     }
     return g;
   }
   // The cells that can hold a point of the lattice cell holding p (at most 512), or nothing:
-  // those whose boxes meet it, less those a facet plane of theirs separates from it, ordered by
+  // those whose boxes meet it, less those a plane of theirs separates from it, ordered by
   // their c_T at the cell's centre, largest first. A point's max c_T then often comes first
   // (the class search ends at it; the max prunes the rest), and a dropped cell has c_T < 0 at
-  // every point of the lattice cell, which no caller reads (only g >= 0 counts).
-  const uint32_t* cellsNear(const double* p, uint32_t& count) const {
-    return CellLists::at(id_, lattice_, p, count, [&](const double* lo, const double* hi, std::vector<uint32_t>& out) {
+  // every point of the lattice cell, which no caller reads (only g >= 0 counts). Per cell
+  // kListWords: its index, its plane of least value at the centre (visit's lead) and that value
+  // as a float rounded down (the first one's: listDepth); count: the words. fromCentre: |p - c|
+  // rounded up, c the lattice cell's centre.
+  static constexpr uint32_t kListWords = 3;
+  static float downToFloat(double x) {
+    const float f = float(x);
+    return double(f) > x ? std::nextafter(f, -INFINITY) : f;
+  }
+  static double listDepth(const uint32_t* list) {
+    float d;
+    std::memcpy(&d, &list[2], sizeof d);
+    return double(d);
+  }
+  const uint32_t* cellsNear(const double* p, uint32_t& count, double& fromCentre) const {
+    uint64_t key;
+    int64_t ijk[3];
+    if (!lattice_.cellOf(p, key, ijk)) return nullptr;
+    double lo[3], hi[3];
+    lattice_.cellBox(ijk, lo, hi);
+    const double pc[3] = {p[0] - (lo[0] + hi[0]) / 2, p[1] - (lo[1] + hi[1]) / 2, p[2] - (lo[2] + hi[2]) / 2};
+    fromCentre = std::sqrt(pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2]) * (1 + 1e-9) + centreSlack_;
+    return CellLists::get(id_, key, count, [&](std::vector<uint32_t>& out) {
       Bvh::Box q;
       for (int k = 0; k < 3; ++k) q.lo[k] = lo[k], q.hi[k] = hi[k];
       // A little beyond the cell: a point may be placed in it from a few ulps outside.
       const double eps = 1e-9 * lattice_.size;
       const double centre[3] = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
-      std::vector<std::pair<double, uint32_t>> found;
+      struct Found {
+        double atCentre;
+        uint32_t cell, lead;
+      };
+      std::vector<Found> found;
       bool fits = true;
       cellBvh_.nearBox(q, eps, [&](uint32_t, uint32_t i) {
         const Bvh::Box& b = cellBoxes_[i];
@@ -414,23 +502,30 @@ class MeshConvexSumField : public DistanceField {
           if (b.lo[k] > q.hi[k] + eps || b.hi[k] < q.lo[k] - eps) return true;
         const Cell& c = cells_[i];
         double atCentre = INFINITY;
-        for (uint32_t k = c.first; k < c.first + c.count; ++k) {
+        uint32_t lead = 0;
+        for (uint32_t k = c.first; k < c.first + c.all; ++k) {
           const auto& u = planes_[k];
           double least = 0;  // min of u . x over the cell grown by eps
           for (int a = 0; a < 3; ++a) least += u[size_t(a)] * (u[size_t(a)] > 0 ? lo[a] - eps : hi[a] + eps);
           if (least > u[3] + eps) return true;  // the plane separates them (eps: its rounding)
-          atCentre = std::min(atCentre, u[3] - (u[0] * centre[0] + u[1] * centre[1] + u[2] * centre[2]));
+          const double v = u[3] - (u[0] * centre[0] + u[1] * centre[1] + u[2] * centre[2]);
+          if (v < atCentre) atCentre = v, lead = k - c.first;
         }
-        found.push_back({atCentre, i});
+        found.push_back({atCentre, i, lead});
         fits = found.size() <= 512;
         return fits;
       });
       if (!fits) return false;
       // Largest first; ties by index, so a list never depends on the hierarchy's visiting order.
-      std::sort(found.begin(), found.end(), [](const auto& x, const auto& y) {
-        return x.first != y.first ? x.first > y.first : x.second < y.second;
+      std::sort(found.begin(), found.end(), [](const Found& x, const Found& y) {
+        return x.atCentre != y.atCentre ? x.atCentre > y.atCentre : x.cell < y.cell;
       });
-      for (const auto& f : found) out.push_back(f.second);
+      for (const Found& f : found) {
+        const float depth = downToFloat(f.atCentre - centreSlack_);
+        uint32_t bits;
+        std::memcpy(&bits, &depth, sizeof bits);
+        out.insert(out.end(), {f.cell, f.lead, bits});
+      }
       return true;
     });
   }

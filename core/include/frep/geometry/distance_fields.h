@@ -170,7 +170,8 @@ class MeshField : public DistanceField {
   struct Nearest;  // mesh_field.cpp
   void offer(const double* p, uint32_t slot, Nearest& n) const;
   void searchAll(const double* p, Nearest& n) const;
-  const uint32_t* cellCandidates(const double* p, uint32_t& count, double& fromCentre, double& centreValue) const;
+  const uint32_t* cellCandidates(const double* p, uint32_t& count, double& fromCentre, double& centreValue,
+                                 double* pc) const;
   bool insideAt(const double* p, uint32_t t, int region, const double* q) const;
   double planeGap(const double* p, uint32_t slot) const;
   double setError_ = 0;
