@@ -73,7 +73,7 @@ def run(op, workers, tmp):
         "start": max(w["first_idle_seconds"] for w in ws),
         "tail": sum(w["tail_idle_seconds"] for w in ws),
         "dups": results - sum(w["bricks"] for w in ws),
-        "reissues": r["faults"]["straggler_reissues"] + r["faults"]["lease_reissues"],
+        "reissues": r["faults"]["straggler_reissues"] + r["faults"]["queued_reissues"] + r["faults"]["lease_reissues"],
         "workers_cpu": worker_cpu,
         "master": master,
         "master_concurrent": min(concurrent, master),

@@ -342,12 +342,20 @@ void LeaseTable::dispatch(LeaseTime now, const Send& send) {
       lease(rid, it->second, bricks_[*next], now, send);
     }
   }
-  // Stragglers: nothing queued and a worker idle -> the oldest long-running brick, once more.
+  // Nothing queued and a worker idle: a brick another worker holds queued behind the ones it is
+  // computing, else the oldest long-running brick, once more (the first result cancels the
+  // other copy, dropped if still queued).
   if (!pending_.empty() || !suspects_.empty()) return;
   double threshold = std::max(1.0, 2 * medianBrickSeconds());
   for (auto& rid : rids) {
     auto it = peers_.find(rid);
     if (it == peers_.end() || it->second.unreachable || !it->second.inflight.empty()) continue;
+    if (BrickLease* queued = queuedElsewhere(rid, it->second)) {
+      queued->backupIssued = true;
+      ++stats_.queuedReissues;
+      lease(rid, it->second, *queued, now, send);
+      continue;
+    }
     BrickLease* oldest = nullptr;
     for (uint64_t id : leased_)
       if (BrickLease& b = bricks_[id]; !b.backupIssued && !b.suspect && !b.holders.count(rid) &&
@@ -361,6 +369,35 @@ void LeaseTable::dispatch(LeaseTime now, const Send& send) {
     spdlog::info("brick {} is a straggler: issued once more to {}", oldest->id, it->second.workerId);
     lease(rid, it->second, *oldest, now, send);
   }
+}
+
+// A worker computes its bricks in the order they were leased to it, `threads` at a time, so
+// those past its first `threads` by lease time wait in its queue. Near the end of a job the
+// credit (kCredit) leaves such bricks behind a slow brick while another worker, done, idles:
+// the last of them (the one that would start last) at any other peer goes to the idle one. The
+// order by lease time is the master's view (ties by brick id); a brick that had started after
+// all is computed twice, as a straggler's backup is.
+BrickLease* LeaseTable::queuedElsewhere(const std::string& rid, const PeerLease& idle) {
+  BrickLease* best = nullptr;
+  std::pair<LeaseTime, uint64_t> bestOrder{};
+  std::vector<std::pair<LeaseTime, uint64_t>> order;
+  for (auto& [otherRid, other] : peers_) {
+    if (otherRid == rid || other.inflight.size() <= other.threads) continue;
+    order.clear();
+    for (uint64_t id : other.inflight) {
+      const BrickLease& b = bricks_[id];
+      if (auto h = b.holders.find(otherRid); h != b.holders.end()) order.push_back({h->second, id});
+    }
+    std::sort(order.begin(), order.end());
+    for (size_t k = other.threads; k < order.size(); ++k) {
+      BrickLease& b = bricks_[order[k].second];
+      if (b.phase != BrickPhase::Leased || b.backupIssued || b.suspect || b.holders.count(rid) ||
+          b.failedBy.count(idle.workerId) || excluded(b.id, idle.workerId))
+        continue;
+      if (!best || bestOrder < order[k]) best = &b, bestOrder = order[k];
+    }
+  }
+  return best;
 }
 
 // Honest workers are almost never refuted, and a model that fails everywhere refutes no one (no

@@ -54,7 +54,7 @@ std::string FarmReport::toJson() const {
                  {"late_results", lateResults},  {"malformed", malformed},
                  {"oversized", oversized},       {"dead_workers", deadWorkers},
                  {"handed_back", handedBack},    {"straggler_reissues", stragglerReissues},
-                 {"lease_reissues", leaseReissues}, {"refused", refused},
+                 {"queued_reissues", queuedReissues}, {"lease_reissues", leaseReissues}, {"refused", refused},
                  {"curve_rejected", curveRejected}, {"foreign_results", foreignResults},
                  {"banned_peers", bannedPeers},  {"suspect_bricks", suspectBricks},
                  {"reconnects", reconnects},     {"master_stalls", masterStalls},

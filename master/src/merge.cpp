@@ -234,6 +234,7 @@ FarmOutcome Master::finish() {
   report_.retries = leases.retries;
   report_.deadWorkers = leases.deadWorkers;
   report_.stragglerReissues = leases.stragglerReissues;
+  report_.queuedReissues = leases.queuedReissues;
   report_.leaseReissues = leases.leaseReissues;
   report_.suspectBricks = leases.suspectBricks;
   report_.masterStalls = leases.masterStalls;

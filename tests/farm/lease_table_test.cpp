@@ -40,8 +40,8 @@ struct Fixture {
       return true;
     });
   }
-  PeerLease& join(const std::string& rid, bool proven = true) {
-    PeerLease& p = table.join(rid, "w-" + rid, 1, now);
+  PeerLease& join(const std::string& rid, bool proven = true, uint32_t threads = 1) {
+    PeerLease& p = table.join(rid, "w-" + rid, threads, now);
     if (proven) table.heard(p, now);
     return p;
   }
@@ -105,6 +105,61 @@ TEST(LeaseTable, NearTheEndAPeerGetsAnotherBrickOnlyWhileTheQueueHasOneForEveryP
   g.join("a");
   g.dispatch();
   EXPECT_EQ(g.inflight("a"), (std::vector<uint64_t>{0, 1, 2, 3}));
+}
+
+TEST(LeaseTable, AnIdlePeerGetsTheLastBrickQueuedAtAnother) {
+  // b computes two bricks at once: the two it holds run, none is queued, so a, done with
+  // its own and nothing pending, gets nothing before the straggler rule.
+  Fixture f(5);
+  f.join("a");
+  f.join("b", true, 2);
+  f.dispatch();  // a0 b1, then a2 b3 (4 waits: NearTheEndAPeerGets...)
+  EXPECT_EQ(f.inflight("a"), (std::vector<uint64_t>{0, 2}));
+  EXPECT_EQ(f.inflight("b"), (std::vector<uint64_t>{1, 3}));
+  f.finish("a", 0);
+  f.finish("a", 2);
+  f.dispatch();
+  EXPECT_EQ(f.inflight("a"), (std::vector<uint64_t>{4}));
+  f.finish("a", 4);
+  f.sent.clear();
+  f.dispatch();
+  EXPECT_TRUE(f.sent.empty());
+  EXPECT_EQ(f.table.stats().queuedReissues, 0u);
+
+  // One thread each: a, alone at first, holds its whole credit 0 1 2 3 and computes 0; b,
+  // idle once nothing is pending, gets the one a would start last (3), then 2, never 0.
+  Fixture g(5);
+  g.join("a");
+  g.dispatch();
+  g.join("b");
+  g.finish("a", 1);
+  g.now += milliseconds(10);
+  g.dispatch();  // b: 4; a keeps 0 2 3
+  EXPECT_EQ(g.inflight("a"), (std::vector<uint64_t>{0, 2, 3}));
+  EXPECT_EQ(g.inflight("b"), (std::vector<uint64_t>{4}));
+  EXPECT_EQ(g.table.stats().queuedReissues, 0u);
+  g.finish("b", 4);
+  g.sent.clear();
+  g.now += milliseconds(10);
+  g.dispatch();
+  ASSERT_EQ(g.sent.size(), 1u);
+  EXPECT_EQ(g.sent[0], std::make_pair(std::string("b"), uint64_t(3)));
+  EXPECT_EQ(g.table.stats().queuedReissues, 1u);
+  EXPECT_EQ(g.table.brick(3).holders.size(), 2u);
+  g.finish("b", 3);  // merged from b: a's copy is cancelled (no longer its credit)
+  EXPECT_EQ(g.inflight("a"), (std::vector<uint64_t>{0, 2}));
+  g.sent.clear();
+  g.dispatch();
+  ASSERT_EQ(g.sent.size(), 1u);
+  EXPECT_EQ(g.sent[0], std::make_pair(std::string("b"), uint64_t(2)));
+  // b idle once more, a holding only the brick it computes: nothing before the straggler
+  // rule's second, and 2 (a backup already) is not issued a third time.
+  g.finish("b", 2);
+  g.sent.clear();
+  g.dispatch();
+  EXPECT_TRUE(g.sent.empty());
+  EXPECT_EQ(g.table.stats().queuedReissues, 2u);
+  EXPECT_EQ(g.table.stats().stragglerReissues, 0u);
 }
 
 TEST(LeaseTable, ASilentPeerIsDeadAfterItsWindowAndItsBricksGoBack) {
@@ -336,8 +391,8 @@ TEST(LeaseTable, AnIdlePeerGetsTheOldestStragglerOnce) {
   LeasePolicy policy;
   policy.liveWindow = seconds(100);
   Fixture f(3, policy);
-  f.join("a");
-  f.dispatch();  // a holds 0, 1, 2
+  f.join("a", true, 3);
+  f.dispatch();  // a holds 0, 1, 2 and computes them all (three threads: none queued)
   f.join("b");
   for (double s : {1.0, 1.0, 1.0}) f.table.addBrickSeconds(s);
   EXPECT_EQ(f.table.medianBrickSeconds(), 1.0);

@@ -83,6 +83,7 @@ struct PeerLease {
 // What the table counted (the master's report adds them).
 struct LeaseStats {
   uint64_t retries = 0, deadWorkers = 0, stragglerReissues = 0, leaseReissues = 0;
+  uint64_t queuedReissues = 0;  // bricks queued at a busy worker given to an idle one as well
   uint64_t suspectBricks = 0, masterStalls = 0, refutedFailures = 0;
 };
 
@@ -156,7 +157,7 @@ class LeaseTable {
   // Leases past their deadline are due once more (the first holder keeps running).
   void reissueOverdue(LeaseTime now);
   // Leases queued bricks to the peers with credit (kCredit rounds, in routing-id order), then
-  // an idle worker gets the oldest straggler once more.
+  // an idle worker gets a brick queued at another once more, or the oldest straggler.
   void dispatch(LeaseTime now, const Send& send);
   void addBrickSeconds(double seconds) { brickSeconds_.push_back(seconds); }
   double medianBrickSeconds();
@@ -182,6 +183,7 @@ class LeaseTable {
     return hooks_.excluded && hooks_.excluded(id, workerId);
   }
   void lease(const std::string& rid, PeerLease& p, BrickLease& b, LeaseTime now, const Send& send);
+  BrickLease* queuedElsewhere(const std::string& rid, const PeerLease& idle);
 
   LeasePolicy policy_;
   Hooks hooks_;

@@ -140,7 +140,7 @@ struct FarmReport {
   bool capped = false;   // ... and whether the mesh was capped there (solid ∩ box)
   double surfaceErrorBound = 0;  // "mesh": no point of the mesh is further from the surface (world units)
   uint64_t retries = 0, duplicates = 0, lateResults = 0, malformed = 0, oversized = 0;
-  uint64_t deadWorkers = 0, handedBack = 0, stragglerReissues = 0, leaseReissues = 0, refused = 0;
+  uint64_t deadWorkers = 0, handedBack = 0, stragglerReissues = 0, queuedReissues = 0, leaseReissues = 0, refused = 0;
   uint64_t curveRejected = 0;
   // Hostile or broken peers and faults (docs/farm.md, "Threat model" and "Faults"):
   uint64_t foreignResults = 0;  // results or failures for a brick the sender does not hold
