@@ -448,14 +448,11 @@ class MeshConvexSumField : public DistanceField {
       const double depth = listDepth(list) - fromCentre;
       if (depth >= 0) return depth;
     }
-    // The list holds every cell whose box meets p's lattice cell; the same boxes as the
-    // hierarchy's test (closed) pick those that hold p, so g is the same max.
-    for (uint32_t j = 0; j < count; j += kListWords) {
-      const Bvh::Box& b = cellBoxes_[list[j]];
-      if (p[0] < b.lo[0] || p[0] > b.hi[0] || p[1] < b.lo[1] || p[1] > b.hi[1] || p[2] < b.lo[2] || p[2] > b.hi[2])
-        continue;
+    // The list holds every cell that may hold a point of p's lattice cell; those that hold p
+    // give the same max as the hierarchy's, the others have c_T < 0 at p, which no caller reads
+    // (testing their boxes first, to pass them over, took 5% longer than the lead plane alone).
+    for (uint32_t j = 0; j < count; j += kListWords)
       if (!visit(list[j], list[j + 1])) break;
-    }
     return g;
   }
   // The cells that can hold a point of the lattice cell holding p (at most 512), or nothing:
