@@ -72,34 +72,11 @@ double triangleDist2(const double* p, const double* a, const double* b, const do
   return dot(d, d);
 }
 
-// x rounded down to a float (for x >= 0), and those bits: the lists' keys are lower bounds.
-float downToFloat(double x) {
-  float g = float(x);
-  if (double(g) > x) g = std::nextafter(g, 0.0f);
-  return g;
-}
-uint32_t floatBitsDown(double x) {
-  const float g = downToFloat(x);
-  uint32_t bits;
-  std::memcpy(&bits, &g, sizeof bits);
-  return bits;
-}
-
 // A cell's candidate list (cellCandidates): per candidate its slot, its key and its linear
 // lower bound's unit direction and base, as floats.
 constexpr uint32_t kCandidateWords = 6;
-float floatAt(const uint32_t* w) {
-  float g;
-  std::memcpy(&g, w, sizeof g);
-  return g;
-}
-uint32_t floatBits(float g) {
-  uint32_t bits;
-  std::memcpy(&bits, &g, sizeof bits);
-  return bits;
-}
 uint32_t candidateSlot(const uint32_t* list, uint32_t i) { return list[kCandidateWords * i]; }
-double candidateKey(const uint32_t* list, uint32_t i) { return double(floatAt(&list[kCandidateWords * i + 1])); }
+double candidateKey(const uint32_t* list, uint32_t i) { return double(floatOfBits(list[kCandidateWords * i + 1])); }
 // A lower bound of |p - T| for candidate i, pc = p - c and fromCentre >= |pc|: T lies in the
 // half-space n . (x - q) <= 0 (q: T's nearest point to c, n: the unit vector from q to c), so
 // |p - T| >= n . (p - q) = |c - q| + n . pc, tight where p moves along the cell's surface rather
@@ -107,7 +84,7 @@ double candidateKey(const uint32_t* list, uint32_t i) { return double(floatAt(&l
 // rounding; 1e-7 |pc| covers n rounded to float.
 double linearGap(const uint32_t* list, uint32_t i, const double* pc, double fromCentre) {
   const uint32_t* e = &list[kCandidateWords * i];
-  const double n0 = floatAt(e + 2), n1 = floatAt(e + 3), n2 = floatAt(e + 4), base = floatAt(e + 5);
+  const double n0 = floatOfBits(e[2]), n1 = floatOfBits(e[3]), n2 = floatOfBits(e[4]), base = floatOfBits(e[5]);
   return base + (n0 * pc[0] + n1 * pc[1] + n2 * pc[2]) - 1e-7 * fromCentre;
 }
 
@@ -350,7 +327,7 @@ const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, doub
     if (c.best2 > 16 * cellSize * cellSize) return false;
     const bool hasClass = check_.closed() && c.found;
     out.push_back(hasClass && insideAt(centre, bvh_.order()[c.slot], c.region, c.q) ? 1u : 0u);
-    out.push_back(floatBitsDown(hasClass ? std::sqrt(c.best2) * (1 - 1e-9) : 0.0));
+    out.push_back(bitsOfFloat(floatBelow(hasClass ? std::sqrt(c.best2) * (1 - 1e-9) : 0.0)));
     const double halfDiag = 0.5 * std::sqrt(3.0) * cellSize;
     const double slack = 1e-12 * scale_;  // a point placed in the cell from a few ulps outside
     const double reach = (std::sqrt(c.best2) + halfDiag) * (1 + 1e-9) + slack;
@@ -383,7 +360,7 @@ const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, doub
       const double dExact = std::sqrt(triangleDist2(centre, v, v + 3, v + 6, qq, region));
       const double dc = dExact * (1 - 1e-9);
       if (dc - halfDiag * (1 + 1e-9) - slack > reach) return true;
-      Found f{downToFloat(dc), slot, {0, 0, 0}, -INFINITY};  // the key, rounded down again
+      Found f{floatBelow(dc), slot, {0, 0, 0}, -INFINITY};  // the key, rounded down again
       // linearGap's direction and base, where c is clear of T (else n is ill-conditioned):
       // q within delta of the true nearest point turns n by at most 2 delta / d, which moves
       // n . (x - q) for x in T by at most delta (1 + 2 diam(T) / d).
@@ -400,7 +377,7 @@ const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, doub
         sub(centre, qq, n);
         normalise(n);
         for (int k = 0; k < 3; ++k) f.n[k] = float(n[k]);
-        f.base = downToFloat(dExact * (1 - 1e-9) - delta * (1 + 2 * std::sqrt(diam2) / dExact));
+        f.base = floatBelow(dExact * (1 - 1e-9) - delta * (1 + 2 * std::sqrt(diam2) / dExact));
       }
       found.push_back(f);
       fits = found.size() <= kMaxCandidates;
@@ -409,8 +386,8 @@ const uint32_t* MeshField::cellCandidates(const double* p, uint32_t& count, doub
     if (!fits) return false;
     std::sort(found.begin(), found.end());
     for (const Found& f : found)
-      out.insert(out.end(), {f.slot, floatBits(f.key), floatBits(f.n[0]), floatBits(f.n[1]), floatBits(f.n[2]),
-                             floatBits(f.base)});
+      out.insert(out.end(), {f.slot, bitsOfFloat(f.key), bitsOfFloat(f.n[0]), bitsOfFloat(f.n[1]), bitsOfFloat(f.n[2]),
+                             bitsOfFloat(f.base)});
     return true;
   });
   if (!list) return nullptr;

@@ -25,6 +25,7 @@
 #include "frep/minkowski_algebra/star_pieces.h"
 #include "convolution_pieces.h"
 #include "mesh_operands.h"
+#include "triangle_sum_cells.h"
 
 namespace frep::minkowski {
 namespace {
@@ -62,23 +63,21 @@ class MeshConvexSumField : public DistanceField {
       for (const V3* x : {&p, &q, &r}) soup.insert(soup.end(), x->begin(), x->end());
       soupTris.insert(soupTris.end(), {base, base + 1, base + 2});
     };
-    std::vector<Bvh::Box> boxes;
     std::vector<std::vector<V3>> pieceDirs;
     for (const Convex& b : bs) {
       pieceDirs.push_back(edgeDirections(b));
-      addCells(a, b, pieceDirs.back(), tol, boxes);
+      cellSet_.add(a, b, pieceDirs.back(), tol);
     }
-    cellBvh_.build(boxes);
+    cellBvh_.build(cellSet_.boxes);
     // Lists for a lattice of 128 cells along the boxes' longest side: a point's query then
     // tests one short list instead of walking the many overlapping boxes of the hierarchy.
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (const Bvh::Box& x : boxes)
+    for (const Bvh::Box& x : cellSet_.boxes)
       for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], x.lo[k]), hi[k] = std::max(hi[k], x.hi[k]);
     lattice_ = CellLattice::over(lo, hi, 128, 0);
     // The rounding of a plane's value at a lattice cell's centre and of |p - c|, far above it.
     centreSlack_ = 1e-9 * lattice_.size + 1e-14 * (std::abs(lo[0]) + std::abs(lo[1]) + std::abs(lo[2]) +
                                                    std::abs(hi[0]) + std::abs(hi[1]) + std::abs(hi[2]));
-    cellBoxes_ = std::move(boxes);
     cellClasses_ = lattice_.size * std::sqrt(3.0) < 1.9 * memoRadius_;
     for (size_t i = 0; i < bs.size(); ++i) convolutionPieces(a, bs[i], pieceDirs[i], complement_, tol, tri);
     pruneInterior(soup, soupTris, tol);
@@ -101,141 +100,6 @@ class MeshConvexSumField : public DistanceField {
   }
 
  private:
-  // Edge directions of B, one per parallel class.
-  static std::vector<V3> edgeDirections(const Convex& b) {
-    std::vector<V3> bDirs;
-    for (const auto& e : b.edges) {
-      V3 d = sub(b.v[e[1]], b.v[e[0]]);
-      const double l = norm(d);
-      if (!(l > 0)) continue;
-      for (double& x : d) x /= l;
-      bool known = false;
-      for (const V3& k : bDirs) known = known || std::abs(dot(k, d)) > 1 - 1e-12;
-      if (!known) bDirs.push_back(d);
-    }
-    return bDirs;
-  }
-
-  // Whether the supporting plane of T ⊕ B of normal u (T's and B's support hT, hB) holds a
-  // facet: the corners of T and of B within tol of their support span two directions. Near-ties
-  // count as ties, so a doubtful plane is kept (a supporting plane is never wrong, only slow).
-  static bool isFacet(const V3 tv[3], const Convex& b, const V3& u, double hT, double hB, double tol) {
-    V3 dirs[2];
-    int found = 0;
-    auto add = [&](const V3& d) {
-      const double l2 = dot(d, d);
-      if (!(l2 > tol * tol)) return false;
-      if (found == 0) {
-        dirs[found++] = d;
-        return false;
-      }
-      const V3 c = cross(dirs[0], d);
-      return dot(c, c) > 1e-20 * dot(dirs[0], dirs[0]) * l2;  // a second direction: a facet
-    };
-    const V3* t0 = nullptr;
-    for (int k = 0; k < 3; ++k)
-      if (dot(u, tv[k]) >= hT - tol) {
-        if (!t0) t0 = &tv[k];
-        else if (add(sub(tv[k], *t0))) return true;
-      }
-    const V3* b0 = nullptr;
-    for (const V3& p : b.v)
-      if (dot(u, p) >= hB - tol) {
-        if (!b0) b0 = &p;
-        else if (add(sub(p, *b0))) return true;
-      }
-    return false;
-  }
-
-  // The cells T ⊕ B of every triangle T of A: their planes and boxes.
-  void addCells(const Mesh& a, const Convex& b, const std::vector<V3>& bDirs, double tol,
-                std::vector<Bvh::Box>& boxes) {
-    V3 bLo{INFINITY, INFINITY, INFINITY}, bHi{-INFINITY, -INFINITY, -INFINITY};  // B's box
-    for (const V3& p : b.v)
-      for (size_t k = 0; k < 3; ++k) bLo[k] = std::min(bLo[k], p[k]), bHi[k] = std::max(bHi[k], p[k]);
-    // B's facet normals, one per plane (a triangulated face gives several triangles).
-    std::vector<V3> bNormals;
-    for (const V3& n : b.faceN) {
-      bool known = false;
-      for (const V3& k : bNormals) known = known || dot(k, n) > 1 - 1e-12;
-      if (!known) bNormals.push_back(n);
-    }
-    // A B with no facets is a segment or a point (a path's piece); one with facets has volume.
-    const bool flatB = bNormals.empty();
-    std::vector<V3> normals;
-    std::vector<std::array<double, 4>> touching;
-    for (const auto& t : a.t) {
-      const V3 tv[3] = {a.v[t[0]], a.v[t[1]], a.v[t[2]]};
-      // The candidate facet normals of T ⊕ B, each once: two within 1e-12 are one (rounding), but
-      // not two that are merely close, such as the facets of a prism T ⊕ d a hair off T's plane
-      // and ±n_T (merged, the thin slanted prism would read as the flat box over its shadow).
-      normals.clear();
-      auto candidate = [&](V3 u) {
-        const double l = norm(u);
-        if (!(l > 0)) return;
-        for (double& x : u) x /= l;
-        for (const V3& k : normals)
-          if (dot(sub(k, u), sub(k, u)) < 1e-24) return;
-        normals.push_back(u);
-      };
-      const V3 n = cross(sub(tv[1], tv[0]), sub(tv[2], tv[0]));
-      const double ln = norm(n);
-      // A flat B (a segment of a path, path_sweep.h): a T of no area adds no cell (its points lie
-      // on its neighbours, and no finite set of planes bounds a segment ⊕ segment's points).
-      if (flatB && !(ln > 0)) continue;
-      candidate(n);
-      candidate({-n[0], -n[1], -n[2]});
-      for (const V3& u : bNormals) candidate(u);
-      for (int k = 0; k < 3; ++k) {
-        const V3 eT = sub(tv[(k + 1) % 3], tv[k]);
-        for (const V3& d : bDirs) {
-          const V3 u = cross(eT, d);
-          if (!(norm(u) > 1e-12 * norm(eT))) continue;  // parallel: the sum of the edges is a segment
-          candidate(u);
-          candidate({-u[0], -u[1], -u[2]});
-        }
-      }
-      // A flat B parallel to T's plane makes T ⊕ B flat too, a polygon whose edges are T's and B's:
-      // its planes are ±n_T and the in-plane normals n_T × e of those edges, which the products
-      // above miss (there they are ±n_T). Supporting planes are exact wherever they point, so they
-      // are added whenever B lies within 1e-5 of T's plane (a prism that thin has them all,
-      // redundant or not), so no B in T's plane up to rounding goes without them.
-      bool parallel = flatB;
-      for (const V3& d : bDirs) parallel = parallel && std::abs(dot(n, d)) < 1e-5 * ln;
-      if (parallel) {
-        auto inPlane = [&](const V3& e) {
-          const V3 u = cross(n, e);
-          candidate(u);
-          candidate({-u[0], -u[1], -u[2]});
-        };
-        for (int k = 0; k < 3; ++k) inPlane(sub(tv[(k + 1) % 3], tv[k]));
-        for (const V3& d : bDirs) inPlane(d);
-      }
-      // The facets of T ⊕ B first, the planes that touch it in an edge or a corner after: the
-      // queries' c_T needs only the facets (inside a convex polytope the nearest of its
-      // supporting planes is a facet's, so the min is the same), the lists' separation test
-      // takes all (a corner's plane may separate a lattice cell that no facet does). A flat sum
-      // (B parallel to T) keeps all: its edges' planes bound it within its plane.
-      const uint32_t first = uint32_t(planes_.size());
-      touching.clear();
-      for (const V3& u : normals) {
-        const double hT = std::max({dot(u, tv[0]), dot(u, tv[1]), dot(u, tv[2])}), hB = b.support(u);
-        const std::array<double, 4> plane{u[0], u[1], u[2], hT + hB};
-        if (parallel || isFacet(tv, b, u, hT, hB, tol)) planes_.push_back(plane);
-        else touching.push_back(plane);
-      }
-      const uint32_t facets = uint32_t(planes_.size()) - first;
-      planes_.insert(planes_.end(), touching.begin(), touching.end());
-      cells_.push_back({first, facets, uint32_t(planes_.size()) - first});
-      Bvh::Box box;
-      for (int k = 0; k < 3; ++k) {
-        box.lo[k] = std::min({tv[0][size_t(k)], tv[1][size_t(k)], tv[2][size_t(k)]}) + bLo[size_t(k)] - tol;
-        box.hi[k] = std::max({tv[0][size_t(k)], tv[1][size_t(k)], tv[2][size_t(k)]}) + bHi[size_t(k)] + tol;
-      }
-      boxes.push_back(box);
-    }
-  }
-
  public:
   void signs(const double* u, const double* v, const double* w, double* out, size_t n) const override {
     for (size_t i = 0; i < n; ++i) {
@@ -286,13 +150,9 @@ class MeshConvexSumField : public DistanceField {
   bool cellClasses_ = false;
   static thread_local SignMemo tSignMemo[kSignMemos];
   static thread_local int tSignMemoNext;
-  std::vector<std::array<double, 4>> planes_;  // u . x <= h
   static constexpr uint32_t kNoLead = UINT32_MAX;
-  struct Cell {
-    uint32_t first, count, all;  // planes_[first, first + count): its facets; to first + all: every plane
-  };
-  std::vector<Cell> cells_;
-  std::vector<Bvh::Box> cellBoxes_;
+  using Cell = TriangleSumCells::Cell;
+  TriangleSumCells cellSet_;  // the cells T ⊕ B: their planes and boxes
   Bvh cellBvh_;
   CellLattice lattice_;  // of the lists of cells whose boxes meet a lattice cell
   double centreSlack_ = 0;
@@ -307,10 +167,10 @@ class MeshConvexSumField : public DistanceField {
   // the triangles are tested in parallel and the kept ones gathered in their order.
   void pruneInterior(std::vector<double>& soup, std::vector<uint32_t>& tris, double tol) const {
     auto depth = [&](uint32_t cell, const double* p) {
-      const Cell& c = cells_[cell];
+      const Cell& c = cellSet_.cells[cell];
       double m = INFINITY;
       for (uint32_t k = c.first; k < c.first + c.count && m > tol; ++k) {
-        const auto& u = planes_[k];
+        const auto& u = cellSet_.planes[k];
         m = std::min(m, u[3] - (u[0] * p[0] + u[1] * p[1] + u[2] * p[2]));
       }
       return m;
@@ -333,8 +193,8 @@ class MeshConvexSumField : public DistanceField {
         return !interior;
       };
       uint32_t count = 0;
-      double fromCentre;
-      const uint32_t* list = interior ? nullptr : cellsNear(v[0], count, fromCentre);
+      double pc2;
+      const uint32_t* list = interior ? nullptr : cellsNear(v[0], count, pc2);
       if (list)
         for (uint32_t j = 0; j < count && inCell(list[j]); j += kListWords) {}
       else if (!interior) cellBvh_.containing(v[0], inCell);
@@ -420,32 +280,32 @@ class MeshConvexSumField : public DistanceField {
     // joins the facets' min: inside the cell it is no smaller (a supporting plane), outside
     // the min is negative either way.
     auto visit = [&](uint32_t i, uint32_t lead) {
-      const Cell& c = cells_[i];
+      const Cell& c = cellSet_.cells[i];
       double m = INFINITY;
       if (lead != kNoLead) {
-        const auto& u = planes_[c.first + lead];
+        const auto& u = cellSet_.planes[c.first + lead];
         m = u[3] - (u[0] * p[0] + u[1] * p[1] + u[2] * p[2]);
       }
       const double stop = std::max(g, floor);
       for (uint32_t k = c.first; k < c.first + c.count && m >= stop && (m > g || firstInside); ++k) {
-        const auto& u = planes_[k];
+        const auto& u = cellSet_.planes[k];
         m = std::min(m, u[3] - (u[0] * p[0] + u[1] * p[1] + u[2] * p[2]));
       }
       if (m >= floor) g = std::max(g, m);
       return !(firstInside && g >= 0);
     };
     uint32_t count = 0;
-    double fromCentre = 0;
-    const uint32_t* list = cellsNear(p, count, fromCentre);
+    double pc2 = 0;
+    const uint32_t* list = cellsNear(p, count, pc2);
     if (!list) {
       cellBvh_.containing(p, [&](uint32_t i) { return visit(i, kNoLead); });
       return g;
     }
     // The class: c_T is 1-Lipschitz (unit normals), so the first cell's c_T at the centre
     // beyond |p - c| puts p inside it (the list is sorted by that value, the first is the
-    // largest), with no plane tested.
-    if (firstInside && count > 0) {
-      const double depth = listDepth(list) - fromCentre;
+    // largest), with no plane tested. |p - c| (rounded up) only when that value is positive.
+    if (firstInside && count > 0 && listDepth(list) >= centreSlack_) {
+      const double depth = listDepth(list) - (std::sqrt(pc2) * (1 + 1e-9) + centreSlack_);
       if (depth >= 0) return depth;
     }
     // The list holds every cell that may hold a point of p's lattice cell; those that hold p
@@ -461,26 +321,18 @@ class MeshConvexSumField : public DistanceField {
   // (the class search ends at it; the max prunes the rest), and a dropped cell has c_T < 0 at
   // every point of the lattice cell, which no caller reads (only g >= 0 counts). Per cell
   // kListWords: its index, its plane of least value at the centre (visit's lead) and that value
-  // as a float rounded down (the first one's: listDepth); count: the words. fromCentre: |p - c|
-  // rounded up, c the lattice cell's centre.
+  // as a float rounded down (the first one's: listDepth); count: the words. pc2: |p - c|^2,
+  // c the lattice cell's centre.
   static constexpr uint32_t kListWords = 3;
-  static float downToFloat(double x) {
-    const float f = float(x);
-    return double(f) > x ? std::nextafter(f, -INFINITY) : f;
-  }
-  static double listDepth(const uint32_t* list) {
-    float d;
-    std::memcpy(&d, &list[2], sizeof d);
-    return double(d);
-  }
-  const uint32_t* cellsNear(const double* p, uint32_t& count, double& fromCentre) const {
+  static double listDepth(const uint32_t* list) { return double(floatOfBits(list[2])); }
+  const uint32_t* cellsNear(const double* p, uint32_t& count, double& pc2) const {
     uint64_t key;
     int64_t ijk[3];
     if (!lattice_.cellOf(p, key, ijk)) return nullptr;
     double lo[3], hi[3];
     lattice_.cellBox(ijk, lo, hi);
     const double pc[3] = {p[0] - (lo[0] + hi[0]) / 2, p[1] - (lo[1] + hi[1]) / 2, p[2] - (lo[2] + hi[2]) / 2};
-    fromCentre = std::sqrt(pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2]) * (1 + 1e-9) + centreSlack_;
+    pc2 = pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2];
     return CellLists::get(id_, key, count, [&](std::vector<uint32_t>& out) {
       Bvh::Box q;
       for (int k = 0; k < 3; ++k) q.lo[k] = lo[k], q.hi[k] = hi[k];
@@ -494,14 +346,14 @@ class MeshConvexSumField : public DistanceField {
       std::vector<Found> found;
       bool fits = true;
       cellBvh_.nearBox(q, eps, [&](uint32_t, uint32_t i) {
-        const Bvh::Box& b = cellBoxes_[i];
+        const Bvh::Box& b = cellSet_.boxes[i];
         for (int k = 0; k < 3; ++k)
           if (b.lo[k] > q.hi[k] + eps || b.hi[k] < q.lo[k] - eps) return true;
-        const Cell& c = cells_[i];
+        const Cell& c = cellSet_.cells[i];
         double atCentre = INFINITY;
         uint32_t lead = 0;
         for (uint32_t k = c.first; k < c.first + c.all; ++k) {
-          const auto& u = planes_[k];
+          const auto& u = cellSet_.planes[k];
           double least = 0;  // min of u . x over the cell grown by eps
           for (int a = 0; a < 3; ++a) least += u[size_t(a)] * (u[size_t(a)] > 0 ? lo[a] - eps : hi[a] + eps);
           if (least > u[3] + eps) return true;  // the plane separates them (eps: its rounding)
@@ -518,17 +370,14 @@ class MeshConvexSumField : public DistanceField {
         return x.atCentre != y.atCentre ? x.atCentre > y.atCentre : x.cell < y.cell;
       });
       for (const Found& f : found) {
-        const float depth = downToFloat(f.atCentre - centreSlack_);
-        uint32_t bits;
-        std::memcpy(&bits, &depth, sizeof bits);
-        out.insert(out.end(), {f.cell, f.lead, bits});
+        out.insert(out.end(), {f.cell, f.lead, bitsOfFloat(floatBelow(f.atCentre - centreSlack_))});
       }
       return true;
     });
   }
   bool sameGeometry(const DistanceField& o) const override {
     const auto& m = static_cast<const MeshConvexSumField&>(o);
-    return m.complement_ == complement_ && m.planes_ == planes_ && m.a_->sameContent(*a_);
+    return m.complement_ == complement_ && m.cellSet_.planes == cellSet_.planes && m.a_->sameContent(*a_);
   }
 };
 
@@ -625,7 +474,7 @@ bool construct(const Expr& aExpr, const Expr& bExpr, bool difference, bool piece
 
 // A ⊕ P for the polyline P through path: P is connected and the union of its segments, each a
 // convex piece with no facets (support max(u · p, u · q), one edge), so the construction above
-// applies as it is, the flat cells aside (addCells). Repeated points are dropped; a single point
+// applies as it is, the flat cells aside (TriangleSumCells::add). Repeated points are dropped; a single point
 // is the segment [p, p] (A moved there).
 bool constructPath(const Expr& aExpr, const std::vector<V3>& path, Expr* out) {
   bool aPoly = false;

@@ -5,12 +5,31 @@
 // its lists supersets of what any point of the cell needs).
 #pragma once
 
+#include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <cstdint>
 #include <utility>
 #include <vector>
 
 namespace frep {
+
+// The lists keep bounds as float bits: x rounded down to a float (a lower bound stays one,
+// whatever its sign), and the bits of a float and back.
+inline float floatBelow(double x) {
+  const float f = float(x);
+  return double(f) > x ? std::nextafter(f, -INFINITY) : f;
+}
+inline uint32_t bitsOfFloat(float f) {
+  uint32_t bits;
+  std::memcpy(&bits, &f, sizeof bits);
+  return bits;
+}
+inline float floatOfBits(uint32_t bits) {
+  float f;
+  std::memcpy(&f, &bits, sizeof f);
+  return f;
+}
 
 // A cubic lattice: cell (i, j, k) is [origin + (i, j, k) size, origin + (i + 1, j + 1, k + 1) size)
 // up to rounding (a point may be placed in a neighbour within a few ulps: users give their
