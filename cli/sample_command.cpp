@@ -90,6 +90,8 @@ int runSample(const SampleRequest& request) {
     grid = io::worldLatticeGrid("-b/--bounds", grown.lo, grown.hi, grid.voxel);
     checkJobSize(grid, options.brickVoxels);
   }
+  grid = io::leafAlignedGrid(grid);  // after the cut box: the cut stays the requested box's
+  checkJobSize(grid, options.brickVoxels);
   farm::JobSpec job = makeJob(m, request.model.path, grid, "sample");
   job.set_band(request.band);
   // The workers store the band's distance: the estimate (--store sdf, fog) or the exact distance

@@ -59,6 +59,17 @@ bool tileBox(const Tile& tile, const std::array<int32_t, 3>& extent, const openv
 
 void addLeaf(openvdb::FloatGrid::Accessor& acc, const LeafBlock& block, const openvdb::Coord& offset) {
   const openvdb::Coord o = openvdb::Coord(block.origin[0], block.origin[1], block.origin[2]) + offset;
+  if (((o.x() | o.y() | o.z()) & 7) == 0) {  // the block is one of OpenVDB's leaves (leafAlignedGrid)
+    // The same voxel order (x, then y, then z) and mask words: every value and state replaced,
+    // as the loop below sets them, without an accessor call a voxel.
+    openvdb::FloatTree::LeafNodeType* leaf = acc.touchLeaf(o);
+    float* values = leaf->buffer().data();
+    for (int n = 0; n < kLeafVoxels; ++n) values[n] = -block.values[size_t(n)];  // negative inside
+    openvdb::FloatTree::LeafNodeType::NodeMaskType mask;
+    for (int w = 0; w < kLeafVoxels / 64; ++w) mask.template getWord<uint64_t>(openvdb::Index(w)) = block.active[size_t(w)];
+    leaf->setValueMask(mask);
+    return;
+  }
   for (int x = 0; x < kLeafDim; ++x)
     for (int y = 0; y < kLeafDim; ++y)
       for (int z = 0; z < kLeafDim; ++z) {

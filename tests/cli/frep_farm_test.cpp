@@ -93,7 +93,7 @@ TEST_F(FarmCli, PoisonedBrickExitsFiveAndIsNamed) {
     r.err = readText(path(".err"));
   }
   EXPECT_EQ(r.code, 5);
-  EXPECT_NE(r.err.find("brick 2 voxels [0,0,64)-(32,32,95)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("brick 2 voxels [0,0,64)-(32,32,96)"), std::string::npos) << r.err;  // 96 points: -48..47 (leafAlignedGrid)
   EXPECT_FALSE(fileExists(path("out.vdb")));
   EXPECT_TRUE(fileExists(path("out.vdb.journal")));
 }

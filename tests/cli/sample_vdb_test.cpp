@@ -301,10 +301,11 @@ TEST_F(FrepTest, SampleCountsNaNValues) {
   RunResult r = run("sample n.hf -b 1 --res 16 -O n.vdb");
   ASSERT_EQ(r.code, 0) << r.err;
   // The slab 0 <= x <= 0.25 is cut by the box's y and z faces, so the lattice grows by the band
-  // and a voxel (4 points) on every side: -12..12 in steps of 2/15. Voxels with x < 0 (12 of 25
-  // columns) are NaN, also outside the box (the cut keeps a NaN a NaN); NaN widens every
-  // interval, so all are sampled: 12 * 25 * 25.
-  EXPECT_NE(r.out.find("  NaN values 7500 (domain errors, stored as outside)\n"), std::string::npos) << r.out;
+  // and a voxel (4 points) on every side: -12..12 in steps of 2/15, then down to OpenVDB's leaf
+  // lattice: -16..12 (29 points). Voxels with x < 0 (16 of 29 columns) are NaN, also outside
+  // the box (the cut keeps a NaN a NaN); NaN widens every interval, so all are sampled: 16 * 29 * 29.
+  EXPECT_NE(r.out.find("wrote n.vdb: 29x29x29 voxels"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  NaN values 13456 (domain errors, stored as outside)\n"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("the solid is cut by the box's faces y-min, y-max, z-min, z-max"), std::string::npos) << r.err;
 }
 

@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
+#include "frep/io/vdb_reader.h"
 #include "frep/io/vdb_writer.h"
 #include "frep/io/world_lattice.h"
 #include "frep/expressions/expr.h"
@@ -238,4 +240,69 @@ TEST(VdbLevelSetBuilder, LeavesWrittenOutAreWrittenOnlyAsStored) {
     EXPECT_THROW(b.write(path, meta), std::logic_error);
     std::remove(path.c_str());
   }
+}
+
+// frep sample's grids start on OpenVDB's leaf lattice (io::leafAlignedGrid): the same lattice
+// points, at most 7 more per axis on the low sides; every sampler leaf is then one OpenVDB leaf,
+// which the writer copies whole (vdb_writer.cpp, addLeaf). Read back, every voxel holds the
+// value and state the sampler gave it, and the space around the leaves its tiles' signs.
+TEST(VdbLevelSetBuilder, LeafAlignedGridsWriteEverySampledVoxelAsItIs) {
+  const double voxel = 2.0 / 95;
+  const GridSpec g = io::worldLatticeGrid("test", {-0.93, -1.13, -0.99}, {1, 1, 1}, voxel);
+  const GridSpec a = io::leafAlignedGrid(g);
+  const int64_t gIndex[3] = {std::llround(g.origin[0] / voxel), std::llround(g.origin[1] / voxel),
+                             std::llround(g.origin[2] / voxel)};
+  int moved = 0;
+  for (int k = 0; k < 3; ++k) {
+    const int64_t aIndex = std::llround(a.origin[k] / voxel);
+    EXPECT_EQ(aIndex % 8, 0) << k;
+    EXPECT_LE(aIndex, gIndex[k]) << k;
+    EXPECT_GT(aIndex, gIndex[k] - 8) << k;
+    EXPECT_EQ(a.dims[k], g.dims[k] + (gIndex[k] - aIndex)) << k;  // the same far side
+    moved += aIndex != gIndex[k];
+  }
+  EXPECT_GE(moved, 2);  // the box was off the leaf lattice: the test covers the move
+  EXPECT_EQ(io::leafAlignedGrid(a).origin, a.origin);  // aligned stays
+  EXPECT_EQ(io::leafAlignedGrid(a).dims, a.dims);
+
+  Expr X = Expr::x(0), Y = Expr::x(1), Z = Expr::x(2);
+  Expr block = min(min(0.7 - abs(X), 0.6 - abs(Y)), 0.5 - abs(Z));
+  Expr ball = 0.45 - sqrt(square(X - 0.3) + square(Y - 0.2) + square(Z - 0.4));
+  const SampleResult s = sample(Tape::compile(min(block, -ball), 3), a);
+  ASSERT_GT(s.leaves.size(), 500u);
+  io::VdbMetadata meta;
+  meta.gridName = "bitten";
+  meta.job = "test";
+  meta.store = io::VdbStore::Raw;
+  const std::string path = emptyFile("aligned.vdb");
+  io::LevelSetBuilder b(s.grid, s.bandVoxels);
+  b.addTiles(s.tiles);
+  b.addLeaves(s.leaves);
+  b.write(path, meta);
+  const io::SampledVdb r = io::readSampledVdb(path, "bitten");
+  std::remove(path.c_str());
+  // The file's leaves by world index (the reader shifts its index space to its own origin).
+  std::map<std::array<int64_t, 3>, const LeafBlock*> read;
+  for (const LeafBlock& l : r.samples.leaves) {
+    std::array<int64_t, 3> w;
+    for (int k = 0; k < 3; ++k) w[k] = std::llround(r.samples.grid.origin[k] / voxel) + l.origin[k];
+    read[w] = &l;
+  }
+  size_t compared = 0;
+  for (const LeafBlock& l : s.leaves) {
+    std::array<int64_t, 3> w;
+    for (int k = 0; k < 3; ++k) w[k] = std::llround(a.origin[k] / voxel) + l.origin[k];
+    bool anyActive = false;
+    for (uint64_t word : l.active) anyActive = anyActive || word != 0;
+    auto it = read.find(w);
+    if (!anyActive) continue;  // pruned to a tile: its sign is checked by the sampler's own tests
+    ASSERT_NE(it, read.end()) << "the leaf at world index " << w[0] << "," << w[1] << "," << w[2] << " is missing";
+    for (int n = 0; n < kLeafVoxels; ++n) {
+      ASSERT_EQ(it->second->isActive(n), l.isActive(n)) << n;
+      if (l.isActive(n)) ASSERT_EQ(it->second->values[size_t(n)], l.values[size_t(n)]) << n;
+      else ASSERT_EQ(it->second->values[size_t(n)] > 0, l.values[size_t(n)] > 0) << n;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 100000u);
 }

@@ -18,4 +18,10 @@ constexpr int64_t kMaxLatticeIndex = int64_t(1) << 30;  // OpenVDB's coordinates
 GridSpec worldLatticeGrid(const std::string& field, const std::array<double, 3>& lo, const std::array<double, 3>& hi,
                           double voxel);
 
+// g with its origin moved down to OpenVDB's leaf lattice (a multiple of 8 voxels from the world
+// origin; at most 7 more points on each axis, at the same places): the sampler's 8^3 leaves and
+// tiles then are OpenVDB's, so the master copies leaves and sets tiles where a misaligned
+// lattice filled and pruned partial leaves (docs/sample_performance.md, "Leaf alignment").
+GridSpec leafAlignedGrid(const GridSpec& g);
+
 }  // namespace frep::io
