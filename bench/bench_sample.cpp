@@ -82,27 +82,30 @@ double denseSeconds(const TapePtr& tape, const GridSpec& g) {
 void report(const char* name, const Expr& model, const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
   auto tape = Tape::compile(model, 3);
   std::printf("\n%s: %zu tape instructions\n", name, tape->size());
-  std::printf("  %5s %5s %12s %12s %9s %9s %10s %10s %8s %9s\n", "res", "band", "point evals", "dense", "fraction",
-              "floor", "sparse s", "dense s", "speedup", "avg tape");
+  std::printf("  %5s %5s %5s %12s %12s %9s %9s %10s %10s %8s %9s\n", "res", "band", "block", "point evals", "dense",
+              "fraction", "floor", "sparse s", "dense s", "speedup", "avg tape");
   for (int res : {128, 256}) {
     GridSpec g = GridSpec::fromBounds(lo, hi, res);
     double dense = denseSeconds(tape, g);
-    for (int band : {1, 2, 3}) {
-      SampleOptions o;
-      o.bandVoxels = band;
-      o.threads = 1;  // single core on both sides of the ratio
-      auto t0 = std::chrono::steady_clock::now();
-      SampleResult r = sample(tape, g, o);
-      double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      double avgTape = r.stats.tapeBatches ? double(r.stats.tapeInstrs) / double(r.stats.tapeBatches) : 0;
-      // floor: the fraction a perfect sampler with the same guarantee needs (a voxel within
-      // band - 1 of a sign-change voxel is within band of both ends of that change)
-      double floorFraction = double(idealBand(tape, g, band)) / double(r.stats.denseEvals);
-      std::printf("  %5d %5d %12llu %12llu %8.2f%% %8.2f%% %10.3f %10.3f %7.1fx %9.1f\n", res, band,
-                  (unsigned long long)r.stats.pointEvals, (unsigned long long)r.stats.denseEvals,
-                  100.0 * double(r.stats.pointEvals) / double(r.stats.denseEvals), 100.0 * floorFraction, s, dense,
-                  dense / s, avgTape);
-    }
+    // block: SampleOptions::leafBlock, 2 (raw store, Python) or 4 (frep sample's distance stores)
+    for (int band : {1, 2, 3})
+      for (int block : {2, 4}) {
+        SampleOptions o;
+        o.bandVoxels = band;
+        o.leafBlock = block;
+        o.threads = 1;  // single core on both sides of the ratio
+        auto t0 = std::chrono::steady_clock::now();
+        SampleResult r = sample(tape, g, o);
+        double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        double avgTape = r.stats.tapeBatches ? double(r.stats.tapeInstrs) / double(r.stats.tapeBatches) : 0;
+        // floor: the fraction a perfect sampler with the same guarantee needs (a voxel within
+        // band - 1 of a sign-change voxel is within band of both ends of that change)
+        double floorFraction = double(idealBand(tape, g, band)) / double(r.stats.denseEvals);
+        std::printf("  %5d %5d %5d %12llu %12llu %8.2f%% %8.2f%% %10.3f %10.3f %7.1fx %9.1f\n", res, band, block,
+                    (unsigned long long)r.stats.pointEvals, (unsigned long long)r.stats.denseEvals,
+                    100.0 * double(r.stats.pointEvals) / double(r.stats.denseEvals), 100.0 * floorFraction, s, dense,
+                    dense / s, avgTape);
+      }
   }
 }
 

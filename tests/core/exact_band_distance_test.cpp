@@ -43,9 +43,10 @@ Expr boxMinusBall() {
 }
 
 SampleResult exactOf(const TapePtr& tape, const GridSpec& g, int band, std::array<int32_t, 3> lo = {0, 0, 0},
-                     std::array<int32_t, 3> hi = {-1, -1, -1}) {
+                     std::array<int32_t, 3> hi = {-1, -1, -1}, int leafBlock = 2) {
   SampleOptions opt;
   opt.bandVoxels = band;
+  opt.leafBlock = leafBlock;
   opt.regionLo = lo;
   opt.regionHi = hi;
   SampleResult r = sample(tape, g, opt);
@@ -96,28 +97,31 @@ TEST(ExactBandDistance, PlaneIsExact) {
   EXPECT_LT(e[1], 1e-6);
 }
 
+// For both leaf blocks (SampleOptions::leafBlock; frep sample's distance stores take 4).
 TEST(ExactBandDistance, SameForAnyRegionSplit) {
-  for (const Expr& model : {sphere(0.62), boxMinusBall(), box()}) {
-    auto tape = Tape::compile(model, 3);
-    GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 45);
-    SampleResult whole = exactOf(tape, g, 3);
-    std::map<std::array<int32_t, 3>, const LeafBlock*> ref;
-    for (const LeafBlock& l : whole.leaves) ref[l.origin] = &l;
-    for (int brick : {8, 16, 24}) {
-      std::map<std::array<int32_t, 3>, LeafBlock> split;
-      for (int32_t x = 0; x < g.dims[0]; x += brick)
-        for (int32_t y = 0; y < g.dims[1]; y += brick)
-          for (int32_t z = 0; z < g.dims[2]; z += brick)
-            for (LeafBlock& l : exactOf(tape, g, 3, {x, y, z}, {x + brick, y + brick, z + brick}).leaves)
-              split[l.origin] = l;
-      ASSERT_EQ(split.size(), ref.size()) << "brick " << brick;
-      for (const auto& [o, l] : split) {
-        ASSERT_TRUE(ref.count(o));
-        EXPECT_EQ(0, std::memcmp(l.values.data(), ref[o]->values.data(), sizeof l.values)) << "brick " << brick;
-        EXPECT_EQ(l.active, ref[o]->active) << "brick " << brick;
+  for (int leafBlock : {2, 4})
+    for (const Expr& model : {sphere(0.62), boxMinusBall(), box()}) {
+      SCOPED_TRACE("leaf block " + std::to_string(leafBlock));
+      auto tape = Tape::compile(model, 3);
+      GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 45);
+      SampleResult whole = exactOf(tape, g, 3, {0, 0, 0}, {-1, -1, -1}, leafBlock);
+      std::map<std::array<int32_t, 3>, const LeafBlock*> ref;
+      for (const LeafBlock& l : whole.leaves) ref[l.origin] = &l;
+      for (int brick : {8, 16, 24}) {
+        std::map<std::array<int32_t, 3>, LeafBlock> split;
+        for (int32_t x = 0; x < g.dims[0]; x += brick)
+          for (int32_t y = 0; y < g.dims[1]; y += brick)
+            for (int32_t z = 0; z < g.dims[2]; z += brick)
+              for (LeafBlock& l : exactOf(tape, g, 3, {x, y, z}, {x + brick, y + brick, z + brick}, leafBlock).leaves)
+                split[l.origin] = l;
+        ASSERT_EQ(split.size(), ref.size()) << "brick " << brick;
+        for (const auto& [o, l] : split) {
+          ASSERT_TRUE(ref.count(o));
+          EXPECT_EQ(0, std::memcmp(l.values.data(), ref[o]->values.data(), sizeof l.values)) << "brick " << brick;
+          EXPECT_EQ(l.active, ref[o]->active) << "brick " << brick;
+        }
       }
     }
-  }
 }
 
 TEST(ExactBandDistance, BallAndBoxNearTheirDistances) {

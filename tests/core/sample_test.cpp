@@ -44,11 +44,12 @@ Dense dense(const TapePtr& tape, const GridSpec& g) {
 using Key = std::array<int32_t, 3>;
 
 // Checks the sampler's output voxel by voxel against the dense grid.
-void checkAgainstDense(const Expr& model, int res, int band) {
+void checkAgainstDense(const Expr& model, int res, int band, int leafBlock = 2) {
   auto tape = Tape::compile(model, 3);
   GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, res);
   SampleOptions opt;
   opt.bandVoxels = band;
+  opt.leafBlock = leafBlock;
   SampleResult r = sample(tape, g, opt);
   Dense d = dense(tape, g);
 
@@ -122,6 +123,12 @@ TEST(Sample, BoxMinusSphereMatchesDenseEvaluationAt128) { checkAgainstDense(boxM
 
 TEST(Sample, NarrowBandOfOneVoxel) { checkAgainstDense(boxMinusSphere(), 70, 1); }
 
+// The distance stores' 4^3 blocks (SampleOptions::leafBlock): the same guarantee, more points.
+TEST(Sample, FourCubedBlocksKeepTheGuarantee) {
+  checkAgainstDense(sphere(0.05, -0.1, 0.02, 0.8), 96, 3, 4);
+  checkAgainstDense(boxMinusSphere(), 70, 1, 4);
+}
+
 TEST(Sample, CostFollowsTheSurface) {
   auto tape = Tape::compile(sphere(0, 0, 0, 0.8), 3);
   GridSpec g = GridSpec::fromBounds({-1, -1, -1}, {1, 1, 1}, 256);
@@ -169,6 +176,11 @@ TEST(Sample, RejectsBadInput) {
   SampleOptions unaligned;
   unaligned.regionLo = {3, 0, 0};
   EXPECT_THROW(sample(tape, g, unaligned), std::invalid_argument);
+  for (int block : {0, 1, 3, 8}) {
+    SampleOptions b;
+    b.leafBlock = block;
+    EXPECT_THROW(sample(tape, g, b), std::invalid_argument) << block;
+  }
   auto tape4 = Tape::compile(sphere(0, 0, 0, 1) - square(Expr::x(3)), 4);
   EXPECT_THROW(sample(tape4, g), std::invalid_argument);
   EXPECT_THROW(GridSpec::fromBounds({1, 0, 0}, {0, 1, 1}, 16), std::invalid_argument);

@@ -73,6 +73,10 @@ BrickOutput computeBrickOnce(const TapePtr& tape, const JobSpec& job, const std:
   // The distance reads values from the neighbouring bricks' halo: extremum values must then be
   // functions of their point alone (cold searches), or the split would show in the output.
   if (job.distance() && !tape->extrema().empty()) opt.pointwiseSearches = true;
+  // The distance stores keep a voxel active only where its distance is in the band, so the
+  // leaves are classified in 4^3 blocks (SampleOptions::leafBlock); raw keeps every evaluated
+  // voxel, so there 2^3 blocks keep the evaluated ones near a possible zero.
+  if (job.distance()) opt.leafBlock = 4;
   const GridSpec grid = gridOf(job);
   SampleResult r = sample(tape, grid, opt);
   if (job.distance()) {

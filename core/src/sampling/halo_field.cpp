@@ -12,8 +12,9 @@ namespace frep::detail {
 namespace {
 
 // Evaluates the points of a box of the halo that the sampler evaluates when it samples the
-// brick they belong to: a point's value is computed when the interval of f over its 2^3 block
-// (on the lattice's 2-grid, clipped to the grid) and the band around it may hold a zero. Blocks
+// brick they belong to: a point's value is computed when the interval of f over its block of
+// SampleOptions::leafBlock^3 (on the lattice's grid of that step, clipped to the grid) and the
+// band around it may hold a zero. Blocks
 // of 8^3 around them, and the box, are classified first (a larger box's interval holds the
 // smaller's: interval arithmetic is inclusion-monotone), so the same points are evaluated.
 class HaloSampler {
@@ -40,13 +41,14 @@ class HaloSampler {
           if (decided(*boxTape, {bx, by, bz}, {up(bx + 8, 8, 0), up(by + 8, 8, 1), up(bz + 8, 8, 2)})) continue;
           const TapePtr blockTape = interval_.pruned(boxTape);
           todo_.clear();
-          for (int64_t ex = std::max(bx, down(lo[0], 2)); ex < std::min(bx + 8, hi[0]); ex += 2)
-            for (int64_t ey = std::max(by, down(lo[1], 2)); ey < std::min(by + 8, hi[1]); ey += 2)
-              for (int64_t ez = std::max(bz, down(lo[2], 2)); ez < std::min(bz + 8, hi[2]); ez += 2) {
-                if (decided(*blockTape, {ex, ey, ez}, {up(ex + 2, 2, 0), up(ey + 2, 2, 1), up(ez + 2, 2, 2)})) continue;
-                for (int64_t x = std::max(ex, lo[0]); x < std::min(ex + 2, hi[0]); ++x)
-                  for (int64_t y = std::max(ey, lo[1]); y < std::min(ey + 2, hi[1]); ++y)
-                    for (int64_t z = std::max(ez, lo[2]); z < std::min(ez + 2, hi[2]); ++z) todo_.push_back({x, y, z});
+          const int64_t e = opt_.leafBlock;  // the sampler's smallest block
+          for (int64_t ex = std::max(bx, down(lo[0], e)); ex < std::min(bx + 8, hi[0]); ex += e)
+            for (int64_t ey = std::max(by, down(lo[1], e)); ey < std::min(by + 8, hi[1]); ey += e)
+              for (int64_t ez = std::max(bz, down(lo[2], e)); ez < std::min(bz + 8, hi[2]); ez += e) {
+                if (decided(*blockTape, {ex, ey, ez}, {up(ex + e, e, 0), up(ey + e, e, 1), up(ez + e, e, 2)})) continue;
+                for (int64_t x = std::max(ex, lo[0]); x < std::min(ex + e, hi[0]); ++x)
+                  for (int64_t y = std::max(ey, lo[1]); y < std::min(ey + e, hi[1]); ++y)
+                    for (int64_t z = std::max(ez, lo[2]); z < std::min(ez + e, hi[2]); ++z) todo_.push_back({x, y, z});
               }
           evaluate(*blockTape, f, value, evaluated);
         }

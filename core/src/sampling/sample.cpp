@@ -4,8 +4,9 @@
 // A cube is classified with interval arithmetic over the box of grid points within bandVoxels
 // of it (the "dilated" box): entirely positive -> inside tile, entirely negative -> outside
 // tile, else it is split (its tape pruned to what the box decided). An 8^3 leaf is split once
-// more into 4^3 and then 2^3 blocks; only points of the 2^3 blocks that stay ambiguous are
-// evaluated (one batch per leaf, with the leaf's pruned tape). Values never depend on the
+// more into 4^3 and then (SampleOptions::leafBlock 2) 2^3 blocks; only points of the smallest
+// blocks that stay ambiguous are evaluated (one batch per leaf, with the leaf's pruned tape).
+// Values never depend on the
 // pruning (a pruned tape is bit-identical to the full tape inside its box), and the leaf-level
 // decisions only depend on the leaf's own boxes, so results are deterministic for any thread
 // count.
@@ -61,6 +62,8 @@ class Sampler {
       throw std::invalid_argument("sample: grid dimensions must be positive");
     if (!(grid.voxel > 0)) throw std::invalid_argument("sample: voxel size must be positive");
     if (opt.bandVoxels < 0) throw std::invalid_argument("sample: band must be >= 0 voxels");
+    if (opt.leafBlock != 2 && opt.leafBlock != 4)
+      throw std::invalid_argument("sample: leafBlock must be 2 or 4 voxels, got " + std::to_string(opt.leafBlock));
     if (nvars_ > 3 && opt.fixedCoords.size() < nvars_ - 3)
       throw std::invalid_argument("sample: model has " + std::to_string(nvars_) +
                                   " coordinates; give values for x[4..] (fixedCoords)");
@@ -205,7 +208,8 @@ class Sampler {
     }
   }
 
-  // One 8^3 leaf: classify 4^3 and 2^3 sub-blocks, evaluate the points of ambiguous 2^3 blocks.
+  // One 8^3 leaf: classify 4^3 blocks and (leafBlock 2) their 2^3 blocks, evaluate the points of
+  // the smallest ambiguous ones.
   void leaf(Worker& w, const std::array<int64_t, 3>& o, const TapePtr& tape) {
     Box3 lb;
     if (!clip(o, kLeafDim, lb)) return;
@@ -239,6 +243,10 @@ class Sampler {
         fillSign(qx, qy, qz, 4, int8_t(qc));
         continue;
       }
+      if (opt_.leafBlock == 4) {
+        addPoints(o, qb, sign, todo.data(), ntodo);
+        continue;
+      }
       for (int e = 0; e < 8; ++e) {
         int ex = qx + ((e >> 2) & 1) * 2, ey = qy + ((e >> 1) & 1) * 2, ez = qz + (e & 1) * 2;
         Box3 eb;
@@ -248,18 +256,24 @@ class Sampler {
           fillSign(ex, ey, ez, 2, int8_t(ec));
           continue;
         }
-        for (int64_t x = eb[0]; x <= eb[3]; ++x)
-          for (int64_t y = eb[1]; y <= eb[4]; ++y)
-            for (int64_t z = eb[2]; z <= eb[5]; ++z) {
-              int off = leafOffset(int(x - o[0]), int(y - o[1]), int(z - o[2]));
-              sign[off] = 0;
-              todo[ntodo++] = uint16_t(off);
-            }
+        addPoints(o, eb, sign, todo.data(), ntodo);
       }
     }
     for (int i = 0; i < kLeafVoxels; ++i) blk.values[i] = sign[i] > 0 ? background_ : outsideValue_;
     evaluatePoints(w, blk, *leafTape, todo.data(), ntodo);
     w.leaves.push_back(blk);
+  }
+
+  // The points of block b (inclusive indices) of the leaf at o, to be evaluated.
+  static void addPoints(const std::array<int64_t, 3>& o, const Box3& b, std::array<int8_t, kLeafVoxels>& sign,
+                        uint16_t* todo, size_t& ntodo) {
+    for (int64_t x = b[0]; x <= b[3]; ++x)
+      for (int64_t y = b[1]; y <= b[4]; ++y)
+        for (int64_t z = b[2]; z <= b[5]; ++z) {
+          const int off = leafOffset(int(x - o[0]), int(y - o[1]), int(z - o[2]));
+          sign[size_t(off)] = 0;
+          todo[ntodo++] = uint16_t(off);
+        }
   }
 
   void evaluatePoints(Worker& w, LeafBlock& blk, const Tape& tape, const uint16_t* todo, size_t n) {

@@ -8,7 +8,8 @@
 // where f is linear, and where f is quadratic along straight gradient lines (a ball's
 // r^2 - |x|^2, an exact distance); elsewhere an estimate of second order in the voxel, not a
 // certified bound. The halo's values are evaluated exactly where the sampler evaluates them in
-// the neighbouring brick (same 2^3 blocks, same band), so the result is the same for any split.
+// the neighbouring brick (same blocks, SampleOptions::leafBlock, same band), so the result is the
+// same for any split.
 #pragma once
 
 #include <cstdint>
