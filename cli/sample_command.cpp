@@ -88,10 +88,9 @@ int runSample(const SampleRequest& request) {
       grown.hi[a] = cutHi[a] + margin;
     }
     grid = io::worldLatticeGrid("-b/--bounds", grown.lo, grown.hi, grid.voxel);
-    checkJobSize(grid, options.brickVoxels);
   }
   grid = io::leafAlignedGrid(grid);  // after the cut box: the cut stays the requested box's
-  checkJobSize(grid, options.brickVoxels);
+  checkJobSize(grid, options.brickVoxels);  // the grid as sampled: grown by the cut, then aligned
   farm::JobSpec job = makeJob(m, request.model.path, grid, "sample");
   job.set_band(request.band);
   // The workers store the band's distance: the estimate (--store sdf, fog) or the exact distance

@@ -66,7 +66,7 @@ void addLeaf(openvdb::FloatGrid::Accessor& acc, const LeafBlock& block, const op
     float* values = leaf->buffer().data();
     for (int n = 0; n < kLeafVoxels; ++n) values[n] = -block.values[size_t(n)];  // negative inside
     openvdb::FloatTree::LeafNodeType::NodeMaskType mask;
-    for (int w = 0; w < kLeafVoxels / 64; ++w) mask.template getWord<uint64_t>(openvdb::Index(w)) = block.active[size_t(w)];
+    for (int w = 0; w < kLeafVoxels / 64; ++w) mask.getWord<uint64_t>(openvdb::Index(w)) = block.active[size_t(w)];
     leaf->setValueMask(mask);
     return;
   }

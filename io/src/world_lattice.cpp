@@ -29,7 +29,7 @@ GridSpec leafAlignedGrid(const GridSpec& g) {
   GridSpec a = g;
   for (int k = 0; k < 3; ++k) {
     const int64_t index = std::llround(g.origin[k] / g.voxel);
-    const int64_t below = index - (index & ~int64_t(7));  // 0..7, also for negative indices
+    const int64_t below = index & 7;  // 0..7, also for negative indices (two's complement)
     a.origin[k] = double(index - below) * g.voxel;
     a.dims[k] = g.dims[k] + int32_t(below);
   }

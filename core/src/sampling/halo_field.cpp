@@ -14,9 +14,9 @@ namespace {
 // Evaluates the points of a box of the halo that the sampler evaluates when it samples the
 // brick they belong to: a point's value is computed when the interval of f over its block of
 // SampleOptions::leafBlock^3 (on the lattice's grid of that step, clipped to the grid) and the
-// band around it may hold a zero. Blocks
-// of 8^3 around them, and the box, are classified first (a larger box's interval holds the
-// smaller's: interval arithmetic is inclusion-monotone), so the same points are evaluated.
+// band around it may hold a zero. Blocks of 8^3 around them, and the box, are classified first
+// (a larger box's interval holds the smaller's: interval arithmetic is inclusion-monotone), so
+// the same points are evaluated.
 class HaloSampler {
  public:
   HaloSampler(const GridSpec& g, const SampleOptions& opt, uint32_t nvars, BandDistanceStats& st)

@@ -6,10 +6,9 @@
 // tile, else it is split (its tape pruned to what the box decided). An 8^3 leaf is split once
 // more into 4^3 and then (SampleOptions::leafBlock 2) 2^3 blocks; only points of the smallest
 // blocks that stay ambiguous are evaluated (one batch per leaf, with the leaf's pruned tape).
-// Values never depend on the
-// pruning (a pruned tape is bit-identical to the full tape inside its box), and the leaf-level
-// decisions only depend on the leaf's own boxes, so results are deterministic for any thread
-// count.
+// Values never depend on the pruning (a pruned tape is bit-identical to the full tape inside its
+// box), and the leaf-level decisions only depend on the leaf's own boxes, so results are
+// deterministic for any thread count.
 #include "frep/sampling/sample.h"
 
 #include <tbb/enumerable_thread_specific.h>
