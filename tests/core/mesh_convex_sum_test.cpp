@@ -22,6 +22,7 @@
 #include "frep/minkowski_algebra/mesh_convex_sum.h"
 #include "frep/minkowski_algebra/registry.h"
 #include "frep/primitives/ops.h"
+#include "frep/sampling/sample.h"
 
 using namespace frep;
 namespace mc = mesh_checks;
@@ -286,14 +287,20 @@ TEST(MeshConvexSum, TetrahedronErodedByABoxIsTheShrunkTetrahedron) {
   EXPECT_FALSE(minkowski::meshConvexDifference(min(X(), Y()), axisBox(clo, chi), 3, &none));
 }
 
+// L ⊕ C and L ⊖ C for the L prism of height 0.4 and a small box C (the tests of classes,
+// bounds and signs-only sampling).
+static bool lPrismSumAndDifference(Expr& sum, Expr& diff) {
+  const V3 clo{-0.1, -0.2, -0.15}, chi{0.3, 0.05, 0.1};
+  return minkowski::meshConvexSum(axisBox(clo, chi), mesh_models::lPrismMesh(0.4), 3, &sum) &&
+         minkowski::meshConvexDifference(mesh_models::lPrismMesh(0.4), axisBox(clo, chi), 3, &diff);
+}
+
 TEST(MeshConvexSum, SignOnlyBatchesClassifyEveryPointAsTheValues) {
   // The simplifier's batches ask only inside/outside (BatchEvaluator::setFieldSignsOnly): the
   // sum skips its distance to the boundary pieces there, and must keep every class, of the sum
   // and of the difference (whose inside is the negated outside).
-  const V3 clo{-0.1, -0.2, -0.15}, chi{0.3, 0.05, 0.1};
   Expr sum, diff;
-  ASSERT_TRUE(minkowski::meshConvexSum(axisBox(clo, chi), mesh_models::lPrismMesh(0.4), 3, &sum));
-  ASSERT_TRUE(minkowski::meshConvexDifference(mesh_models::lPrismMesh(0.4), axisBox(clo, chi), 3, &diff));
+  ASSERT_TRUE(lPrismSumAndDifference(sum, diff));
   for (const Expr* e : {&sum, &diff}) {
     TapePtr tape = Tape::compile(*e, 3);
     BatchEvaluator<double> values, signs;
@@ -326,6 +333,97 @@ TEST(MeshConvexSum, SignOnlyBatchesClassifyEveryPointAsTheValues) {
     EXPECT_GT(in, 20);
     EXPECT_GT(out, 20);
     EXPECT_GT(cheaper, 20);  // the distance was skipped, not computed anyway
+  }
+}
+
+TEST(MeshConvexSum, IntervalBoundsCertifySignsAndHoldOutsideValues) {
+  // The sampler's boxes (DistanceField::bound: f(c) +- the half-diagonal). Inside, the sum's
+  // value is a lower bound of the depth, not 1-Lipschitz across cells, so a bound certifies
+  // signs only (0 excluded: every point of the box on that side); where the centre is outside
+  // it also holds every value (minus the distance, exact, and inside points are at most
+  // r - dist(c) deep). Points: corners, centre, random; the sum and the difference; boxes clear
+  // of the surface must be decided. (A bound from the gap to the boundary pieces' leaf boxes,
+  // with no distance at the centre, measured no faster on bunny ⊕ tetrahedral tool.)
+  Expr sum, diff;
+  ASSERT_TRUE(lPrismSumAndDifference(sum, diff));
+  for (const Expr* e : {&sum, &diff}) {
+    TapePtr tape = Tape::compile(*e, 3);
+    IntervalEvaluator ie;
+    std::mt19937 rng(21);
+    std::uniform_real_distribution<double> u(-1.5, 3.5), size(0.005, 0.6), unit(0, 1);
+    // Random boxes, then small ones about a point deep inside (L ⊕ C: the corner block; L ⊖ C:
+    // the first bar's middle, 0.075 deep).
+    const V3 deep = e == &sum ? V3{0.5, 0.5, 0.2} : V3{0.8, 0.5, 0.225};
+    std::uniform_real_distribution<double> near(-0.03, 0.03), small(0.003, 0.02);
+    int decidedIn = 0, decidedOut = 0, enclosed = 0;
+    for (int i = 0; i < 1800; ++i) {
+      const bool inner = i >= 1500;
+      const V3 c = inner ? V3{deep[0] + near(rng), deep[1] + near(rng), deep[2] + 0.5 * near(rng)}
+                         : V3{u(rng), u(rng), 0.5 * u(rng)};
+      const double h = inner ? small(rng) : size(rng);
+      Interval box[3];
+      for (int k = 0; k < 3; ++k) box[k] = Interval(c[size_t(k)] - h, c[size_t(k)] + h * (0.5 + unit(rng)));
+      const Interval b = ie.eval(*tape, box);
+      ASSERT_LE(b.lo, b.hi);
+      V3 mid;
+      for (int k = 0; k < 3; ++k) mid[size_t(k)] = 0.5 * (box[k].lo + box[k].hi);
+      // The centre outside the sum (of A, or of A^c for the difference, whose values are negated).
+      const bool outsideCentre = (e == &sum ? eval(*e, mid) : -eval(*e, mid)) < 0;
+      enclosed += outsideCentre;
+      for (int j = 0; j < 24; ++j) {
+        V3 p;
+        for (int k = 0; k < 3; ++k) {
+          const double t = j < 8 ? double((j >> k) & 1) : j == 8 ? 0.5 : unit(rng);
+          p[size_t(k)] = box[k].lo + t * (box[k].hi - box[k].lo);
+        }
+        const double f = eval(*e, p);
+        if (b.lo > 0) ASSERT_GE(f, 0) << p[0] << " " << p[1] << " " << p[2] << " box " << i;
+        if (b.hi < 0) ASSERT_LT(f, 0) << p[0] << " " << p[1] << " " << p[2] << " box " << i;
+        if (outsideCentre) {
+          ASSERT_GE(f, b.lo - 1e-12) << p[0] << " " << p[1] << " " << p[2] << " box " << i;
+          ASSERT_LE(f, b.hi + 1e-12) << p[0] << " " << p[1] << " " << p[2] << " box " << i;
+        }
+      }
+      decidedIn += b.lo > 0;
+      decidedOut += b.hi < 0;
+    }
+    EXPECT_GT(decidedIn, 50) << (e == &sum ? "sum" : "difference");
+    EXPECT_GT(decidedOut, 300);
+    EXPECT_GT(enclosed, 150);
+  }
+}
+
+TEST(MeshConvexSum, SamplerReadingSignsOnlyGivesEveryPointTheValuesClass) {
+  // The mesher samples with SampleOptions::fieldSignsOnly: the sum's class, not its distance
+  // outside. The same leaves, tiles and active voxels as a sample of the values, every stored
+  // value of the same class, and outside values that are not the distance (the cheap path ran);
+  // the sum and the difference.
+  Expr sum, diff;
+  ASSERT_TRUE(lPrismSumAndDifference(sum, diff));
+  const GridSpec grid = GridSpec::fromBounds({-0.4, -0.4, -0.4}, {2.6, 2.6, 0.8}, 72);
+  for (const Expr* e : {&sum, &diff}) {
+    TapePtr tape = Tape::compile(*e, 3);
+    SampleOptions values, signs;
+    values.bandVoxels = signs.bandVoxels = 1;
+    signs.fieldSignsOnly = true;
+    const SampleResult a = sample(tape, grid, values), b = sample(tape, grid, signs);
+    ASSERT_EQ(a.leaves.size(), b.leaves.size());
+    ASSERT_EQ(a.tiles.size(), b.tiles.size());
+    size_t checked = 0, cheaper = 0;
+    for (size_t i = 0; i < a.leaves.size(); ++i) {
+      ASSERT_EQ(a.leaves[i].origin, b.leaves[i].origin);
+      ASSERT_EQ(a.leaves[i].active, b.leaves[i].active);
+      for (size_t v = 0; v < kLeafVoxels; ++v) {
+        if (!(a.leaves[i].active[v >> 6] >> (v & 63) & 1)) continue;
+        if (a.leaves[i].values[v] == 0) continue;  // on the surface either class is right
+        ASSERT_EQ(a.leaves[i].values[v] >= 0, b.leaves[i].values[v] >= 0) << "leaf " << i << " voxel " << v;
+        ++checked;
+        cheaper += a.leaves[i].values[v] != b.leaves[i].values[v];
+      }
+    }
+    for (size_t i = 0; i < a.tiles.size(); ++i) ASSERT_EQ(a.tiles[i].inside, b.tiles[i].inside);
+    EXPECT_GT(checked, 10000u);
+    EXPECT_GT(cheaper, 1000u);
   }
 }
 

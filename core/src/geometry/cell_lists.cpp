@@ -16,23 +16,6 @@ CellLattice CellLattice::over(const double lo[3], const double hi[3], int cells,
   return l;
 }
 
-bool CellLattice::cellOf(const double* p, uint64_t& key, int64_t ijk[3]) const {
-  for (int k = 0; k < 3; ++k) {
-    const double u = std::floor((p[k] - origin[k]) * inverse);
-    if (!(u >= 0 && u < double(1 << 20))) return false;
-    ijk[k] = int64_t(u);
-  }
-  key = uint64_t(ijk[0]) | uint64_t(ijk[1]) << 20 | uint64_t(ijk[2]) << 40;
-  return true;
-}
-
-void CellLattice::cellBox(const int64_t ijk[3], double lo[3], double hi[3]) const {
-  for (int k = 0; k < 3; ++k) {
-    lo[k] = origin[k] + double(ijk[k]) * size;
-    hi[k] = origin[k] + double(ijk[k] + 1) * size;
-  }
-}
-
 uint64_t CellLists::newOwner() {
   static std::atomic<uint64_t> next{1};
   return next++;

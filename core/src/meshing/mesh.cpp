@@ -155,6 +155,7 @@ struct CellOutput {
   std::vector<std::array<EdgeKey, 4>> quads;
   uint64_t cellsVisited = 0, cellsCrossed = 0, directEvals = 0;
   PointEvaluator point;
+  BatchEvaluator<double> signs;  // one lane, the sampler's class of a field result
 };
 
 struct RootWorker {
@@ -200,6 +201,7 @@ class RegionMesher {
     so.bandVoxels = extremumPath ? 0 : 1;
     so.pointwiseSearches = extremumPath;  // signs that do not depend on the region
     so.extremumSignsOnly = extremumPath;  // ... and only signs: searches stop once theirs is known
+    so.fieldSignsOnly = true;             // a field result's class, not its distance
     so.tilesCoverCells = true;            // every crossed cell starts in a leaf, whatever the band
     so.fixedCoords = opt_.fixedCoords;
     so.threads = opt_.threads;
@@ -362,7 +364,13 @@ class RegionMesher {
     auto w = grid_.world(i, j, k);
     for (uint32_t v = 0; v < nvars_; ++v) px[v] = v < 3 ? w[v] : opt_.fixedCoords[v - 3];
     ++out.directEvals;
-    return insideValue(out.point.eval(*tape_, px));
+    // The class the sampler gives the point (fieldSignsOnly), whichever region holds it; a
+    // tape with extrema keeps the point evaluator (its cold search, as pointwiseSearches).
+    if (tape_->hasExtrema() || tape_->fields().empty()) return insideValue(out.point.eval(*tape_, px));
+    out.signs.reserve(*tape_);
+    out.signs.setFieldSignsOnly(true);
+    for (uint32_t v = 0; v < nvars_; ++v) out.signs.in(v)[0] = px[v];
+    return insideValue(out.signs.eval(*tape_, 1)[0]);
   }
 
   void leafCells(CellOutput& out, const LeafBlock& leaf) {

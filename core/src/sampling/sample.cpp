@@ -281,6 +281,7 @@ class Sampler {
     w.batch.countDomainErrors(&w.stats.domainErrors);
     w.batch.setExtremumWarmStarts(!opt_.pointwiseSearches);
     w.batch.setExtremumSignsOnly(opt_.pointwiseSearches && opt_.extremumSignsOnly);
+    w.batch.setFieldSignsOnly(opt_.fieldSignsOnly);
     for (size_t start = 0; start < n; start += B) {
       size_t count = std::min(B, n - start);
       for (size_t k = 0; k < count; ++k) {

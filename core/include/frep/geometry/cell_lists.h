@@ -39,9 +39,24 @@ struct CellLattice {
   double size = 1, inverse = 1;  // inverse = 1 / size
   // The lattice over a box [lo, hi]: `cells` along its longest side, `margin` cells around it.
   static CellLattice over(const double lo[3], const double hi[3], int cells, int margin);
-  // The key of the cell holding p and its indices; false outside 2^20 cells a side.
-  bool cellOf(const double* p, uint64_t& key, int64_t ijk[3]) const;
-  void cellBox(const int64_t ijk[3], double lo[3], double hi[3]) const;
+  // The key of the cell holding p and its indices; false outside 2^20 cells a side. Inline and
+  // without std::floor (a libm call on baseline x86-64): a class query asks this up to three
+  // times. For u >= 0, truncation is the floor; u < 0 or NaN fails the test either way.
+  bool cellOf(const double* p, uint64_t& key, int64_t ijk[3]) const {
+    for (int k = 0; k < 3; ++k) {
+      const double u = (p[k] - origin[k]) * inverse;
+      if (!(u >= 0 && u < double(1 << 20))) return false;
+      ijk[k] = int64_t(u);
+    }
+    key = uint64_t(ijk[0]) | uint64_t(ijk[1]) << 20 | uint64_t(ijk[2]) << 40;
+    return true;
+  }
+  void cellBox(const int64_t ijk[3], double lo[3], double hi[3]) const {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = origin[k] + double(ijk[k]) * size;
+      hi[k] = origin[k] + double(ijk[k] + 1) * size;
+    }
+  }
 };
 
 class CellLists {
